@@ -1,0 +1,219 @@
+/*
+ * gcs-skin — skin deformation by generalized cross-sections (Li, Wang, Mao), with the
+ * classic cross-section model, linear blend skinning and dual quaternions as references.
+ *
+ * The C API of the core. One header documents every parameter's contract.
+ *
+ * Life cycle (ozz-animation style: an offline "raw → runtime" builder, then per-frame jobs):
+ *   1. gcs_rig_create()      validates and copies a skinned mesh + skeleton (the raw input).
+ *   2. gcs_build_*()         builds a runtime deformer from a rig (GCS, classic, LBS, DQS).
+ *                            A deformer keeps no pointer to the rig: the rig may be destroyed.
+ *   3. gcs_deformer_deform() once per frame, from J skinning matrices; writes positions and
+ *                            normals into arrays owned by the deformer (no allocation).
+ *   4. gcs_deformer_destroy(), gcs_rig_destroy().
+ *
+ * Errors: every function that can fail returns 0 (or a null handle) and records an error code
+ * (GcsError) and an English sentence, read by gcs_last_error_code()/gcs_last_error_message().
+ * A successful call sets the code to GCS_OK. A rejected call never changes the object it was
+ * given: the object stays usable.
+ *
+ * Conventions: matrices are column-major float[16] (glTF, three.js, GLM). Positions and normals
+ * are float[3] per vertex, interleaved (x, y, z). Indices are uint32 triangle lists.
+ * Pointers handed out (positions, normals, indices, …) point into wasm memory: they stay valid
+ * until the owning object is destroyed, but JavaScript views on them die when memory grows.
+ */
+#ifndef GCS_SKIN_H
+#define GCS_SKIN_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum GcsError {
+  GCS_OK = 0,
+  GCS_ERR_INVALID_ARGUMENT = 1,   /* a null pointer, a bad enum value, a bad handle */
+  GCS_ERR_LENGTH_MISMATCH = 2,    /* array lengths that do not agree with each other */
+  GCS_ERR_INDEX_OUT_OF_RANGE = 3, /* a triangle index >= vertex count */
+  GCS_ERR_JOINT_OUT_OF_RANGE = 4, /* a skin joint id or a parent id out of range, or a cycle */
+  GCS_ERR_NON_FINITE = 5,         /* NaN or infinity in positions, normals, weights, matrices */
+  GCS_ERR_BAD_WEIGHTS = 6,        /* negative weights, or a vertex whose weights sum to 0 */
+  GCS_ERR_SECTION_COUNT = 7,      /* section count outside [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS] */
+  GCS_ERR_ZERO_LENGTH_BONE = 8,   /* a part whose proximal and distal joints coincide */
+  GCS_ERR_OUT_OF_RANGE = 9,       /* another numeric parameter outside its documented range */
+  GCS_ERR_NO_SKIN = 10,           /* no vertices, no triangles or no joints */
+  GCS_ERR_OUT_OF_MEMORY = 11,     /* an allocation failed (wasm memory cannot grow further) */
+  GCS_ERR_DEGENERATE = 12         /* the input cannot be processed at all (e.g. no part can be resampled) */
+} GcsError;
+
+#define GCS_MIN_SECTIONS 3
+#define GCS_MAX_SECTIONS 256
+#define GCS_MAX_JOINTS 1024
+#define GCS_MAX_VERTICES 16777216
+
+/* ---------------------------------------------------------------- errors and memory */
+
+/* The code of the last call's outcome (GCS_OK after a successful call). */
+int gcs_last_error_code(void);
+/* The sentence describing the last error, NUL-terminated, owned by the library ("" when OK). */
+const char* gcs_last_error_message(void);
+
+/* Scratch memory for handing arrays across the JS boundary. Returns 0 on failure. */
+void* gcs_alloc(uint32_t bytes);
+void gcs_free(void* pointer);
+
+/* ---------------------------------------------------------------- rig (raw input) */
+
+typedef struct GcsRig GcsRig;
+
+/*
+ * Validates and copies a skinned mesh and its skeleton.
+ *   positions        vertexCount × 3 floats, bind-pose positions in mesh space; finite.
+ *   normals          vertexCount × 3 floats, or null (then computed, area-weighted); finite.
+ *   vertexCount      1 .. GCS_MAX_VERTICES.
+ *   indices          indexCount uint32, a triangle list; each < vertexCount.
+ *   indexCount       a multiple of 3, at least 3.
+ *   joints           vertexCount × 4 joint ids (uint32), each < jointCount where its weight > 0.
+ *   weights          vertexCount × 4 floats, ≥ 0, finite, sum > 0 (normalised on copy).
+ *   parents          jointCount int32: the parent joint id, or -1 for a root; no cycles.
+ *   inverseBind      jointCount × 16 floats (column-major): glTF inverse bind matrices,
+ *                    mapping mesh space to joint space in the bind pose; invertible, finite.
+ *   jointCount       1 .. GCS_MAX_JOINTS.
+ * Returns a rig handle, or null with the error recorded.
+ */
+GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount,
+                       const uint32_t* indices, uint32_t indexCount,
+                       const uint32_t* joints, const float* weights,
+                       const int32_t* parents, const float* inverseBind, uint32_t jointCount);
+void gcs_rig_destroy(GcsRig* rig);
+uint32_t gcs_rig_vertex_count(const GcsRig* rig);
+uint32_t gcs_rig_joint_count(const GcsRig* rig);
+/* Model height: the largest extent of the bind-pose bounding box. */
+float gcs_rig_height(const GcsRig* rig);
+
+/* ---------------------------------------------------------------- deformers (runtime) */
+
+typedef struct GcsDeformer GcsDeformer;
+
+typedef enum GcsCriterion {
+  GCS_CRITERION_Y = 0,     /* the paper's: bin by the bind-pose Y coordinate */
+  GCS_CRITERION_AXIAL = 1  /* ours: bin by the projection on the bone axis (works in T-pose) */
+} GcsCriterion;
+
+typedef enum GcsDeformerKind {
+  GCS_KIND_GCS = 0,
+  GCS_KIND_CLASSIC = 1,
+  GCS_KIND_LBS = 2,
+  GCS_KIND_DQS = 3
+} GcsDeformerKind;
+
+/*
+ * Builds a generalized cross-section model from a rig.
+ *   sections        sections per part (2 shared sections + sections−2 inner), in
+ *                   [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS].
+ *   criterion       a GcsCriterion.
+ *   influenceWidth  fraction of a part over which joint influence ramps, in (0, 1]; 1 = the paper.
+ *   smooth          nonzero: each vertex blends the two nearest sections' transforms.
+ *   twistSpread     nonzero: a joint's twist about its bone is spread along the child part.
+ * The output mesh is the rig's vertices reordered section by section (see
+ * gcs_deformer_source_vertex) with the rig's triangles remapped (gcs_deformer_indices).
+ */
+GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
+                           float influenceWidth, int smooth, int twistSpread);
+/* Linear blend skinning and dual-quaternion skinning; output in the rig's vertex order. */
+GcsDeformer* gcs_build_lbs(const GcsRig* rig);
+GcsDeformer* gcs_build_dqs(const GcsRig* rig);
+
+void gcs_deformer_destroy(GcsDeformer* deformer);
+uint32_t gcs_deformer_kind(const GcsDeformer* deformer);
+
+/*
+ * Deforms for one frame.
+ *   skinMatrices   jointCount × 16 floats: S_j = posed world · inverse bind, column-major,
+ *                  mapping bind-pose mesh space to posed mesh space; finite.
+ *   jointCount     must equal the rig's joint count.
+ * Writes positions and normals (the arrays below). Returns 1, or 0 with the error recorded
+ * (then the output arrays keep the previous frame).
+ */
+int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount);
+
+/* The output mesh. Arrays are owned by the deformer and stay at the same address for its life. */
+uint32_t gcs_deformer_vertex_count(const GcsDeformer* deformer);
+float* gcs_deformer_positions(GcsDeformer* deformer);   /* vertexCount × 3 */
+float* gcs_deformer_normals(GcsDeformer* deformer);     /* vertexCount × 3 */
+uint32_t gcs_deformer_index_count(const GcsDeformer* deformer);
+const uint32_t* gcs_deformer_indices(const GcsDeformer* deformer);
+/* For each output vertex, the rig vertex it comes from; null for resampled (classic) vertices
+   that come from no rig vertex (there, see gcs_deformer_source_part). */
+const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* deformer);
+
+/*
+ * Per-deformer statistics (a float per query; unknown queries return NaN, no error).
+ *   GCS_STAT_SECTIONS          number of sections (GCS), contours (classic), 0 otherwise
+ *   GCS_STAT_PARTS             number of parts
+ *   GCS_STAT_ADJUSTED_SHARE    last frame: share of sections whose transform is not their part's
+ *                              rigid transform (moves a vertex by > 0.1 % of model height)
+ *   GCS_STAT_BUILD_MS          not measured in C++ (no clock import); always 0
+ */
+typedef enum GcsStat {
+  GCS_STAT_SECTIONS = 0,
+  GCS_STAT_PARTS = 1,
+  GCS_STAT_ADJUSTED_SHARE = 2,
+  GCS_STAT_ADJUSTED_SECTIONS = 3
+} GcsStat;
+float gcs_deformer_stat(const GcsDeformer* deformer, uint32_t stat);
+
+/*
+ * GCS introspection (for colouring by section, tests and metrics).
+ *   gcs_gcs_section_of_vertex   output vertexCount uint32: section id of each output vertex.
+ *   gcs_gcs_section_info        sectionCount × 8 floats per section:
+ *                               [first vertex, vertex count, part joint, distal joint or -1,
+ *                                kind (0 inner, 1 shared section), mean t, alpha, beta]
+ * Null for deformers that are not GCS.
+ */
+const uint32_t* gcs_gcs_section_of_vertex(const GcsDeformer* deformer);
+const float* gcs_gcs_section_info(const GcsDeformer* deformer);
+/* The transform (16 floats, column-major) of each section in the last frame; sectionCount × 16. */
+const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
+
+
+/* ---------------------------------------------------------------- classic cross-sections */
+
+#define GCS_CLASSIC_MIN_CONTOURS 2
+#define GCS_CLASSIC_MAX_CONTOURS 256
+#define GCS_CLASSIC_MIN_RAYS 3
+#define GCS_CLASSIC_MAX_RAYS 256
+#define GCS_CLASSIC_MAX_BULGE 4.0f
+
+/*
+ * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994): each
+ * cylinder-like part is resampled into `contours` planes × `rays` star rays; other parts are
+ * carried rigidly with their original triangles.
+ *   contours  contours per resampled part, in [GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS].
+ *   rays      rays per contour, in [GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_MAX_RAYS].
+ *   bulge     muscle bulge gain b in [0, GCS_CLASSIC_MAX_BULGE]: radii scale by
+ *             1 + b · flex · sin(π t), flex = joint bend / π.
+ * Its output mesh is its own (own vertices, own triangles).
+ */
+GcsDeformer* gcs_build_classic(const GcsRig* rig, uint32_t contours, uint32_t rays, float bulge);
+/* Changes the bulge gain of a classic deformer without rebuilding. Returns 1, or 0 on error. */
+int gcs_classic_set_bulge(GcsDeformer* deformer, float bulge);
+/*
+ * Per-part report of a classic model: partCount × 4 int32 per part:
+ *   [joint id, resampled (1) or carried rigidly (0), first output vertex, output vertex count].
+ * gcs_classic_part_count gives partCount. Null for other deformers.
+ */
+uint32_t gcs_classic_part_count(const GcsDeformer* deformer);
+const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
+/*
+ * Detail loss of resampling: distance from each original vertex of a resampled part to the
+ * resampled surface, as a percentage of model height. which = 0: RMS, 1: max. NaN for others.
+ */
+float gcs_classic_detail_loss(const GcsDeformer* deformer, uint32_t which);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GCS_SKIN_H */

@@ -1,0 +1,149 @@
+// The C API (gcs_skin.h): argument checks, error recording, and nothing else.
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include "../include/gcs_skin.h"
+#include "error.h"
+#include "gcs_model.h"
+#include "reference_deformers.h"
+#include "rig.h"
+
+struct GcsRig {
+  gcs::Rig rig;
+};
+
+using gcs::fail;
+
+extern "C" {
+
+int gcs_last_error_code(void) { return gcs::lastErrorCode(); }
+const char* gcs_last_error_message(void) { return gcs::lastErrorMessage(); }
+
+void* gcs_alloc(uint32_t bytes) {
+  gcs::clearError();
+  void* p = std::malloc(bytes ? bytes : 1);
+  if (!p) fail(GCS_ERR_OUT_OF_MEMORY, "out of memory: could not allocate %u bytes", bytes);
+  return p;
+}
+void gcs_free(void* pointer) { std::free(pointer); }
+
+GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount,
+                       const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,
+                       const float* weights, const int32_t* parents, const float* inverseBind,
+                       uint32_t jointCount) {
+  gcs::clearError();
+  GcsRig* handle = new (std::nothrow) GcsRig();
+  if (!handle) {
+    fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while creating a rig");
+    return nullptr;
+  }
+  if (!gcs::buildRig(positions, normals, vertexCount, indices, indexCount, joints, weights,
+                     parents, inverseBind, jointCount, handle->rig)) {
+    delete handle;
+    return nullptr;
+  }
+  return handle;
+}
+
+void gcs_rig_destroy(GcsRig* rig) { delete rig; }
+uint32_t gcs_rig_vertex_count(const GcsRig* rig) { return rig ? rig->rig.vertexCount : 0; }
+uint32_t gcs_rig_joint_count(const GcsRig* rig) { return rig ? rig->rig.jointCount : 0; }
+float gcs_rig_height(const GcsRig* rig) { return rig ? rig->rig.height : 0.0f; }
+
+static GcsDeformer* wrap(gcs::Deformer* impl) {
+  if (!impl) return nullptr;
+  GcsDeformer* handle = new (std::nothrow) GcsDeformer{impl};
+  if (!handle) {
+    delete impl;
+    fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while creating a deformer");
+  }
+  return handle;
+}
+
+static bool checkRig(const GcsRig* rig) {
+  if (!rig) return fail(GCS_ERR_INVALID_ARGUMENT, "the rig is null (destroyed or never created)");
+  return true;
+}
+
+GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
+                           float influenceWidth, int smooth, int twistSpread) {
+  gcs::clearError();
+  if (!checkRig(rig)) return nullptr;
+  gcs::GcsSettings settings;
+  settings.sections = sections;
+  settings.criterion = GcsCriterion(criterion);
+  settings.influenceWidth = influenceWidth;
+  settings.smooth = smooth != 0;
+  settings.twistSpread = twistSpread != 0;
+  return wrap(gcs::buildGcs(rig->rig, settings));
+}
+
+GcsDeformer* gcs_build_lbs(const GcsRig* rig) {
+  gcs::clearError();
+  if (!checkRig(rig)) return nullptr;
+  return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_LBS));
+}
+
+GcsDeformer* gcs_build_dqs(const GcsRig* rig) {
+  gcs::clearError();
+  if (!checkRig(rig)) return nullptr;
+  return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_DQS));
+}
+
+void gcs_deformer_destroy(GcsDeformer* deformer) {
+  if (!deformer) return;
+  delete deformer->impl;
+  delete deformer;
+}
+
+uint32_t gcs_deformer_kind(const GcsDeformer* deformer) {
+  return deformer ? uint32_t(deformer->impl->kind()) : 0xffffffffu;
+}
+
+int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  if (!skinMatrices) return fail(GCS_ERR_INVALID_ARGUMENT, "the skin matrices are null");
+  gcs::Deformer& d = *deformer->impl;
+  if (jointCount != d.jointCount)
+    return fail(GCS_ERR_LENGTH_MISMATCH, "got %u skin matrices, but the rig has %u joints", jointCount, d.jointCount);
+  for (uint32_t i = 0; i < jointCount * 16; ++i)
+    if (!std::isfinite(skinMatrices[i]))
+      return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u contains NaN or infinity", i / 16);
+  // glm::mat4 is 16 floats, column-major, no padding: the array can be read in place.
+  static_assert(sizeof(glm::mat4) == 16 * sizeof(float), "glm::mat4 must be 16 packed floats");
+  d.deform(reinterpret_cast<const glm::mat4*>(skinMatrices));
+  return 1;
+}
+
+uint32_t gcs_deformer_vertex_count(const GcsDeformer* d) { return d ? d->impl->vertexCount : 0; }
+float* gcs_deformer_positions(GcsDeformer* d) { return d ? d->impl->positions.data() : nullptr; }
+float* gcs_deformer_normals(GcsDeformer* d) { return d ? d->impl->normals.data() : nullptr; }
+uint32_t gcs_deformer_index_count(const GcsDeformer* d) { return d ? uint32_t(d->impl->indices.size()) : 0; }
+const uint32_t* gcs_deformer_indices(const GcsDeformer* d) { return d ? d->impl->indices.data() : nullptr; }
+const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* d) {
+  return d && !d->impl->sourceVertex.empty() ? d->impl->sourceVertex.data() : nullptr;
+}
+
+float gcs_deformer_stat(const GcsDeformer* d, uint32_t stat) {
+  return d ? d->impl->stat(GcsStat(stat)) : std::nanf("");
+}
+
+static const gcs::GcsDeformerImpl* asGcs(const GcsDeformer* d) {
+  return d && d->impl->kind() == GCS_KIND_GCS ? static_cast<const gcs::GcsDeformerImpl*>(d->impl) : nullptr;
+}
+
+const uint32_t* gcs_gcs_section_of_vertex(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g ? g->sectionOfVertex.data() : nullptr;
+}
+const float* gcs_gcs_section_info(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g ? g->sectionInfo.data() : nullptr;
+}
+const float* gcs_gcs_section_matrices(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g ? &g->sectionMatrices[0][0][0] : nullptr;
+}
+
+}  // extern "C"

@@ -1,0 +1,38 @@
+// The runtime side: a deformer owns its output mesh and fills it once per frame.
+#pragma once
+#include <cstdint>
+#include <vector>
+#include <glm/glm.hpp>
+#include "../include/gcs_skin.h"
+
+namespace gcs {
+
+class Deformer {
+ public:
+  virtual ~Deformer() = default;
+  virtual GcsDeformerKind kind() const = 0;
+  // skin: jointCount matrices S_j, already validated (count and finiteness) by the caller.
+  virtual void deform(const glm::mat4* skin) = 0;
+  virtual float stat(GcsStat which) const;
+
+  uint32_t jointCount = 0;
+  uint32_t vertexCount = 0;
+  // One spare float at the end of each array: the SIMD path stores 4 lanes per vertex.
+  std::vector<float> positions;
+  std::vector<float> normals;
+  std::vector<uint32_t> indices;
+  std::vector<uint32_t> sourceVertex;  // empty when output vertices have no single source
+
+  void allocateOutput(uint32_t count) {
+    vertexCount = count;
+    positions.assign(size_t(count) * 3 + 1, 0.0f);
+    normals.assign(size_t(count) * 3 + 1, 0.0f);
+  }
+};
+
+}  // namespace gcs
+
+// The opaque handle of the C API is the C++ object.
+struct GcsDeformer {
+  gcs::Deformer* impl;
+};

@@ -1,0 +1,71 @@
+// The generalized cross-section (GCS) model: build once per mesh and setting, deform per frame.
+// design.md §2–3; the paper's sections 3.1–3.2.
+#pragma once
+#include <cstdint>
+#include <vector>
+#include <glm/glm.hpp>
+#include "deformer.h"
+#include "rig.h"
+#include "transform.h"
+
+namespace gcs {
+
+struct GcsSettings {
+  uint32_t sections = 6;                    // per part: 2 shared + sections−2 inner
+  GcsCriterion criterion = GCS_CRITERION_AXIAL;
+  float influenceWidth = 1.0f;              // (0, 1]
+  bool smooth = false;
+  bool twistSpread = false;
+};
+
+// One generalized section: a run of output vertices that share one transform per frame,
+//   M = S_parent · D_part^(alpha, tau) · D_distal^beta      (parent < 0: M = S_part · D_distal^beta)
+struct Section {
+  uint32_t first = 0, count = 0;  // output vertex run
+  uint32_t part = 0;              // joint owning the part (for a shared section: the child part)
+  int32_t parent = -1;            // the part's parent part joint, or -1 (root part)
+  int32_t distal = -1;            // the child part joint this section's branch leads to, or -1
+  bool shared = false;            // a shared generalized section (SGS) between part and parent
+  float t = 0.0f;                 // mean normalised axial coordinate, 0 proximal … 1 distal
+  float alpha = 1.0f, beta = 0.0f, tau = 1.0f;
+  glm::vec3 centre{0.0f};         // bind-pose bounding sphere, for the "adjusted" test
+  float radius = 0.0f;
+};
+
+struct PartInfo {
+  int32_t parent = -1;            // parent part joint or -1
+  glm::vec3 twistAxis{0.0f, 1.0f, 0.0f};
+  bool isPart = false;
+};
+
+class GcsDeformerImpl final : public Deformer {
+ public:
+  GcsDeformerKind kind() const override { return GCS_KIND_GCS; }
+  void deform(const glm::mat4* skin) override;
+  float stat(GcsStat which) const override;
+
+  GcsSettings settings;
+  std::vector<Section> sections;
+  std::vector<PartInfo> parts;          // indexed by joint
+  std::vector<glm::vec3> jointCentres;  // bind pose
+  uint32_t partCount = 0;
+  std::vector<float> restPositions;     // output order, interleaved
+  std::vector<float> restNormals;
+  std::vector<uint32_t> sectionOfVertex;
+  std::vector<float> sectionInfo;       // 8 floats per section (see gcs_skin.h)
+  // Smooth mode: per output vertex, two sections and the blend factor towards the second.
+  std::vector<uint32_t> blendA, blendB;
+  std::vector<float> blendF;
+  float adjustTolerance = 0.0f;
+
+  // Per-frame state, allocated at build time.
+  std::vector<Motion> motions;          // D_j per part joint
+  std::vector<glm::quat> swings, twists;
+  std::vector<glm::mat4> sectionMatrices;
+  uint32_t adjustedSections = 0;
+};
+
+// Builds the GCS model of a rig. Returns null with the error recorded on failure.
+GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings);
+
+}  // namespace gcs

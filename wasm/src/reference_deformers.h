@@ -1,0 +1,27 @@
+// Linear blend skinning and dual-quaternion skinning on the rig's own vertices: the baselines.
+#pragma once
+#include "deformer.h"
+#include "rig.h"
+
+namespace gcs {
+
+class SkinningDeformer final : public Deformer {
+ public:
+  explicit SkinningDeformer(GcsDeformerKind k) : kind_(k) {}
+  GcsDeformerKind kind() const override { return kind_; }
+  void deform(const glm::mat4* skin) override;
+  float stat(GcsStat which) const override;
+
+  std::vector<float> restPositions, restNormals;
+  std::vector<glm::uvec4> joints;
+  std::vector<glm::vec4> weights;
+  // Per-frame scratch, allocated at build time: per joint, a dual quaternion (DQS).
+  std::vector<glm::vec4> real, dual;
+
+ private:
+  GcsDeformerKind kind_;
+};
+
+SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind);
+
+}  // namespace gcs

@@ -1,0 +1,159 @@
+#include "rig.h"
+#include <cmath>
+#include <new>
+#include "error.h"
+
+namespace gcs {
+
+bool allFinite(const float* values, size_t count) {
+  for (size_t i = 0; i < count; ++i)
+    if (!std::isfinite(values[i])) return false;
+  return true;
+}
+
+uint32_t Rig::dominantJoint(uint32_t v) const {
+  const glm::vec4& w = weights[v];
+  int best = 0;
+  for (int i = 1; i < 4; ++i)
+    if (w[i] > w[best]) best = i;
+  return joints[v][best];
+}
+
+void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+                    std::vector<glm::vec3>& normals) {
+  normals.assign(positions.size(), glm::vec3(0.0f));
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const glm::vec3& a = positions[indices[t]];
+    const glm::vec3& b = positions[indices[t + 1]];
+    const glm::vec3& c = positions[indices[t + 2]];
+    glm::vec3 n = glm::cross(b - a, c - a);  // length = 2 · area: area weighting for free
+    normals[indices[t]] += n;
+    normals[indices[t + 1]] += n;
+    normals[indices[t + 2]] += n;
+  }
+  for (glm::vec3& n : normals) {
+    float len = glm::length(n);
+    n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+  }
+}
+
+static bool validateParents(const int32_t* parents, uint32_t jointCount) {
+  for (uint32_t j = 0; j < jointCount; ++j) {
+    int32_t p = parents[j];
+    if (p < -1 || p >= int32_t(jointCount) || p == int32_t(j))
+      return fail(GCS_ERR_JOINT_OUT_OF_RANGE,
+                  "joint %u has parent %d, but parents must be -1 or another joint id below %u",
+                  j, p, jointCount);
+  }
+  // Cycle check: walking up from any joint must reach a root within jointCount steps.
+  for (uint32_t j = 0; j < jointCount; ++j) {
+    int32_t p = parents[j];
+    for (uint32_t steps = 0; p != -1; ++steps) {
+      if (steps > jointCount)
+        return fail(GCS_ERR_JOINT_OUT_OF_RANGE,
+                    "the joint hierarchy has a cycle through joint %u", j);
+      p = parents[p];
+    }
+  }
+  return true;
+}
+
+bool buildRig(const float* positions, const float* normals, uint32_t vertexCount,
+              const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,
+              const float* weights, const int32_t* parents, const float* inverseBind,
+              uint32_t jointCount, Rig& rig) {
+  if (!positions || !indices || !joints || !weights || !parents || !inverseBind)
+    return fail(GCS_ERR_INVALID_ARGUMENT,
+                "positions, indices, joints, weights, parents and inverse bind matrices are all required");
+  if (vertexCount == 0) return fail(GCS_ERR_NO_SKIN, "the mesh has no vertices");
+  if (vertexCount > GCS_MAX_VERTICES)
+    return fail(GCS_ERR_OUT_OF_RANGE, "the mesh has %u vertices; at most %u are supported",
+                vertexCount, unsigned(GCS_MAX_VERTICES));
+  if (jointCount == 0) return fail(GCS_ERR_NO_SKIN, "the skeleton has no joints");
+  if (jointCount > GCS_MAX_JOINTS)
+    return fail(GCS_ERR_OUT_OF_RANGE, "the skeleton has %u joints; at most %u are supported",
+                jointCount, unsigned(GCS_MAX_JOINTS));
+  if (indexCount == 0) return fail(GCS_ERR_NO_SKIN, "the mesh has no triangles");
+  if (indexCount % 3 != 0)
+    return fail(GCS_ERR_LENGTH_MISMATCH,
+                "the index count %u is not a multiple of 3 (a triangle list is expected)", indexCount);
+  if (!allFinite(positions, size_t(vertexCount) * 3))
+    return fail(GCS_ERR_NON_FINITE, "a vertex position is NaN or infinite");
+  if (normals && !allFinite(normals, size_t(vertexCount) * 3))
+    return fail(GCS_ERR_NON_FINITE, "a vertex normal is NaN or infinite");
+  if (!allFinite(inverseBind, size_t(jointCount) * 16))
+    return fail(GCS_ERR_NON_FINITE, "an inverse bind matrix contains NaN or infinity");
+  for (uint32_t i = 0; i < indexCount; ++i)
+    if (indices[i] >= vertexCount)
+      return fail(GCS_ERR_INDEX_OUT_OF_RANGE,
+                  "triangle index %u (at position %u) is out of range: the mesh has %u vertices",
+                  indices[i], i, vertexCount);
+  if (!validateParents(parents, jointCount)) return false;
+
+  try {
+    rig = Rig();
+    rig.vertexCount = vertexCount;
+    rig.jointCount = jointCount;
+    rig.positions.resize(vertexCount);
+    rig.joints.resize(vertexCount);
+    rig.weights.resize(vertexCount);
+    for (uint32_t v = 0; v < vertexCount; ++v) {
+      rig.positions[v] = glm::vec3(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+      float sum = 0.0f;
+      for (int i = 0; i < 4; ++i) {
+        float w = weights[4 * v + i];
+        uint32_t j = joints[4 * v + i];
+        if (!std::isfinite(w)) return fail(GCS_ERR_NON_FINITE, "the skin weights of vertex %u are NaN or infinite", v);
+        if (w < 0.0f) return fail(GCS_ERR_BAD_WEIGHTS, "vertex %u has a negative skin weight (%g)", v, double(w));
+        if (w > 0.0f && j >= jointCount)
+          return fail(GCS_ERR_JOINT_OUT_OF_RANGE,
+                      "vertex %u is skinned to joint %u, but the skeleton has %u joints", v, j, jointCount);
+        rig.joints[v][i] = w > 0.0f ? j : 0u;  // unused slots point at joint 0 with weight 0
+        rig.weights[v][i] = w;
+        sum += w;
+      }
+      if (!(sum > 0.0f))
+        return fail(GCS_ERR_BAD_WEIGHTS, "vertex %u has no skin weight (its weights sum to 0)", v);
+      rig.weights[v] /= sum;
+    }
+    rig.indices.assign(indices, indices + indexCount);
+    if (normals) {
+      rig.normals.resize(vertexCount);
+      for (uint32_t v = 0; v < vertexCount; ++v) {
+        glm::vec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+        float len = glm::length(n);
+        rig.normals[v] = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+      }
+    } else {
+      computeNormals(rig.positions, rig.indices, rig.normals);
+    }
+    rig.parents.assign(parents, parents + jointCount);
+    rig.inverseBind.resize(jointCount);
+    rig.bind.resize(jointCount);
+    rig.jointCentres.resize(jointCount);
+    for (uint32_t j = 0; j < jointCount; ++j) {
+      glm::mat4 m;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) m[c][r] = inverseBind[16 * j + 4 * c + r];
+      float det = glm::determinant(m);
+      if (!(std::fabs(det) > 1e-12f))
+        return fail(GCS_ERR_NON_FINITE, "the inverse bind matrix of joint %u is not invertible", j);
+      rig.inverseBind[j] = m;
+      rig.bind[j] = glm::inverse(m);
+      rig.jointCentres[j] = glm::vec3(rig.bind[j][3]);
+    }
+    rig.boundsMin = rig.boundsMax = rig.positions[0];
+    for (const glm::vec3& p : rig.positions) {
+      rig.boundsMin = glm::min(rig.boundsMin, p);
+      rig.boundsMax = glm::max(rig.boundsMax, p);
+    }
+    glm::vec3 extent = rig.boundsMax - rig.boundsMin;
+    rig.height = glm::max(extent.x, glm::max(extent.y, extent.z));
+    if (!(rig.height > 0.0f)) return fail(GCS_ERR_DEGENERATE, "all vertices are at the same point");
+  } catch (const std::bad_alloc&) {
+    return fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while copying the rig (%u vertices)", vertexCount);
+  }
+  return true;
+}
+
+}  // namespace gcs
