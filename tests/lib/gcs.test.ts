@@ -1,0 +1,252 @@
+// The GCS method on analytic rigs (design.md §2–3): the ω schedule, exact rest pose, seams,
+// criteria, smooth mode and twist spread.
+import { beforeAll, describe, expect, test } from 'vitest';
+import * as THREE from 'three';
+import { initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
+import { makeTube, maxAbsDiff, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
+
+let gcs: GcsSkin;
+beforeAll(async () => {
+  gcs = await initGcsSkin();
+});
+
+const Z = new THREE.Vector3(0, 0, 1);
+
+function expectMatrixClose(actual: ArrayLike<number>, expected: THREE.Matrix4, tol = 1e-5) {
+  expect(maxAbsDiff(actual, expected.elements)).toBeLessThan(tol);
+}
+
+describe('GCS on a two-bone tube', () => {
+  test('the rest pose returns the input exactly, positions and normals', () => {
+    const tube = makeTube();
+    const rig = gcs.createRig(tube.input);
+    for (const options of [{}, { smooth: true }, { twistSpread: true }, { criterion: 'y' as const, sections: 9 }]) {
+      const d = rig.buildGcs(options);
+      d.deform(tubeSkin(new THREE.Matrix4()));
+      const src = d.sourceVertex!;
+      const pos = d.positions;
+      const input = tube.input.positions as Float32Array;
+      for (let o = 0; o < d.vertexCount; o++)
+        for (let c = 0; c < 3; c++) expect(pos[3 * o + c]).toBe(input[3 * src[o] + c]);
+      d.dispose();
+    }
+    rig.dispose();
+  });
+
+  test('bent 90°: each section follows the ω schedule; the SGS turns by exactly half', () => {
+    const tube = makeTube();
+    const rig = gcs.createRig(tube.input);
+    const d = rig.buildGcs({ sections: 6 });
+    const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
+    d.deform(tubeSkin(bend));
+    const sections = d.sections();
+    const matrices = d.sectionMatrices();
+    expect(sections.length).toBe(2 * 4 + 1); // 2 parts × 4 inner sections + the one SGS between them
+    const shared = sections.filter((s) => s.shared);
+    expect(shared.length).toBe(1);
+    for (let i = 0; i < sections.length; i++) {
+      const s = sections[i];
+      const m = matrices.subarray(16 * i, 16 * i + 16);
+      // Fraction of the joint's 90° this section turns by.
+      let fraction: number;
+      if (s.shared) fraction = 0.5;
+      else if (s.part === 0) fraction = 0.5 * Math.min(1, Math.max(0, s.t)); // β ramp, w = 1
+      else fraction = 0.5 + 0.5 * Math.min(1, Math.max(0, s.t));             // α ramp, w = 1
+      if (s.shared) expect(s.alpha).toBe(0.5);
+      else if (s.part === 0) expect(s.beta).toBeCloseTo(fraction, 6);
+      else expect(s.alpha).toBeCloseTo(fraction, 6);
+      expectMatrixClose(m, rotationAbout(tube.joint, Z, fraction * Math.PI / 2));
+    }
+    // The schedule is monotone along the tube: α rises away from the joint, β rises towards it.
+    const part0 = sections.filter((s) => !s.shared && s.part === 0);
+    const part1 = sections.filter((s) => !s.shared && s.part === 1);
+    expect(part0.length).toBe(4);
+    expect(part1.length).toBe(4);
+    for (let i = 1; i < 4; i++) {
+      expect(part0[i].beta).toBeGreaterThan(part0[i - 1].beta);
+      expect(part1[i].alpha).toBeGreaterThan(part1[i - 1].alpha);
+    }
+    // Every vertex is its section's matrix applied to its rest position.
+    const pos = d.positions, src = d.sourceVertex!, of = d.sectionOfVertex();
+    const input = tube.input.positions as Float32Array;
+    const v = new THREE.Vector3();
+    for (let o = 0; o < d.vertexCount; o++) {
+      const m = new THREE.Matrix4().fromArray(matrices, 16 * of[o]);
+      v.fromArray(input, 3 * src[o]).applyMatrix4(m);
+      expect(Math.abs(pos[3 * o] - v.x) + Math.abs(pos[3 * o + 1] - v.y) + Math.abs(pos[3 * o + 2] - v.z)).toBeLessThan(1e-5);
+    }
+    expect(d.adjustedShare).toBeGreaterThan(0.5);
+    d.deform(tubeSkin(new THREE.Matrix4()));
+    expect(d.adjustedShare).toBe(0);
+    d.dispose();
+    rig.dispose();
+  });
+
+  test('sections outside the influence width are rigid', () => {
+    const tube = makeTube();
+    const rig = gcs.createRig(tube.input);
+    const w = 0.3;
+    const d = rig.buildGcs({ sections: 12, influenceWidth: w });
+    const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
+    d.deform(tubeSkin(bend));
+    const sections = d.sections();
+    const matrices = d.sectionMatrices();
+    let rigid = 0;
+    sections.forEach((s, i) => {
+      const m = matrices.subarray(16 * i, 16 * i + 16);
+      if (s.shared) return expectMatrixClose(m, rotationAbout(tube.joint, Z, Math.PI / 4));
+      if (s.part === 0 && s.t < 1 - w) { expectMatrixClose(m, new THREE.Matrix4()); rigid++; }
+      if (s.part === 1 && s.t > w) { expectMatrixClose(m, bend); rigid++; }
+      if (s.part === 0 && s.t > 1 - w) expect(s.beta).toBeGreaterThan(0);
+      if (s.part === 1 && s.t < w) expect(s.alpha).toBeLessThan(1);
+    });
+    expect(rigid).toBeGreaterThan(sections.length / 2);
+    d.dispose();
+    rig.dispose();
+  });
+
+  test('vertices at the same position (a UV seam) never separate: seam gap is exactly 0', () => {
+    const tube = makeTube({ seam: true });
+    const rig = gcs.createRig(tube.input);
+    for (const options of [{ sections: 5 }, { sections: 7, smooth: true }, { sections: 4, twistSpread: true }]) {
+      const d = rig.buildGcs(options);
+      d.deform(tubeSkin(rotationAbout(tube.joint, new THREE.Vector3(0.3, 0.2, 1), 2.0)));
+      const src = d.sourceVertex!, pos = d.positions, input = tube.input.positions as Float32Array;
+      const byKey = new Map<string, number[]>();
+      for (let o = 0; o < d.vertexCount; o++) {
+        const k = Array.from(input.subarray(3 * src[o], 3 * src[o] + 3)).join(',');
+        const prev = byKey.get(k);
+        if (prev) for (let c = 0; c < 3; c++) expect(pos[3 * o + c]).toBe(prev[c]);
+        else byKey.set(k, [pos[3 * o], pos[3 * o + 1], pos[3 * o + 2]]);
+      }
+      expect(byKey.size).toBe(tube.rings * tube.segments);
+      d.dispose();
+    }
+    rig.dispose();
+  });
+
+  test('Y criterion vs axial criterion on a horizontal limb', () => {
+    const tube = makeTube({ axis: 'x' });
+    const rig = gcs.createRig(tube.input);
+    const extentAlong = (criterion: 'y' | 'axial') => {
+      const d = rig.buildGcs({ sections: 6, criterion });
+      const src = d.sourceVertex!;
+      let widest = 0;
+      for (const s of d.sections().filter((x) => !x.shared)) {
+        let lo = Infinity, hi = -Infinity;
+        for (let o = s.first; o < s.first + s.count; o++) {
+          lo = Math.min(lo, tube.along[src[o]]);
+          hi = Math.max(hi, tube.along[src[o]]);
+        }
+        widest = Math.max(widest, hi - lo);
+      }
+      d.dispose();
+      return widest;
+    };
+    // Axial: each inner section is a slab of the limb (≤ a quarter of a part, plus a ring).
+    expect(extentAlong('axial')).toBeLessThan(0.3);
+    // Y: the bins slice the horizontal limb lengthwise, so a section runs along the whole part.
+    expect(extentAlong('y')).toBeGreaterThan(0.9);
+    rig.dispose();
+  });
+
+  test('smooth mode removes the banding of few sections', () => {
+    const tube = makeTube({ rings: 81 });
+    const rig = gcs.createRig(tube.input);
+    const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
+    // Largest change of direction between consecutive longitudinal edges of one column.
+    const maxKink = (smooth: boolean) => {
+      const d = rig.buildGcs({ sections: 4, smooth });
+      d.deform(tubeSkin(bend));
+      const out = new Float32Array(tube.input.positions.length);
+      const src = d.sourceVertex!, pos = d.positions;
+      for (let o = 0; o < d.vertexCount; o++) out.set(pos.subarray(3 * o, 3 * o + 3), 3 * src[o]);
+      const segs = tube.segments;
+      let worst = 0;
+      const p = (ring: number) => new THREE.Vector3().fromArray(out, 3 * ring * segs);
+      for (let i = 1; i + 1 < tube.rings; i++) {
+        const a = p(i).sub(p(i - 1)).normalize(), b = p(i + 1).sub(p(i)).normalize();
+        worst = Math.max(worst, a.angleTo(b));
+      }
+      d.dispose();
+      return worst;
+    };
+    const banded = maxKink(false), smooth = maxKink(true);
+    expect(banded).toBeGreaterThan(0.1);
+    expect(smooth).toBeLessThan(banded * 0.5);
+    rig.dispose();
+  });
+
+  test('twist spread: a 180° twist ramps along the child part and keeps the limb thick', () => {
+    const tube = makeTube({ band: 0.3 });
+    const rig = gcs.createRig(tube.input);
+    const twist = rotationAbout(tube.joint, tube.axis, Math.PI);
+    // Radius of each ring after deformation (distance of its vertices from the axis).
+    const ringRadius = (positions: Float32Array, src: Uint32Array | null, ring: number) => {
+      let sum = 0, n = 0;
+      for (let o = 0; o < positions.length / 3; o++) {
+        const v = src ? src[o] : o;
+        if (tube.ringOf[v] !== ring) continue;
+        sum += Math.hypot(positions[3 * o], positions[3 * o + 2]);
+        n++;
+      }
+      return sum / n;
+    };
+    const jointRing = Math.round((tube.rings - 1) / 2);
+    for (const twistSpread of [false, true]) {
+      const d = rig.buildGcs({ sections: 8, twistSpread });
+      d.deform(tubeSkin(twist));
+      const sections = d.sections();
+      const m = d.sectionMatrices();
+      const sgs = sections.findIndex((s) => s.shared);
+      // Angle the SGS turns by: 90° (half) in the paper's scheme, 0° with the twist spread out.
+      const q = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().fromArray(m, 16 * sgs));
+      const angle = 2 * Math.acos(Math.min(1, Math.abs(q.w)));
+      expect(angle).toBeCloseTo(twistSpread ? 0 : Math.PI / 2, 4);
+      if (twistSpread) {
+        // Along part 1 the twist grows with t: the last section turns by close to the full 180°.
+        const last = sections.reduce((best, s, i) => (s.part === 1 && !s.shared && s.t > sections[best].t ? i : best), sgs);
+        const ql = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().fromArray(m, 16 * last));
+        expect(2 * Math.acos(Math.min(1, Math.abs(ql.w)))).toBeGreaterThan(Math.PI * sections[last].t - 1e-3);
+      }
+      expect(ringRadius(d.positions, d.sourceVertex, jointRing)).toBeCloseTo(0.1, 5);
+      d.dispose();
+    }
+    // LBS collapses at the joint under the same twist (candy wrapper).
+    const lbs = rig.buildLbs();
+    lbs.deform(tubeSkin(twist));
+    expect(ringRadius(lbs.positions, null, jointRing)).toBeLessThan(0.02);
+    lbs.dispose();
+    rig.dispose();
+  });
+});
+
+describe('reference deformers against hand-computed values', () => {
+  test('LBS blends the joint matrices; DQS blends the rotations', () => {
+    const tube = makeTube({ band: 0.25 });
+    const rig = gcs.createRig(tube.input);
+    const lbs = rig.buildLbs();
+    const dqs = rig.buildDqs();
+    const angle = Math.PI / 2;
+    const bend = rotationAbout(tube.joint, Z, angle);
+    lbs.deform(tubeSkin(bend));
+    dqs.deform(tubeSkin(bend));
+    const input = tube.input.positions as Float32Array, weights = tube.input.weights as Float32Array;
+    const v = new THREE.Vector3(), a = new THREE.Vector3(), b = new THREE.Vector3();
+    for (let i = 0; i < lbs.vertexCount; i++) {
+      const w1 = weights[4 * i + 1];
+      v.fromArray(input, 3 * i);
+      // LBS: (1 − w) x + w S₁ x.
+      a.copy(v).multiplyScalar(1 - w1).add(b.copy(v).applyMatrix4(bend).multiplyScalar(w1));
+      expect(Math.abs(lbs.positions[3 * i] - a.x) + Math.abs(lbs.positions[3 * i + 1] - a.y)).toBeLessThan(1e-5);
+      // DQS of two rotations about one centre: the rotation by the blended angle about it.
+      const blendedAngle = 2 * Math.atan2(w1 * Math.sin(angle / 2), (1 - w1) + w1 * Math.cos(angle / 2));
+      a.copy(v).applyMatrix4(rotationAbout(tube.joint, Z, blendedAngle));
+      expect(Math.abs(dqs.positions[3 * i] - a.x) + Math.abs(dqs.positions[3 * i + 1] - a.y)).toBeLessThan(1e-5);
+    }
+    // At the joint (w = ½) LBS pulls the surface inwards by cos 45°, DQS does not.
+    lbs.dispose();
+    dqs.dispose();
+    rig.dispose();
+  });
+});

@@ -1,0 +1,472 @@
+/**
+ * gcs-skin: skin deformation by generalized cross-sections, in WebAssembly.
+ *
+ *   const gcs = await initGcsSkin();
+ *   const rig = gcs.createRig({ positions, indices, joints, weights, parents, inverseBindMatrices });
+ *   const deformer = rig.buildGcs({ sections: 8 });
+ *   deformer.deform(skinMatrices);          // every frame: J × 16 floats
+ *   deformer.positions / deformer.normals   // Float32Array views on wasm memory
+ *   deformer.dispose(); rig.dispose();
+ *
+ * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
+ * 'DISPOSED'. Every failure is a GcsError with a `code`.
+ */
+import { GcsError, type GcsErrorCode } from './errors.js';
+import { instantiateCore, type CoreExports, type WasmSource } from './loader.js';
+
+export { GcsError, type GcsErrorCode } from './errors.js';
+export type { WasmSource } from './loader.js';
+
+export const MIN_SECTIONS = 3;
+export const MAX_SECTIONS = 256;
+export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
+
+type ArrayLikeNumbers = ArrayLike<number>;
+
+/** A skinned mesh and its skeleton in the bind pose (glTF conventions). */
+export interface RigInput {
+  /** vertexCount × 3 bind-pose positions (mesh space). */
+  positions: ArrayLikeNumbers;
+  /** vertexCount × 3 normals; computed (area-weighted) when omitted. */
+  normals?: ArrayLikeNumbers | null;
+  /** Triangle list; each index < vertexCount. */
+  indices: ArrayLikeNumbers;
+  /** vertexCount × 4 joint ids (glTF JOINTS_0). */
+  joints: ArrayLikeNumbers;
+  /** vertexCount × 4 weights (glTF WEIGHTS_0); normalised on copy. */
+  weights: ArrayLikeNumbers;
+  /** jointCount parent ids, -1 for a root. */
+  parents: ArrayLikeNumbers;
+  /** jointCount × 16 column-major inverse bind matrices. */
+  inverseBindMatrices: ArrayLikeNumbers;
+}
+
+export type Criterion = 'y' | 'axial';
+
+export interface GcsOptions {
+  /** Sections per part (2 shared + sections−2 inner), 3..256. Default 6. */
+  sections?: number;
+  /** 'y': the paper's Y-coordinate criterion; 'axial' (default): projection on the bone axis. */
+  criterion?: Criterion;
+  /** Fraction of a part over which joint influence ramps, (0, 1]. Default 1 (the paper). */
+  influenceWidth?: number;
+  /** Each vertex blends the two nearest sections' transforms. Default false. */
+  smooth?: boolean;
+  /** Spread a joint's twist along the child part. Default false. */
+  twistSpread?: boolean;
+}
+
+export interface ClassicOptions {
+  /** Contours per resampled part, 2..256. Default 25. */
+  contours?: number;
+  /** Rays per contour, 3..256. Default 20. */
+  rays?: number;
+  /** Muscle bulge gain, 0..4. Default 0.3. */
+  bulge?: number;
+}
+
+export type DeformerKind = 'gcs' | 'classic' | 'lbs' | 'dqs';
+const KINDS: DeformerKind[] = ['gcs', 'classic', 'lbs', 'dqs'];
+
+export interface SectionInfo {
+  first: number;
+  count: number;
+  /** Joint owning the part (for a shared section: the child part). */
+  part: number;
+  /** Child part joint the section's branch leads to, or -1. */
+  distal: number;
+  /** A shared generalized section (SGS) between a part and its parent part. */
+  shared: boolean;
+  /** Mean normalised axial coordinate, 0 (proximal) … 1 (distal). */
+  t: number;
+  alpha: number;
+  beta: number;
+}
+
+export interface ClassicPart {
+  joint: number;
+  resampled: boolean;
+  firstVertex: number;
+  vertexCount: number;
+}
+
+/** Owns the instantiated core and the views on its memory. */
+export class GcsSkin {
+  /** @internal */ readonly core: CoreExports;
+  private f32 = new Float32Array(0);
+  private u32 = new Uint32Array(0);
+  private i32 = new Int32Array(0);
+  private u8 = new Uint8Array(0);
+
+  /** @internal */
+  constructor(core: CoreExports) {
+    this.core = core;
+    this.refreshViews();
+  }
+
+  /** The wasm memory; its `buffer` is replaced when it grows. */
+  get memory(): WebAssembly.Memory {
+    return this.core.memory;
+  }
+
+  /** @internal Re-creates heap views after memory growth (a grown memory detaches old views). */
+  refreshViews(): void {
+    const buffer = this.core.memory.buffer;
+    if (this.f32.buffer === buffer) return;
+    this.f32 = new Float32Array(buffer);
+    this.u32 = new Uint32Array(buffer);
+    this.i32 = new Int32Array(buffer);
+    this.u8 = new Uint8Array(buffer);
+  }
+
+  /** @internal A fresh Float32Array view of `length` floats at byte offset `ptr`. */
+  viewF32(ptr: number, length: number): Float32Array {
+    return new Float32Array(this.core.memory.buffer, ptr, length);
+  }
+  /** @internal */
+  viewU32(ptr: number, length: number): Uint32Array {
+    return new Uint32Array(this.core.memory.buffer, ptr, length);
+  }
+  /** @internal */
+  viewI32(ptr: number, length: number): Int32Array {
+    return new Int32Array(this.core.memory.buffer, ptr, length);
+  }
+
+  /** @internal Throws the core's last error as a GcsError. */
+  raise(fallback: string): never {
+    const code = this.core.gcs_last_error_code();
+    const message = this.readString(this.core.gcs_last_error_message()) || fallback;
+    throw new GcsError(GcsError.codeFromNumber(code), message);
+  }
+
+  private readString(ptr: number): string {
+    this.refreshViews();
+    let end = ptr;
+    while (this.u8[end] !== 0 && end < this.u8.length) end++;
+    return new TextDecoder().decode(this.u8.subarray(ptr, end));
+  }
+
+  /** @internal Copies numbers into a fresh wasm allocation; the caller frees it. */
+  copyIn(values: ArrayLikeNumbers, type: 'f32' | 'u32' | 'i32'): number {
+    const bytes = Math.max(4, values.length * 4);
+    const ptr = this.core.gcs_alloc(bytes);
+    if (!ptr) this.raise(`out of memory: could not allocate ${bytes} bytes`);
+    this.refreshViews();
+    const view = type === 'f32' ? this.f32 : type === 'u32' ? this.u32 : this.i32;
+    if (type === 'u32') {
+      // Negative or fractional ids must not wrap silently into valid ones: map them out of range.
+      for (let i = 0; i < values.length; i++) {
+        const v = values[i];
+        view[(ptr >> 2) + i] = Number.isInteger(v) && v >= 0 && v <= 0xffffffff ? v : 0xffffffff;
+      }
+    } else {
+      view.set(values as ArrayLike<number>, ptr >> 2);
+    }
+    return ptr;
+  }
+
+  /** Validates and copies a skinned mesh and its skeleton into wasm memory. */
+  createRig(input: RigInput): Rig {
+    if (!input || typeof input !== 'object') throw new GcsError('INVALID_ARGUMENT', 'createRig expects an object with positions, indices, joints, weights, parents and inverseBindMatrices');
+    for (const key of ['positions', 'indices', 'joints', 'weights', 'parents', 'inverseBindMatrices'] as const) {
+      const a = input[key];
+      if (!a || typeof a.length !== 'number') throw new GcsError('INVALID_ARGUMENT', `createRig: '${key}' is missing or not an array`);
+    }
+    const { positions, normals, indices, joints, weights, parents, inverseBindMatrices } = input;
+    if (positions.length % 3 !== 0) throw new GcsError('LENGTH_MISMATCH', `positions has ${positions.length} numbers, which is not a multiple of 3`);
+    const vertexCount = positions.length / 3;
+    const jointCount = parents.length;
+    if (vertexCount === 0) throw new GcsError('NO_SKIN', 'the mesh has no vertices');
+    if (jointCount === 0) throw new GcsError('NO_SKIN', 'the skeleton has no joints (parents is empty): is the mesh skinned?');
+    if (normals && normals.length !== positions.length)
+      throw new GcsError('LENGTH_MISMATCH', `normals has ${normals.length} numbers but positions has ${positions.length}`);
+    if (joints.length !== vertexCount * 4)
+      throw new GcsError('LENGTH_MISMATCH', `joints has ${joints.length} ids; 4 per vertex are expected (${vertexCount * 4})`);
+    if (weights.length !== vertexCount * 4)
+      throw new GcsError('LENGTH_MISMATCH', `weights has ${weights.length} numbers; 4 per vertex are expected (${vertexCount * 4})`);
+    if (inverseBindMatrices.length !== jointCount * 16)
+      throw new GcsError('LENGTH_MISMATCH', `inverseBindMatrices has ${inverseBindMatrices.length} numbers; 16 per joint are expected (${jointCount * 16}, from ${jointCount} parents)`);
+    for (let i = 0; i < indices.length; i++) {
+      const v = indices[i];
+      if (!Number.isInteger(v) || v < 0 || v >= vertexCount)
+        throw new GcsError('INDEX_OUT_OF_RANGE', `triangle index ${v} (at position ${i}) is out of range: the mesh has ${vertexCount} vertices`);
+    }
+    const ptrs: number[] = [];
+    try {
+      const p = this.copyIn(positions, 'f32'); ptrs.push(p);
+      const n = normals ? this.copyIn(normals, 'f32') : 0; if (n) ptrs.push(n);
+      const ix = this.copyIn(indices, 'u32'); ptrs.push(ix);
+      const jt = this.copyIn(joints, 'u32'); ptrs.push(jt);
+      const wt = this.copyIn(weights, 'f32'); ptrs.push(wt);
+      const pa = this.copyIn(parents, 'i32'); ptrs.push(pa);
+      const ib = this.copyIn(inverseBindMatrices, 'f32'); ptrs.push(ib);
+      const handle = this.core.gcs_rig_create(p, n, vertexCount, ix, indices.length, jt, wt, pa, ib, jointCount);
+      if (!handle) this.raise('the rig was rejected');
+      return new Rig(this, handle);
+    } finally {
+      for (const ptr of ptrs) this.core.gcs_free(ptr);
+    }
+  }
+}
+
+/** Loads the wasm core. `wasm` overrides where the binary comes from (default: beside this module). */
+export async function initGcsSkin(options: { wasm?: WasmSource } = {}): Promise<GcsSkin> {
+  let core: CoreExports;
+  try {
+    core = await instantiateCore(options.wasm);
+  } catch (e) {
+    throw new GcsError('WASM_LOAD', `could not load gcs-skin.wasm: ${(e as Error).message}`);
+  }
+  return new GcsSkin(core);
+}
+
+/** A validated skinned mesh in wasm memory: the input every deformer is built from. */
+export class Rig {
+  readonly vertexCount: number;
+  readonly jointCount: number;
+  /** Largest extent of the bind-pose bounding box (model units). */
+  readonly height: number;
+  private handle: number;
+
+  /** @internal */
+  constructor(readonly gcs: GcsSkin, handle: number) {
+    this.handle = handle;
+    this.vertexCount = gcs.core.gcs_rig_vertex_count(handle);
+    this.jointCount = gcs.core.gcs_rig_joint_count(handle);
+    this.height = gcs.core.gcs_rig_height(handle);
+  }
+
+  private live(): number {
+    if (!this.handle) throw new GcsError('DISPOSED', 'this rig has been disposed');
+    return this.handle;
+  }
+
+  /** Builds a generalized cross-section model (design.md §2). */
+  buildGcs(options: GcsOptions = {}): GcsDeformer {
+    const sections = options.sections ?? 6;
+    const criterion = options.criterion ?? 'axial';
+    const width = options.influenceWidth ?? 1;
+    if (!Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
+      throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${sections}`);
+    if (criterion !== 'y' && criterion !== 'axial')
+      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'y' or 'axial'; got '${String(criterion)}'`);
+    if (!(width > 0 && width <= 1))
+      throw new GcsError('OUT_OF_RANGE', `the influence width must be in (0, 1]; got ${width}`);
+    const h = this.gcs.core.gcs_build_gcs(this.live(), sections, criterion === 'y' ? 0 : 1, width,
+      options.smooth ? 1 : 0, options.twistSpread ? 1 : 0);
+    if (!h) this.gcs.raise('the GCS model could not be built');
+    return new GcsDeformer(this.gcs, h, this.jointCount);
+  }
+
+  /** Builds the classic cross-section model (design.md §4). */
+  buildClassic(options: ClassicOptions = {}): ClassicDeformer {
+    const contours = options.contours ?? 25;
+    const rays = options.rays ?? 20;
+    const bulge = options.bulge ?? 0.3;
+    const L = CLASSIC_LIMITS;
+    if (!Number.isInteger(contours) || contours < L.minContours || contours > L.maxContours)
+      throw new GcsError('OUT_OF_RANGE', `contours must be a whole number between ${L.minContours} and ${L.maxContours}; got ${contours}`);
+    if (!Number.isInteger(rays) || rays < L.minRays || rays > L.maxRays)
+      throw new GcsError('OUT_OF_RANGE', `rays must be a whole number between ${L.minRays} and ${L.maxRays}; got ${rays}`);
+    if (!(bulge >= 0 && bulge <= L.maxBulge))
+      throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${L.maxBulge}; got ${bulge}`);
+    const h = this.gcs.core.gcs_build_classic(this.live(), contours, rays, bulge);
+    if (!h) this.gcs.raise('the classic cross-section model could not be built');
+    return new ClassicDeformer(this.gcs, h, this.jointCount);
+  }
+
+  /** Linear blend skinning (what three.js does), on the rig's own vertices. */
+  buildLbs(): Deformer {
+    const h = this.gcs.core.gcs_build_lbs(this.live());
+    if (!h) this.gcs.raise('the LBS deformer could not be built');
+    return new Deformer(this.gcs, h, this.jointCount);
+  }
+
+  /** Dual-quaternion skinning, on the rig's own vertices. */
+  buildDqs(): Deformer {
+    const h = this.gcs.core.gcs_build_dqs(this.live());
+    if (!h) this.gcs.raise('the DQS deformer could not be built');
+    return new Deformer(this.gcs, h, this.jointCount);
+  }
+
+  /** Builds a deformer by kind name. */
+  build(kind: DeformerKind, options: GcsOptions & ClassicOptions = {}): Deformer {
+    switch (kind) {
+      case 'gcs': return this.buildGcs(options);
+      case 'classic': return this.buildClassic(options);
+      case 'lbs': return this.buildLbs();
+      case 'dqs': return this.buildDqs();
+      default: throw new GcsError('INVALID_ARGUMENT', `unknown deformer kind '${String(kind)}' (gcs, classic, lbs, dqs)`);
+    }
+  }
+
+  /** Frees the rig's wasm memory. Deformers built from it stay valid. */
+  dispose(): void {
+    if (this.handle) this.gcs.core.gcs_rig_destroy(this.handle);
+    this.handle = 0;
+  }
+}
+
+/** A runtime deformer: owns its output mesh in wasm memory and fills it every frame. */
+export class Deformer {
+  readonly kind: DeformerKind;
+  readonly vertexCount: number;
+  readonly jointCount: number;
+  protected handle: number;
+  private positionsPtr: number;
+  private normalsPtr: number;
+  private skinPtr: number;
+  private positionsView: Float32Array;
+  private normalsView: Float32Array;
+  private skinView: Float32Array;
+
+  /** @internal */
+  constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
+    const core = gcs.core;
+    this.handle = handle;
+    this.kind = KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
+    this.vertexCount = core.gcs_deformer_vertex_count(handle);
+    this.jointCount = jointCount;
+    this.positionsPtr = core.gcs_deformer_positions(handle);
+    this.normalsPtr = core.gcs_deformer_normals(handle);
+    this.skinPtr = core.gcs_alloc(jointCount * 64);
+    if (!this.skinPtr) {
+      core.gcs_deformer_destroy(handle);
+      gcs.raise('out of memory for the skin matrices');
+    }
+    this.positionsView = gcs.viewF32(this.positionsPtr, this.vertexCount * 3);
+    this.normalsView = gcs.viewF32(this.normalsPtr, this.vertexCount * 3);
+    this.skinView = gcs.viewF32(this.skinPtr, jointCount * 16);
+  }
+
+  protected live(): number {
+    if (!this.handle) throw new GcsError('DISPOSED', `this ${this.kind} deformer has been disposed`);
+    return this.handle;
+  }
+
+  /** Deformed positions (vertexCount × 3): a view on wasm memory, re-created after growth. */
+  get positions(): Float32Array {
+    this.live();
+    if (this.positionsView.buffer !== this.gcs.memory.buffer)
+      this.positionsView = this.gcs.viewF32(this.positionsPtr, this.vertexCount * 3);
+    return this.positionsView;
+  }
+
+  /** Deformed unit normals (vertexCount × 3): a view on wasm memory, re-created after growth. */
+  get normals(): Float32Array {
+    this.live();
+    if (this.normalsView.buffer !== this.gcs.memory.buffer)
+      this.normalsView = this.gcs.viewF32(this.normalsPtr, this.vertexCount * 3);
+    return this.normalsView;
+  }
+
+  /** The output mesh's triangles (a copy: they never change). */
+  get indices(): Uint32Array {
+    const h = this.live();
+    const n = this.gcs.core.gcs_deformer_index_count(h);
+    return this.gcs.viewU32(this.gcs.core.gcs_deformer_indices(h), n).slice();
+  }
+
+  /** For each output vertex the rig vertex it comes from (a copy), or null (resampled vertices). */
+  get sourceVertex(): Uint32Array | null {
+    const h = this.live();
+    const ptr = this.gcs.core.gcs_deformer_source_vertex(h);
+    return ptr ? this.gcs.viewU32(ptr, this.vertexCount).slice() : null;
+  }
+
+  /**
+   * Deforms for one frame from J skinning matrices S_j = posed world · inverse bind (column-major,
+   * 16 floats each, bind-pose mesh space → posed mesh space). One copy into wasm, no allocation.
+   */
+  deform(skinMatrices: ArrayLike<number>): void {
+    const h = this.live();
+    if (!skinMatrices || skinMatrices.length !== this.jointCount * 16)
+      throw new GcsError('LENGTH_MISMATCH', `deform expects ${this.jointCount * 16} numbers (16 per joint for ${this.jointCount} joints); got ${skinMatrices?.length ?? 0}`);
+    if (this.skinView.buffer !== this.gcs.memory.buffer) this.skinView = this.gcs.viewF32(this.skinPtr, this.jointCount * 16);
+    this.skinView.set(skinMatrices);
+    if (!this.gcs.core.gcs_deformer_deform(h, this.skinPtr, this.jointCount)) this.gcs.raise('deform failed');
+  }
+
+  /** Sections (GCS) or contours (classic) in the model; 0 for LBS/DQS. */
+  get sectionCount(): number {
+    return this.gcs.core.gcs_deformer_stat(this.live(), 0);
+  }
+  /** Parts (joints that own vertices) in the model; 0 for LBS/DQS. */
+  get partCount(): number {
+    return this.gcs.core.gcs_deformer_stat(this.live(), 1);
+  }
+
+  /** Frees the deformer's wasm memory; its views must not be used afterwards. */
+  dispose(): void {
+    if (!this.handle) return;
+    this.gcs.core.gcs_deformer_destroy(this.handle);
+    this.gcs.core.gcs_free(this.skinPtr);
+    this.handle = 0;
+  }
+
+  get disposed(): boolean {
+    return this.handle === 0;
+  }
+}
+
+/** The generalized cross-section deformer. */
+export class GcsDeformer extends Deformer {
+  /** Last frame: share of sections whose transform is not their part's rigid transform. */
+  get adjustedShare(): number {
+    return this.gcs.core.gcs_deformer_stat(this.live(), 2);
+  }
+  get adjustedSections(): number {
+    return this.gcs.core.gcs_deformer_stat(this.live(), 3);
+  }
+  /** Section id of each output vertex (a copy). */
+  sectionOfVertex(): Uint32Array {
+    const h = this.live();
+    return this.gcs.viewU32(this.gcs.core.gcs_gcs_section_of_vertex(h), this.vertexCount).slice();
+  }
+  /** The sections, in output-vertex order. */
+  sections(): SectionInfo[] {
+    const h = this.live();
+    const n = this.sectionCount;
+    const info = this.gcs.viewF32(this.gcs.core.gcs_gcs_section_info(h), n * 8);
+    const out: SectionInfo[] = [];
+    for (let i = 0; i < n; i++) {
+      const o = i * 8;
+      out.push({ first: info[o], count: info[o + 1], part: info[o + 2], distal: info[o + 3], shared: info[o + 4] === 1,
+        t: info[o + 5], alpha: info[o + 6], beta: info[o + 7] });
+    }
+    return out;
+  }
+  /** The last frame's section transforms (sectionCount × 16, a copy). */
+  sectionMatrices(): Float32Array {
+    const h = this.live();
+    return this.gcs.viewF32(this.gcs.core.gcs_gcs_section_matrices(h), this.sectionCount * 16).slice();
+  }
+}
+
+/** The classic cross-section deformer (resampled contours). */
+export class ClassicDeformer extends Deformer {
+  /** Which parts were resampled and which are carried rigidly. */
+  get parts(): ClassicPart[] {
+    const h = this.live();
+    const n = this.gcs.core.gcs_classic_part_count(h);
+    const ptr = this.gcs.core.gcs_classic_parts(h);
+    if (!ptr) return [];
+    const a = this.gcs.viewI32(ptr, n * 4);
+    const out: ClassicPart[] = [];
+    for (let i = 0; i < n; i++)
+      out.push({ joint: a[4 * i], resampled: a[4 * i + 1] === 1, firstVertex: a[4 * i + 2], vertexCount: a[4 * i + 3] });
+    return out;
+  }
+  /** Resampling detail loss, % of model height: RMS and max distance of original vertices to the resampled surface. */
+  get detailLoss(): { rms: number; max: number } {
+    const h = this.live();
+    return { rms: this.gcs.core.gcs_classic_detail_loss(h, 0), max: this.gcs.core.gcs_classic_detail_loss(h, 1) };
+  }
+  /** Changes the muscle bulge gain (0..4) without rebuilding. */
+  setBulge(bulge: number): void {
+    const h = this.live();
+    if (!(bulge >= 0 && bulge <= CLASSIC_LIMITS.maxBulge))
+      throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${CLASSIC_LIMITS.maxBulge}; got ${bulge}`);
+    if (!this.gcs.core.gcs_classic_set_bulge(h, bulge)) this.gcs.raise('setBulge failed');
+  }
+}

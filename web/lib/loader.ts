@@ -1,0 +1,82 @@
+// Instantiates the standalone gcs-skin.wasm (no emscripten JS glue) in node, vitest and browsers.
+
+/** Where to find the wasm binary: a URL or path, its bytes, or a compiled module. */
+export type WasmSource = URL | string | ArrayBuffer | Uint8Array | WebAssembly.Module;
+
+/** The raw exports of the core (see wasm/include/gcs_skin.h). Pointers are byte offsets. */
+export interface CoreExports {
+  memory: WebAssembly.Memory;
+  _initialize(): void;
+  gcs_last_error_code(): number;
+  gcs_last_error_message(): number;
+  gcs_alloc(bytes: number): number;
+  gcs_free(ptr: number): void;
+  gcs_rig_create(pos: number, nrm: number, vc: number, idx: number, ic: number, joints: number,
+    weights: number, parents: number, ibm: number, jc: number): number;
+  gcs_rig_destroy(rig: number): void;
+  gcs_rig_vertex_count(rig: number): number;
+  gcs_rig_joint_count(rig: number): number;
+  gcs_rig_height(rig: number): number;
+  gcs_build_gcs(rig: number, sections: number, criterion: number, width: number, smooth: number, twist: number): number;
+  gcs_build_lbs(rig: number): number;
+  gcs_build_dqs(rig: number): number;
+  gcs_build_classic(rig: number, contours: number, rays: number, bulge: number): number;
+  gcs_deformer_destroy(d: number): void;
+  gcs_deformer_kind(d: number): number;
+  gcs_deformer_deform(d: number, skin: number, jointCount: number): number;
+  gcs_deformer_vertex_count(d: number): number;
+  gcs_deformer_positions(d: number): number;
+  gcs_deformer_normals(d: number): number;
+  gcs_deformer_index_count(d: number): number;
+  gcs_deformer_indices(d: number): number;
+  gcs_deformer_source_vertex(d: number): number;
+  gcs_deformer_stat(d: number, stat: number): number;
+  gcs_gcs_section_of_vertex(d: number): number;
+  gcs_gcs_section_info(d: number): number;
+  gcs_gcs_section_matrices(d: number): number;
+  gcs_classic_set_bulge(d: number, bulge: number): number;
+  gcs_classic_part_count(d: number): number;
+  gcs_classic_parts(d: number): number;
+  gcs_classic_detail_loss(d: number, which: number): number;
+}
+
+const isNode = typeof process !== 'undefined' && !!process.versions?.node && typeof window === 'undefined';
+
+async function readBytes(source: URL | string): Promise<ArrayBuffer | Uint8Array> {
+  const url = typeof source === 'string' ? new URL(source, isNode ? `file://${process.cwd()}/` : location.href) : source;
+  if (url.protocol === 'file:') {
+    const fs = await import(/* @vite-ignore */ 'node:fs/promises');
+    const { fileURLToPath } = await import(/* @vite-ignore */ 'node:url');
+    return fs.readFile(fileURLToPath(url));
+  }
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`HTTP ${response.status} for ${url}`);
+  return response.arrayBuffer();
+}
+
+/** Compiles and instantiates the core. Throws a plain Error when the binary cannot be had. */
+export async function instantiateCore(source?: WasmSource): Promise<CoreExports> {
+  let module: WebAssembly.Module;
+  if (source instanceof WebAssembly.Module) {
+    module = source;
+  } else if (source instanceof ArrayBuffer || source instanceof Uint8Array) {
+    module = await WebAssembly.compile(source as BufferSource);
+  } else {
+    const bytes = await readBytes(source ?? new URL('./gcs-skin.wasm', import.meta.url));
+    module = await WebAssembly.compile(bytes as BufferSource);
+  }
+  let exports: CoreExports | undefined;
+  const imports = {
+    // Memory growth is noticed lazily: every view is checked against memory.buffer before use.
+    env: { emscripten_notify_memory_growth: () => {} },
+    wasi_snapshot_preview1: {
+      proc_exit: (code: number) => {
+        throw new Error(`gcs-skin core aborted (exit ${code})`);
+      },
+    },
+  };
+  const instance = await WebAssembly.instantiate(module, imports);
+  exports = instance.exports as unknown as CoreExports;
+  exports._initialize();
+  return exports;
+}
