@@ -62,6 +62,8 @@ const char* gcs_last_error_message(void);
 /* Scratch memory for handing arrays across the JS boundary. Returns 0 on failure. */
 void* gcs_alloc(uint32_t bytes);
 void gcs_free(void* pointer);
+/* Copies `bytes` bytes (memcpy). For benchmarks: the memory bound a deformer is measured against. */
+void gcs_copy_bytes(void* destination, const void* source, uint32_t bytes);
 
 /* ---------------------------------------------------------------- rig (raw input) */
 

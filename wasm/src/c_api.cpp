@@ -1,6 +1,7 @@
 // The C API (gcs_skin.h): argument checks, error recording, and nothing else.
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include "../include/gcs_skin.h"
 #include "error.h"
@@ -26,6 +27,9 @@ void* gcs_alloc(uint32_t bytes) {
   return p;
 }
 void gcs_free(void* pointer) { std::free(pointer); }
+void gcs_copy_bytes(void* destination, const void* source, uint32_t bytes) {
+  if (destination && source) std::memcpy(destination, source, bytes);
+}
 
 GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount,
                        const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,

@@ -11,6 +11,7 @@ export interface CoreExports {
   gcs_last_error_message(): number;
   gcs_alloc(bytes: number): number;
   gcs_free(ptr: number): void;
+  gcs_copy_bytes(dst: number, src: number, bytes: number): void;
   gcs_rig_create(pos: number, nrm: number, vc: number, idx: number, ic: number, joints: number,
     weights: number, parents: number, ibm: number, jc: number): number;
   gcs_rig_destroy(rig: number): void;
