@@ -1,0 +1,50 @@
+// Packaging: the `npm pack` tarball, installed into an empty folder, imports and deforms in node
+// through the package's `exports` map (no access to this repository's sources).
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readdirSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { expect, test } from 'vitest';
+
+const root = resolve(__dirname, '..');
+const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
+
+test('the npm tarball installs into an empty folder, imports and deforms', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'gcs-skin-pack-'));
+  execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: root, stdio: ['ignore', 'pipe', 'pipe'] });
+  const tarball = readdirSync(dir).find((f) => f.endsWith('.tgz'));
+  expect(tarball).toBeDefined();
+  const app = join(dir, 'app');
+  execFileSync('mkdir', ['-p', app]);
+  writeFileSync(join(app, 'package.json'), JSON.stringify({ name: 'app', private: true, type: 'module' }));
+  execFileSync(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', join(dir, tarball!)], { cwd: app, stdio: ['ignore', 'pipe', 'pipe'] });
+  writeFileSync(join(app, 'main.mjs'), `
+    import { initGcsSkin, GcsError } from 'gcs-skin';
+    const gcs = await initGcsSkin();
+    // Two rings of a bar, one joint each.
+    const positions = [], joints = [], weights = [];
+    for (let r = 0; r < 4; r++) for (let k = 0; k < 4; k++) {
+      const a = k * Math.PI / 2;
+      positions.push(Math.cos(a) * 0.1, r * 0.5, Math.sin(a) * 0.1);
+      joints.push(r < 2 ? 0 : 1, 0, 0, 0); weights.push(1, 0, 0, 0);
+    }
+    const indices = [];
+    for (let r = 0; r < 3; r++) for (let k = 0; k < 4; k++) {
+      const a = r * 4 + k, b = r * 4 + (k + 1) % 4; indices.push(a, b, a + 4, b, b + 4, a + 4);
+    }
+    const id = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1];
+    const rig = gcs.createRig({ positions, indices, joints, weights, parents: [-1, 0],
+      inverseBindMatrices: [...id, 1,0,0,0, 0,1,0,0, 0,0,1,0, 0,-0.75,0,1] });
+    const d = rig.buildGcs({ sections: 4 });
+    d.deform([...id, ...id]);
+    let code = null;
+    try { rig.buildGcs({ sections: 1 }); } catch (e) { code = e instanceof GcsError ? e.code : String(e); }
+    console.log(JSON.stringify({ vertices: d.vertexCount, sections: d.sectionCount, first: Array.from(d.positions.slice(0, 3)), code }));
+  `);
+  const out = execFileSync(process.execPath, ['main.mjs'], { cwd: app, encoding: 'utf8' });
+  const result = JSON.parse(out.trim().split('\n').pop()!);
+  expect(result.vertices).toBe(16);
+  expect(result.sections).toBeGreaterThan(2);
+  expect(result.first.every(Number.isFinite)).toBe(true);
+  expect(result.code).toBe('SECTION_COUNT');
+}, 240000);
