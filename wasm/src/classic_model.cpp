@@ -1,0 +1,736 @@
+#include "classic_model.h"
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <unordered_map>
+#include "error.h"
+#include "transform.h"
+
+namespace gcs {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+constexpr float kMinBoneFraction = 0.03f;  // a cylinder-like part is at least 3 % of the height long
+constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried rigidly
+constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
+
+// Same welding as the GCS model: vertices at one bind position belong to one part.
+std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
+  struct Key {
+    uint32_t x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    size_t operator()(const Key& k) const {
+      return size_t(k.x * 73856093u) ^ size_t(k.y * 19349663u) ^ size_t(k.z * 83492791u);
+    }
+  };
+  std::unordered_map<Key, uint32_t, Hash> seen;
+  seen.reserve(rig.vertexCount * 2);
+  std::vector<uint32_t> group(rig.vertexCount);
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+    Key k;
+    glm::vec3 p = rig.positions[v] + glm::vec3(0.0f);
+    std::memcpy(&k.x, &p.x, 4);
+    std::memcpy(&k.y, &p.y, 4);
+    std::memcpy(&k.z, &p.z, 4);
+    auto it = seen.emplace(k, uint32_t(representative.size()));
+    if (it.second) representative.push_back(v);
+    group[v] = it.first->second;
+  }
+  return group;
+}
+
+glm::vec3 anyPerpendicular(const glm::vec3& a) {
+  glm::vec3 g = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+  return glm::normalize(glm::cross(a, g));
+}
+
+// The minimal rotation taking unit a to unit b, applied to v.
+glm::vec3 minRotate(const glm::vec3& a, const glm::vec3& b, const glm::vec3& v) {
+  float c = glm::dot(a, b);
+  if (c < -0.99999f) {
+    glm::vec3 p = anyPerpendicular(a);
+    return 2.0f * glm::dot(p, v) * p - v;
+  }
+  glm::vec3 x = glm::cross(a, b);
+  return c * v + glm::cross(x, v) + x * (glm::dot(x, v) / (1.0f + c));
+}
+
+// u made perpendicular to unit n and unit length (fallback: any perpendicular).
+glm::vec3 orthonormal(const glm::vec3& u, const glm::vec3& n) {
+  glm::vec3 p = u - glm::dot(u, n) * n;
+  float len = glm::length(p);
+  return len > 1e-6f ? p / len : anyPerpendicular(n);
+}
+
+glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
+  glm::vec3 s = a + b;
+  float len = glm::length(s);
+  return len > 1e-6f ? s / len : a;
+}
+
+// Casts the `k` star rays of one contour plane (origin O, normal n, frame u, w) against a triangle
+// list: each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle
+// lies in the segment's angular span are tested. radius[r] = outermost hit distance, or −1.
+void castContour(const Rig& rig, const uint32_t* tris, uint32_t triCount, const glm::vec3& O,
+                 const glm::vec3& n, const glm::vec3& u, const glm::vec3& w, uint32_t k,
+                 const float* cosT, const float* sinT, float* radius) {
+  for (uint32_t r = 0; r < k; ++r) radius[r] = -1.0f;
+  const float step = 2.0f * kPi / float(k);
+  for (uint32_t i = 0; i < triCount; ++i) {
+    const uint32_t* t = &rig.indices[size_t(tris[i]) * 3];
+    glm::vec3 p[3] = {rig.positions[t[0]] - O, rig.positions[t[1]] - O, rig.positions[t[2]] - O};
+    float h[3] = {glm::dot(p[0], n), glm::dot(p[1], n), glm::dot(p[2], n)};
+    bool neg0 = h[0] < 0.0f, neg1 = h[1] < 0.0f, neg2 = h[2] < 0.0f;
+    if (neg0 == neg1 && neg1 == neg2) continue;
+    glm::vec2 seg[2];
+    int s = 0;
+    for (int e = 0; e < 3 && s < 2; ++e) {
+      int a = e, b = (e + 1) % 3;
+      if ((h[a] < 0.0f) == (h[b] < 0.0f)) continue;
+      float f = h[a] / (h[a] - h[b]);
+      glm::vec3 x = p[a] + f * (p[b] - p[a]);
+      seg[s++] = glm::vec2(glm::dot(x, u), glm::dot(x, w));
+    }
+    if (s < 2) continue;
+    glm::vec2 P = seg[0], E = seg[1] - seg[0];
+    float aP = std::atan2(P.y, P.x), aQ = std::atan2(seg[1].y, seg[1].x);
+    float delta = aQ - aP;
+    if (delta > kPi) delta -= 2.0f * kPi;
+    if (delta < -kPi) delta += 2.0f * kPi;
+    float start = delta >= 0.0f ? aP : aQ, span = std::fabs(delta);
+    int r0 = int(std::ceil((start - 1e-5f) / step));
+    int r1 = int(std::floor((start + span + 1e-5f) / step));
+    if (r1 - r0 >= int(k)) r1 = r0 + int(k) - 1;
+    for (int rr = r0; rr <= r1; ++rr) {
+      uint32_t r = uint32_t(((rr % int(k)) + int(k)) % int(k));
+      glm::vec2 d(cosT[r], sinT[r]);
+      float denom = d.x * E.y - d.y * E.x;
+      if (std::fabs(denom) < 1e-12f) continue;
+      float lambda = (P.x * E.y - P.y * E.x) / denom;
+      float mu = (P.x * d.y - P.y * d.x) / denom;
+      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f && lambda > radius[r]) radius[r] = lambda;
+    }
+  }
+}
+
+// Hits farther than kOutlierFactor × the contour's median hit are misses (a ray that slipped past
+// the limb and hit a far part of the surface). Returns the number of hits left.
+uint32_t rejectOutliers(float* radius, uint32_t k, std::vector<float>& scratch) {
+  scratch.clear();
+  for (uint32_t r = 0; r < k; ++r)
+    if (radius[r] > 0.0f) scratch.push_back(radius[r]);
+  if (scratch.empty()) return 0;
+  std::nth_element(scratch.begin(), scratch.begin() + scratch.size() / 2, scratch.end());
+  float limit = kOutlierFactor * scratch[scratch.size() / 2];
+  uint32_t hits = 0;
+  for (uint32_t r = 0; r < k; ++r) {
+    if (radius[r] > limit) radius[r] = -1.0f;
+    if (radius[r] > 0.0f) ++hits;
+  }
+  return hits;
+}
+
+// Misses take the radius of their nearest hit neighbours (interpolated by angle). False when the
+// contour has no hit at all.
+bool fillMisses(float* radius, uint32_t k) {
+  int firstHit = -1;
+  for (uint32_t r = 0; r < k; ++r)
+    if (radius[r] > 0.0f) { firstHit = int(r); break; }
+  if (firstHit < 0) return false;
+  for (uint32_t r = 0; r < k; ++r) {
+    if (radius[r] > 0.0f) continue;
+    int before = 1, after = 1;
+    while (radius[(r + k - before) % k] <= 0.0f) ++before;
+    while (radius[(r + after) % k] <= 0.0f) ++after;
+    float a = radius[(r + k - before) % k], b = radius[(r + after) % k];
+    radius[r] = -(a + (b - a) * float(before) / float(before + after));  // negative: filled
+  }
+  for (uint32_t r = 0; r < k; ++r) radius[r] = std::fabs(radius[r]);
+  return true;
+}
+
+// Closest distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5).
+float pointTriangleDistance(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  glm::vec3 ab = b - a, ac = c - a, ap = p - a;
+  float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0f && d2 <= 0.0f) return glm::length(ap);
+  glm::vec3 bp = p - b;
+  float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0f && d4 <= d3) return glm::length(bp);
+  float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+  glm::vec3 cp = p - c;
+  float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0f && d5 <= d6) return glm::length(cp);
+  float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+  float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
+    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  float denom = 1.0f / (va + vb + vc);
+  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
+}
+
+}  // namespace
+
+float ClassicModel::stat(GcsStat which) const {
+  switch (which) {
+    case GCS_STAT_SECTIONS: return float(contours.size());
+    case GCS_STAT_PARTS: return float(reportJoints.size());
+    case GCS_STAT_ADJUSTED_SHARE: return 1.0f;  // every contour is recomputed each frame
+    case GCS_STAT_ADJUSTED_SECTIONS: return float(contours.size());
+  }
+  return std::nanf("");
+}
+
+ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, float bulge) {
+  if (contourSetting < GCS_CLASSIC_MIN_CONTOURS || contourSetting > GCS_CLASSIC_MAX_CONTOURS) {
+    fail(GCS_ERR_OUT_OF_RANGE, "the contour count must be between %d and %d; got %u",
+         GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS, contourSetting);
+    return nullptr;
+  }
+  if (k < GCS_CLASSIC_MIN_RAYS || k > GCS_CLASSIC_MAX_RAYS) {
+    fail(GCS_ERR_OUT_OF_RANGE, "the ray count must be between %d and %d; got %u", GCS_CLASSIC_MIN_RAYS,
+         GCS_CLASSIC_MAX_RAYS, k);
+    return nullptr;
+  }
+  if (!(bulge >= 0.0f && bulge <= GCS_CLASSIC_MAX_BULGE)) {
+    fail(GCS_ERR_OUT_OF_RANGE, "the bulge must be between 0 and %g; got %g", double(GCS_CLASSIC_MAX_BULGE),
+         double(bulge));
+    return nullptr;
+  }
+  ClassicModel* model = nullptr;
+  try {
+    model = new ClassicModel();
+    ClassicModel& m = *model;
+    const uint32_t J = rig.jointCount;
+    m.jointCount = J;
+    m.rays = k;
+    m.bulge = bulge;
+    m.height = rig.height > 0.0f ? rig.height : 1.0f;
+    m.jointCentres = rig.jointCentres;
+    m.cosTable.resize(k);
+    m.sinTable.resize(k);
+    for (uint32_t r = 0; r < k; ++r) {
+      double a = 2.0 * 3.14159265358979323846 * double(r) / double(k);
+      m.cosTable[r] = float(std::cos(a));
+      m.sinTable[r] = float(std::sin(a));
+    }
+
+    // 1. Parts by dominant weight (welded), parent part = nearest ancestor that owns vertices.
+    std::vector<uint32_t> representative;
+    std::vector<uint32_t> group = weldByPosition(rig, representative);
+    std::vector<uint32_t> partOf(rig.vertexCount);
+    m.parts.assign(J, ClassicPart());
+    for (uint32_t j = 0; j < J; ++j) m.parts[j].joint = j;
+    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+      partOf[v] = rig.dominantJoint(representative[group[v]]);
+      m.parts[partOf[v]].isPart = true;
+    }
+    std::vector<std::vector<uint32_t>> childParts(J);
+    for (uint32_t j = 0; j < J; ++j) {
+      if (!m.parts[j].isPart) continue;
+      int32_t p = rig.parents[j];
+      while (p >= 0 && !m.parts[p].isPart) p = rig.parents[p];
+      m.parts[j].parent = p;
+      if (p >= 0) childParts[p].push_back(j);
+    }
+
+    // 2. Own triangles: triangles with at least one vertex in the part (boundary triangles count
+    // for both sides, so the end contours find skin on either side of the weight boundary).
+    const uint32_t T = uint32_t(rig.indices.size() / 3);
+    std::vector<uint32_t> triFirst(J + 1, 0), triList;
+    {
+      auto forParts = [&](uint32_t t, auto&& fn) {
+        uint32_t a = partOf[rig.indices[3 * t]], b = partOf[rig.indices[3 * t + 1]],
+                 c = partOf[rig.indices[3 * t + 2]];
+        fn(a);
+        if (b != a) fn(b);
+        if (c != a && c != b) fn(c);
+      };
+      for (uint32_t t = 0; t < T; ++t) forParts(t, [&](uint32_t p) { ++triFirst[p + 1]; });
+      for (uint32_t j = 0; j < J; ++j) triFirst[j + 1] += triFirst[j];
+      triList.resize(triFirst[J]);
+      std::vector<uint32_t> cursor(triFirst.begin(), triFirst.end() - 1);
+      for (uint32_t t = 0; t < T; ++t) forParts(t, [&](uint32_t p) { triList[cursor[p]++] = t; });
+    }
+
+    // 3. Directions of every part (for bends), candidates (chain parts long enough), their axes.
+    std::vector<glm::vec3> centroid(J, glm::vec3(0.0f));
+    std::vector<uint32_t> ownCount(J, 0);
+    for (uint32_t g = 0; g < representative.size(); ++g) {
+      uint32_t v = representative[g];
+      centroid[partOf[v]] += rig.positions[v];
+      ++ownCount[partOf[v]];
+    }
+    const float minBone = kMinBoneFraction * m.height;
+    float longest = 0.0f;
+    for (uint32_t j = 0; j < J; ++j) {
+      ClassicPart& P = m.parts[j];
+      if (!P.isPart) continue;
+      const glm::vec3 cj = rig.jointCentres[j];
+      glm::vec3 dir(0.0f);
+      for (uint32_t c : childParts[j]) {
+        glm::vec3 d = rig.jointCentres[c] - cj;
+        if (glm::length(d) > 1e-6f * m.height) dir += glm::normalize(d);
+      }
+      if (childParts[j].empty() && ownCount[j]) dir = centroid[j] / float(ownCount[j]) - cj;
+      if (glm::length(dir) < 1e-6f * m.height && P.parent >= 0) dir = cj - rig.jointCentres[P.parent];
+      P.direction = glm::length(dir) > 1e-6f * m.height ? glm::normalize(dir) : glm::vec3(0, 1, 0);
+      if (childParts[j].empty()) {
+        P.reason = CLASSIC_LEAF;
+      } else if (childParts[j].size() > 1) {
+        P.reason = CLASSIC_BRANCHING;
+      } else {
+        P.child = int32_t(childParts[j][0]);
+        glm::vec3 bone = rig.jointCentres[P.child] - cj;
+        P.length = glm::length(bone);
+        if (!(P.length >= minBone)) {
+          P.reason = CLASSIC_TOO_SHORT;
+        } else {
+          P.candidate = P.resampled = true;
+          P.axis = bone / P.length;
+          longest = std::max(longest, P.length);
+        }
+      }
+    }
+    // Reference directions: parallel-transported down each chain of candidates, so that the
+    // contour frames agree at shared contours; a chain starts from +Z (or +Y) projected.
+    {
+      std::vector<uint8_t> done(J, 0);
+      std::vector<uint32_t> stack;
+      for (uint32_t j0 = 0; j0 < J; ++j0) {
+        if (!m.parts[j0].candidate || done[j0]) continue;
+        stack.clear();
+        uint32_t j = j0;
+        while (true) {  // climb to the first undone candidate ancestor
+          stack.push_back(j);
+          int32_t p = m.parts[j].parent;
+          if (p < 0 || !m.parts[p].candidate || done[p]) break;
+          j = uint32_t(p);
+        }
+        for (size_t s = stack.size(); s-- > 0;) {
+          ClassicPart& P = m.parts[stack[s]];
+          int32_t p = P.parent;
+          if (p >= 0 && m.parts[p].candidate) {
+            P.u = orthonormal(minRotate(m.parts[p].axis, P.axis, m.parts[p].u), P.axis);
+          } else {
+            glm::vec3 g = std::fabs(P.axis.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+            P.u = orthonormal(g, P.axis);
+          }
+          done[stack[s]] = 1;
+        }
+      }
+    }
+    for (uint32_t j = 0; j < J; ++j) {
+      ClassicPart& P = m.parts[j];
+      if (!P.candidate) continue;
+      float share = P.length / longest;
+      P.contourCount = std::max<uint32_t>(GCS_CLASSIC_MIN_CONTOURS,
+                                          uint32_t(std::lround(double(contourSetting) * share)));
+      P.contourCount = std::min(P.contourCount, contourSetting);
+    }
+
+    // 4. Cast rays per candidate part; parts with too many misses fall back to rigid, which changes
+    // their neighbours' end normals, so those are recast (only parts are ever removed: it ends).
+    std::vector<std::vector<float>> hits(J);
+    std::vector<uint8_t> dirty(J, 0);
+    for (uint32_t j = 0; j < J; ++j) dirty[j] = m.parts[j].candidate;
+    std::vector<float> scratch;
+    scratch.reserve(k);
+    auto endNormals = [&](const ClassicPart& P, glm::vec3& nProx, glm::vec3& nDist) {
+      nProx = P.proxShared ? bisector(m.parts[P.parent].axis, P.axis) : P.axis;
+      nDist = P.distShared ? bisector(P.axis, m.parts[P.child].axis) : P.axis;
+    };
+    auto contourFrame = [&](const ClassicPart& P, float t, const glm::vec3& nProx, const glm::vec3& nDist,
+                            glm::vec3& centre, glm::vec3& n, glm::vec3& u) {
+      centre = rig.jointCentres[P.joint] + t * P.length * P.axis;
+      n = glm::normalize((1.0f - t) * nProx + t * nDist);
+      u = orthonormal(minRotate(P.axis, n, P.u), n);
+    };
+    for (int pass = 0; pass < 64; ++pass) {
+      bool any = false;
+      for (uint32_t j = 0; j < J; ++j) {
+        ClassicPart& P = m.parts[j];
+        if (!P.resampled || !dirty[j]) continue;
+        dirty[j] = 0;
+        P.proxShared = P.parent >= 0 && m.parts[P.parent].resampled;
+        P.distShared = m.parts[P.child].resampled;
+        glm::vec3 nProx, nDist;
+        endNormals(P, nProx, nDist);
+        const uint32_t mm = P.contourCount;
+        hits[j].assign(size_t(mm) * k, -1.0f);
+        uint32_t hitCount = 0;
+        for (uint32_t i = 0; i < mm; ++i) {
+          float t = float(i) / float(mm - 1);
+          glm::vec3 O, n, u;
+          contourFrame(P, t, nProx, nDist, O, n, u);
+          float* rad = &hits[j][size_t(i) * k];
+          castContour(rig, &triList[triFirst[j]], triFirst[j + 1] - triFirst[j], O, n, u, glm::cross(n, u), k,
+                      m.cosTable.data(), m.sinTable.data(), rad);
+          hitCount += rejectOutliers(rad, k, scratch);
+        }
+        float miss = 1.0f - float(hitCount) / float(mm * k);
+        if (hitCount == 0 || miss > kMaxMissShare) {
+          P.resampled = false;
+          P.reason = CLASSIC_RAYS_MISS;
+          any = true;
+          if (P.parent >= 0 && m.parts[P.parent].resampled) dirty[P.parent] = 1;
+          if (m.parts[P.child].resampled) dirty[P.child] = 1;
+        }
+      }
+      if (!any) break;
+    }
+
+    // 5. Contours. Chains of resampled parts are laid out root → leaf, so that a part's rings are
+    // contiguous and a shared contour is the last ring of one part and the first of the next.
+    uint32_t vertex = 0;
+    for (uint32_t j0 = 0; j0 < J; ++j0) {
+      ClassicPart& head = m.parts[j0];
+      if (!head.resampled || (head.parent >= 0 && m.parts[head.parent].resampled)) continue;
+      for (int32_t j = int32_t(j0); j >= 0 && m.parts[j].resampled;
+           j = m.parts[j].distShared ? m.parts[j].child : -1) {
+        ClassicPart& P = m.parts[j];
+        glm::vec3 nProx, nDist;
+        endNormals(P, nProx, nDist);
+        const uint32_t mm = P.contourCount;
+        P.contours.clear();
+        for (uint32_t i = 0; i < mm; ++i) {
+          if (i == 0 && P.proxShared) {  // the parent's last contour
+            uint32_t id = m.parts[P.parent].contours.back();
+            P.contours.push_back(id);
+            ClassicContour& c = m.contours[id];
+            float* rad = &m.radii[c.radii];
+            const float* mine = &hits[j][0];
+            for (uint32_t r = 0; r < k; ++r) rad[r] = std::max(rad[r], mine[r]);  // union of both sides
+            c.part = j;
+            c.proximal = P.parent;
+            c.t = 0.0f;
+            continue;
+          }
+          ClassicContour c;
+          c.part = j;
+          c.t = float(i) / float(mm - 1);
+          contourFrame(P, c.t, nProx, nDist, c.centre, c.normal, c.u);
+          c.first = vertex;
+          vertex += k;
+          c.radii = uint32_t(m.radii.size());
+          m.radii.insert(m.radii.end(), hits[j].begin() + size_t(i) * k, hits[j].begin() + size_t(i + 1) * k);
+          P.contours.push_back(uint32_t(m.contours.size()));
+          m.contours.push_back(c);
+        }
+        P.first = m.contours[P.contours.front()].first;
+        P.count = mm * k;
+      }
+    }
+    m.tubeVertexCount = vertex;
+    // Fill misses: from neighbours in the contour, or, for a contour without any hit, from the
+    // nearest contour of its part that has hits.
+    std::vector<uint8_t> empty(m.contours.size(), 0);
+    for (size_t c = 0; c < m.contours.size(); ++c) empty[c] = !fillMisses(&m.radii[m.contours[c].radii], k);
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.resampled) continue;
+      const int n = int(P.contours.size());
+      for (int i = 0; i < n; ++i) {
+        uint32_t id = P.contours[i];
+        if (!empty[id]) continue;
+        for (int d = 1; d < n; ++d) {
+          int cand[2] = {i - d, i + d};
+          int found = -1;
+          for (int q : cand)
+            if (q >= 0 && q < n && !empty[P.contours[q]]) { found = q; break; }
+          if (found >= 0) {
+            std::memcpy(&m.radii[m.contours[id].radii], &m.radii[m.contours[P.contours[found]].radii], k * sizeof(float));
+            empty[id] = 0;
+            break;
+          }
+        }
+      }
+    }
+    for (size_t c = 0; c < m.contours.size(); ++c)
+      if (empty[c]) std::fill(m.radii.begin() + m.contours[c].radii, m.radii.begin() + m.contours[c].radii + k, 0.0f);
+
+    // 6. Caps where a tube meets a rigid part (or nothing).
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.resampled) continue;
+      if (!P.proxShared) {
+        m.caps.push_back({P.contours.front(), vertex, -1.0f});
+        vertex += k + 1;
+      }
+      if (!P.distShared) {
+        m.caps.push_back({P.contours.back(), vertex, 1.0f});
+        vertex += k + 1;
+      }
+    }
+
+    // 7. Carried triangles: those with a vertex in a rigid part. Their vertices are copied and move
+    // rigidly with their own part's S_j; the copies are grouped by part (one transform run each).
+    std::vector<uint8_t> carriedTri(T, 0);
+    std::vector<int64_t> outputOf(rig.vertexCount, -1);
+    for (uint32_t t = 0; t < T; ++t) {
+      for (int e = 0; e < 3; ++e)
+        if (!m.parts[partOf[rig.indices[3 * t + e]]].resampled) carriedTri[t] = 1;
+      if (carriedTri[t])
+        for (int e = 0; e < 3; ++e) outputOf[rig.indices[3 * t + e]] = 0;
+    }
+    std::vector<uint32_t> runCount(J, 0);
+    for (uint32_t v = 0; v < rig.vertexCount; ++v)
+      if (outputOf[v] == 0) ++runCount[partOf[v]];
+    m.carriedFirst = vertex;
+    for (uint32_t j = 0; j < J; ++j) {
+      m.parts[j].runFirst = vertex;
+      m.parts[j].runCount = runCount[j];
+      vertex += runCount[j];
+    }
+    {
+      std::vector<uint32_t> cursor(J);
+      for (uint32_t j = 0; j < J; ++j) cursor[j] = m.parts[j].runFirst;
+      for (uint32_t v = 0; v < rig.vertexCount; ++v)
+        if (outputOf[v] == 0) outputOf[v] = cursor[partOf[v]]++;
+    }
+    m.allocateOutput(vertex);
+    const uint32_t carried = vertex - m.carriedFirst;
+    m.restPositions.assign(size_t(carried) * 3 + 1, 0.0f);
+    m.restNormals.assign(size_t(carried) * 3 + 1, 0.0f);
+    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+      if (outputOf[v] < 0) continue;
+      size_t o = size_t(outputOf[v] - m.carriedFirst) * 3;
+      for (int c = 0; c < 3; ++c) {
+        m.restPositions[o + c] = rig.positions[v][c];
+        m.restNormals[o + c] = rig.normals[v][c];
+      }
+    }
+
+    // 8. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
+    // about the contour normal, which points distally), then caps, then the carried triangles.
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.resampled) continue;
+      for (size_t i = 0; i + 1 < P.contours.size(); ++i) {
+        uint32_t a = m.contours[P.contours[i]].first, b = m.contours[P.contours[i + 1]].first;
+        for (uint32_t r = 0; r < k; ++r) {
+          uint32_t r1 = (r + 1) % k;
+          m.indices.insert(m.indices.end(), {a + r, a + r1, b + r1, a + r, b + r1, b + r});
+        }
+      }
+    }
+    m.tubeIndexCount = uint32_t(m.indices.size());
+    for (const ClassicCap& cap : m.caps) {
+      uint32_t centre = cap.first + k;
+      for (uint32_t r = 0; r < k; ++r) {
+        uint32_t r1 = (r + 1) % k;
+        if (cap.sign > 0.0f) m.indices.insert(m.indices.end(), {centre, cap.first + r, cap.first + r1});
+        else m.indices.insert(m.indices.end(), {centre, cap.first + r1, cap.first + r});
+      }
+    }
+    for (uint32_t t = 0; t < T; ++t) {
+      if (!carriedTri[t]) continue;
+      for (int e = 0; e < 3; ++e) m.indices.push_back(uint32_t(outputOf[rig.indices[3 * t + e]]));
+    }
+
+    // 9. The report (parts in joint order) and the detail-loss inputs.
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.isPart) continue;
+      m.reportJoints.push_back(j);
+      m.report.insert(m.report.end(), {int32_t(j), P.resampled ? 1 : 0,
+                                       int32_t(P.resampled ? P.first : P.runFirst),
+                                       int32_t(P.resampled ? P.count : P.runCount)});
+    }
+    for (uint32_t v = 0; v < rig.vertexCount; ++v)
+      if (m.parts[partOf[v]].resampled) {
+        m.lossPoints.push_back(rig.positions[v]);
+        m.lossParts.push_back(partOf[v]);
+      }
+
+    // 10. The bind pose as the initial output (and the bind tube for the detail loss).
+    std::vector<glm::mat4> identity(J, glm::mat4(1.0f));
+    m.deform(identity.data());
+    m.bindPositions.resize(m.carriedFirst);
+    for (uint32_t o = 0; o < m.carriedFirst; ++o)
+      m.bindPositions[o] = glm::vec3(m.positions[3 * o], m.positions[3 * o + 1], m.positions[3 * o + 2]);
+  } catch (const std::bad_alloc&) {
+    delete model;
+    fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while building the classic cross-section model");
+    return nullptr;
+  }
+  return model;
+}
+
+void ClassicModel::deform(const glm::mat4* skin) {
+  const uint32_t J = jointCount;
+  const uint32_t k = rays;
+  // Per part: posed joints, bone direction, twisted reference direction, bend of the distal joint.
+  for (uint32_t j = 0; j < J; ++j) {
+    ClassicPart& P = parts[j];
+    if (!P.resampled) continue;
+    glm::quat q = rotationOf(skin[j]);
+    P.rotation = glm::mat3_cast(q);
+    P.posedA = glm::vec3(skin[j] * glm::vec4(jointCentres[j], 1.0f));
+    P.posedB = glm::vec3(skin[P.child] * glm::vec4(jointCentres[P.child], 1.0f));
+    glm::vec3 d = P.posedB - P.posedA;
+    float len = glm::length(d);
+    P.posedDir = len > 1e-6f * height ? d / len : glm::normalize(P.rotation * P.axis);
+    P.posedU = P.rotation * P.u;
+    P.scale = (glm::length(glm::vec3(skin[j][0])) + glm::length(glm::vec3(skin[j][1])) +
+               glm::length(glm::vec3(skin[j][2]))) / 3.0f;
+    const glm::vec3 cd = parts[P.child].direction;
+    glm::vec3 straight = P.rotation * cd;
+    glm::vec3 actual = glm::mat3_cast(rotationOf(skin[P.child])) * cd;
+    float c = glm::clamp(glm::dot(straight, actual) / (glm::length(straight) * glm::length(actual)), -1.0f, 1.0f);
+    P.flex = std::acos(c) / kPi;
+  }
+  for (uint32_t j = 0; j < J; ++j) {
+    ClassicPart& P = parts[j];
+    if (!P.resampled) continue;
+    P.nProx = P.proxShared ? bisector(parts[P.parent].posedDir, P.posedDir) : P.posedDir;
+    P.nDist = P.distShared ? bisector(P.posedDir, parts[P.child].posedDir) : P.posedDir;
+  }
+  // Contours.
+  for (const ClassicContour& c : contours) {
+    const ClassicPart& P = parts[c.part];
+    glm::vec3 centre, n, u;
+    float scale = 1.0f;
+    if (c.proximal >= 0) {  // shared joint contour: bisector normal, half of the twist of each side
+      const ClassicPart& Q = parts[c.proximal];
+      centre = P.posedA;
+      n = P.nProx;
+      glm::vec3 uq = minRotate(Q.posedDir, n, Q.posedU), up = minRotate(P.posedDir, n, P.posedU);
+      glm::vec3 s = uq + up;
+      u = orthonormal(glm::dot(s, s) > 1e-8f ? s : uq, n);
+      scale = 0.5f * (P.scale + Q.scale);
+    } else {
+      centre = P.posedA + c.t * (P.posedB - P.posedA);
+      n = (1.0f - c.t) * P.nProx + c.t * P.nDist;
+      float len = glm::length(n);
+      n = len > 1e-6f ? n / len : P.posedDir;
+      u = orthonormal(minRotate(P.posedDir, n, P.posedU), n);
+      scale = P.scale * (1.0f + bulge * P.flex * std::sin(kPi * c.t));
+    }
+    glm::vec3 w = glm::cross(n, u);
+    const float* rad = &radii[c.radii];
+    float* out = &positions[size_t(c.first) * 3];
+    for (uint32_t r = 0; r < k; ++r) {
+      float s = scale * rad[r];
+      glm::vec3 p = centre + s * (cosTable[r] * u + sinTable[r] * w);
+      out[3 * r] = p.x, out[3 * r + 1] = p.y, out[3 * r + 2] = p.z;
+    }
+  }
+  // Tube normals: area-weighted from the deformed tube triangles.
+  std::memset(normals.data(), 0, size_t(tubeVertexCount) * 3 * sizeof(float));
+  for (uint32_t i = 0; i < tubeIndexCount; i += 3) {
+    uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+    glm::vec3 pa(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
+    glm::vec3 pb(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
+    glm::vec3 pc(positions[3 * c], positions[3 * c + 1], positions[3 * c + 2]);
+    glm::vec3 f = glm::cross(pb - pa, pc - pa);
+    for (uint32_t v : {a, b, c}) {
+      normals[3 * v] += f.x;
+      normals[3 * v + 1] += f.y;
+      normals[3 * v + 2] += f.z;
+    }
+  }
+  for (uint32_t v = 0; v < tubeVertexCount; ++v) {
+    float* nn = &normals[3 * size_t(v)];
+    float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    if (len > 0.0f) nn[0] /= len, nn[1] /= len, nn[2] /= len;
+    else nn[0] = 0.0f, nn[1] = 1.0f, nn[2] = 0.0f;
+  }
+  // Caps: rim copies and the centre, normal along the contour normal (outward).
+  for (const ClassicCap& cap : caps) {
+    const ClassicContour& c = contours[cap.contour];
+    const ClassicPart& P = parts[c.part];
+    glm::vec3 n = (1.0f - c.t) * P.nProx + c.t * P.nDist;
+    n = cap.sign * glm::normalize(n);
+    glm::vec3 centre = P.posedA + c.t * (P.posedB - P.posedA);
+    std::memcpy(&positions[size_t(cap.first) * 3], &positions[size_t(c.first) * 3], size_t(k) * 3 * sizeof(float));
+    for (uint32_t r = 0; r <= k; ++r) {
+      float* nn = &normals[size_t(cap.first + r) * 3];
+      nn[0] = n.x, nn[1] = n.y, nn[2] = n.z;
+    }
+    float* pc = &positions[size_t(cap.first + k) * 3];
+    pc[0] = centre.x, pc[1] = centre.y, pc[2] = centre.z;
+  }
+  // Carried vertices: rigid, by their own part's S_j (runs in increasing output order: the SIMD
+  // store of a run's last vertex spills one float into the next run, which is written after).
+  for (uint32_t j = 0; j < J; ++j) {
+    const ClassicPart& P = parts[j];
+    if (!P.runCount) continue;
+    size_t o = size_t(P.runFirst - carriedFirst) * 3;
+    transformRun(skin[j], &restPositions[o], &restNormals[o], &positions[size_t(P.runFirst) * 3],
+                 &normals[size_t(P.runFirst) * 3], P.runCount);
+  }
+}
+
+float ClassicModel::detailLoss(uint32_t which) const {
+  if (which > 1) return std::nanf("");
+  if (!lossDone) {
+    // For each original vertex of a resampled part, the nearest bind-pose tube triangle among the
+    // cells around its own (contour interval ±2, ray sector ±2, following shared contours into the
+    // neighbouring part) and the part's caps.
+    const uint32_t k = rays;
+    const float step = 2.0f * kPi / float(k);
+    double sum = 0.0;
+    float worst = 0.0f;
+    auto testCell = [&](const ClassicPart& P, int interval, int sector, float& best, const glm::vec3& x) {
+      const ClassicPart* Q = &P;
+      int n = int(Q->contours.size());
+      if (interval < 0) {
+        if (!Q->proxShared) return;
+        Q = &parts[Q->parent];
+        interval += int(Q->contours.size()) - 1;
+        n = int(Q->contours.size());
+        if (interval < 0) return;
+      } else if (interval > n - 2) {
+        if (!Q->distShared) return;
+        interval -= n - 1;
+        Q = &parts[Q->child];
+        n = int(Q->contours.size());
+        if (interval > n - 2) return;
+      }
+      uint32_t a = contours[Q->contours[interval]].first, b = contours[Q->contours[interval + 1]].first;
+      uint32_t r = uint32_t(((sector % int(k)) + int(k)) % int(k)), r1 = (r + 1) % k;
+      best = std::min(best, pointTriangleDistance(x, bindPositions[a + r], bindPositions[a + r1], bindPositions[b + r1]));
+      best = std::min(best, pointTriangleDistance(x, bindPositions[a + r], bindPositions[b + r1], bindPositions[b + r]));
+    };
+    for (size_t i = 0; i < lossPoints.size(); ++i) {
+      const glm::vec3& x = lossPoints[i];
+      const ClassicPart& P = parts[lossParts[i]];
+      glm::vec3 rel = x - jointCentres[P.joint];
+      float t = glm::dot(rel, P.axis) / P.length;
+      int n = int(P.contours.size());
+      int interval = int(std::floor(t * float(n - 1)));
+      interval = std::max(-n, std::min(2 * n, interval));
+      float angle = std::atan2(glm::dot(rel, glm::cross(P.axis, P.u)), glm::dot(rel, P.u));
+      if (angle < 0.0f) angle += 2.0f * kPi;
+      int sector = int(std::floor(angle / step));
+      float best = INFINITY;
+      for (int di = -2; di <= 2; ++di)
+        for (int dr = -2; dr <= 2; ++dr) testCell(P, interval + di, sector + dr, best, x);
+      for (const ClassicCap& cap : caps) {
+        if (contours[cap.contour].part != int32_t(P.joint)) continue;
+        glm::vec3 centre = bindPositions[cap.first + k];
+        for (uint32_t r = 0; r < k; ++r)
+          best = std::min(best, pointTriangleDistance(x, centre, bindPositions[cap.first + r],
+                                                      bindPositions[cap.first + (r + 1) % k]));
+      }
+      if (!std::isfinite(best)) {  // far from every cell: fall back to the whole part
+        for (int di = 0; di + 1 < n; ++di)
+          for (int dr = 0; dr < int(k); ++dr) testCell(P, di, dr, best, x);
+      }
+      sum += double(best) * double(best);
+      worst = std::max(worst, best);
+    }
+    lossRms = lossPoints.empty() ? 0.0f : float(std::sqrt(sum / double(lossPoints.size()))) / height * 100.0f;
+    lossMax = worst / height * 100.0f;
+    lossDone = true;
+  }
+  return which == 0 ? lossRms : lossMax;
+}
+
+}  // namespace gcs

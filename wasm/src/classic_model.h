@@ -1,0 +1,96 @@
+// The classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; the paper's section 2;
+// design.md §4): cylinder-like parts are resampled into contours × star rays and deformed contour by
+// contour; the other parts are carried rigidly with their original triangles.
+#pragma once
+#include <cstdint>
+#include <vector>
+#include <glm/glm.hpp>
+#include "deformer.h"
+#include "rig.h"
+
+namespace gcs {
+
+// One contour: a ring of `rays` output vertices in a plane.
+struct ClassicContour {
+  uint32_t first = 0;        // first output vertex of the ring
+  uint32_t radii = 0;        // offset of its `rays` radii in ClassicModel::radii
+  int32_t part = -1;         // the part whose parameter t applies (for a shared contour: distal part)
+  int32_t proximal = -1;     // shared contour: the proximal part (whose distal end it is); else -1
+  float t = 0.0f;            // 0 at the part's proximal joint … 1 at its distal joint
+  glm::vec3 centre{0.0f}, normal{0.0f, 1.0f, 0.0f}, u{1.0f, 0.0f, 0.0f};  // bind pose
+};
+
+// A tube end that meets a rigid part: closed by a fan (rim copies + a centre vertex).
+struct ClassicCap {
+  uint32_t contour = 0;
+  uint32_t first = 0;        // rays rim vertices, then the centre
+  float sign = 1.0f;         // +1: outward = +contour normal (distal end), −1: proximal end
+};
+
+struct ClassicPart {
+  uint32_t joint = 0;
+  bool isPart = false;       // the joint owns vertices
+  bool candidate = false;    // cylinder-like by shape (one child part, long enough)
+  bool resampled = false;    // candidate whose rays hit well enough
+  uint8_t reason = 0;        // why not resampled (ClassicRigidReason)
+  int32_t parent = -1;       // parent part joint or −1
+  int32_t child = -1;        // the single child part joint (chain parts), or −1
+  float length = 0.0f;
+  glm::vec3 axis{0.0f, 1.0f, 0.0f};  // bind bone direction (c_child − c_joint, normalised)
+  glm::vec3 u{1.0f, 0.0f, 0.0f};     // bind reference direction ⟂ axis (parallel-transported)
+  glm::vec3 direction{0.0f, 1.0f, 0.0f};  // bind direction of any part (for the bend of its joint)
+  uint32_t contourCount = 0;         // m_j (including shared end contours)
+  bool proxShared = false, distShared = false;
+  std::vector<uint32_t> contours;    // contour ids, proximal → distal
+  uint32_t first = 0, count = 0;     // reported output range
+  uint32_t runFirst = 0, runCount = 0;  // carried rig vertices moved rigidly by S_joint
+  // Per-frame scratch (no allocation per frame).
+  glm::mat3 rotation{1.0f};
+  glm::vec3 posedA{0.0f}, posedB{0.0f}, posedDir{0.0f, 1.0f, 0.0f}, posedU{1.0f, 0.0f, 0.0f};
+  glm::vec3 nProx{0.0f, 1.0f, 0.0f}, nDist{0.0f, 1.0f, 0.0f};
+  float flex = 0.0f;
+  float scale = 1.0f;        // uniform scale of S_joint (mesh-node transforms), applied to radii
+};
+
+enum ClassicRigidReason : uint8_t {
+  CLASSIC_RESAMPLED = 0,
+  CLASSIC_LEAF = 1,          // no child part (head, hands, feet, finger tips)
+  CLASSIC_BRANCHING = 2,     // several child parts (pelvis, chest, a hand with fingers)
+  CLASSIC_TOO_SHORT = 3,     // bone shorter than 3 % of the model height (incl. zero length)
+  CLASSIC_RAYS_MISS = 4      // too many rays miss the part's own triangles (or none hits)
+};
+
+class ClassicModel final : public Deformer {
+ public:
+  GcsDeformerKind kind() const override { return GCS_KIND_CLASSIC; }
+  void deform(const glm::mat4* skin) override;
+  float stat(GcsStat which) const override;
+  float detailLoss(uint32_t which) const;  // 0: RMS, 1: max, % of height (computed on first use)
+
+  uint32_t rays = 0;
+  float bulge = 0.0f;
+  float height = 1.0f;
+  std::vector<ClassicPart> parts;          // indexed by joint
+  std::vector<glm::vec3> jointCentres;
+  std::vector<ClassicContour> contours;
+  std::vector<ClassicCap> caps;
+  std::vector<float> radii;                // per contour, `rays` bind radii
+  std::vector<float> cosTable, sinTable;   // ray directions in a contour frame
+  uint32_t tubeIndexCount = 0;             // tube triangles come first in `indices`
+  uint32_t tubeVertexCount = 0;            // ring vertices come first in the output
+  uint32_t carriedFirst = 0;               // carried rig vertices: [carriedFirst, vertexCount)
+  std::vector<float> restPositions, restNormals;  // carried vertices, interleaved (+1 spare)
+  std::vector<int32_t> report;             // partCount × 4 (see gcs_classic_parts)
+  std::vector<uint32_t> reportJoints;      // parts in report order
+  // Detail loss inputs: original vertices of resampled parts (position, part).
+  std::vector<glm::vec3> lossPoints;
+  std::vector<uint32_t> lossParts;
+  std::vector<glm::vec3> bindPositions;    // tube and cap vertices in the bind pose
+  mutable bool lossDone = false;
+  mutable float lossRms = 0.0f, lossMax = 0.0f;
+};
+
+// Builds the model; records an error and returns null on bad settings (see gcs_build_classic).
+ClassicModel* buildClassic(const Rig& rig, uint32_t contours, uint32_t rays, float bulge);
+
+}  // namespace gcs
