@@ -1,7 +1,7 @@
 // Packaging: the `npm pack` tarball, installed into an empty folder, imports and deforms in node
 // through the package's `exports` map (no access to this repository's sources).
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readdirSync, writeFileSync } from 'node:fs';
+import { cpSync, mkdtempSync, readdirSync, symlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { expect, test } from 'vitest';
@@ -11,7 +11,13 @@ const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
 
 test('the npm tarball installs into an empty folder, imports and deforms', () => {
   const dir = mkdtempSync(join(tmpdir(), 'gcs-skin-pack-'));
-  execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: root, stdio: ['ignore', 'pipe', 'pipe'] });
+  // Pack from a copy of the package sources: `prepare` rebuilds dist/ there, never under the
+  // feet of other test files that use this checkout's dist/.
+  const src = join(dir, 'src');
+  for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'bin', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
+    cpSync(join(root, entry), join(src, entry), { recursive: true });
+  symlinkSync(join(root, 'node_modules'), join(src, 'node_modules'));
+  execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: src, stdio: ['ignore', 'pipe', 'pipe'] });
   const tarball = readdirSync(dir).find((f) => f.endsWith('.tgz'));
   expect(tarball).toBeDefined();
   const app = join(dir, 'app');
