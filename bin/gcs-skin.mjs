@@ -3,6 +3,7 @@
 // `npm run build:lib`) exporting `run(argv) → Promise<exit code>` and `usage`.
 const SUBCOMMANDS = {
   human: { module: '../dist/human/cli.js', about: 'write the default human character (mesh, skin, clips) as .glb' },
+  report: { module: '../dist/cli/report.js', about: 'build every deformer on a glTF skinned model and report counts, timings, fidelity' },
 };
 
 function usage() {
