@@ -189,28 +189,80 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
 #define GCS_CLASSIC_MAX_BULGE 4.0f
 
 /*
- * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994): each
- * cylinder-like part is resampled into `contours` planes × `rays` star rays; other parts are
- * carried rigidly with their original triangles.
- *   contours  contours per resampled part, in [GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS].
- *   rays      rays per contour, in [GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_MAX_RAYS].
- *   bulge     muscle bulge gain b in [0, GCS_CLASSIC_MAX_BULGE]: radii scale by
- *             1 + b · flex · sin(π t), flex = joint bend / π.
- * Its output mesh is its own (own vertices, own triangles).
+ * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; design.md §4).
+ *
+ * Parts are the GCS parts (vertices by dominant weight, welded by position; parent part = nearest
+ * ancestor joint owning vertices). A part is resampled when it is cylinder-like:
+ *   - it has exactly one child part (a chain part: upper arm, forearm, thigh, shank, spine, neck);
+ *     leaves (head, hands without fingers, feet, finger tips) and branching parts (pelvis, chest,
+ *     a hand with fingers) are carried rigidly;
+ *   - its bone (joint → child part's joint) is at least 3 % of the model height (a zero-length or
+ *     tiny bone is carried rigidly);
+ *   - at most 30 % of its rays miss its own triangles (triangles with a vertex in the part), after
+ *     hits farther than 3 × the contour's median are dropped as misses (e.g. a clavicle, or a part
+ *     of an open mesh with a side missing, is carried rigidly);
+ *   - its bone turns by at most 45° from its resampled parent's bone (a foot on a shank is rigid).
+ * A resampled part gets contour planes at even spacing t = i/(m−1) from its joint (t = 0) to its
+ * child part's joint (t = 1), each with `rays` star rays at angles 2πr/rays in a frame
+ * parallel-transported along the limb; a ray's contour point is its outermost hit with the part's
+ * own triangles; a ray that misses takes the radius interpolated from its nearest hit neighbours.
+ * Two resampled neighbours share their joint contour (stored once, cast against both parts'
+ * triangles, its plane normal the bisector of the two bones). Where a tube meets a rigid part, the
+ * tube is closed by a flat cap (a fan) in its end contour plane; the rigid part keeps every input
+ * triangle that has a vertex in a rigid part (its vertices that belong to a resampled part move
+ * rigidly with that part's bone), so the rigid mesh overlaps the capped tube end: no see-through
+ * hole, but a visible step where the original surface and the tube differ.
+ *
+ *   contours  contour count of the LONGEST resampled-candidate bone, in
+ *             [GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS]; every other part gets
+ *             round(contours · its bone length / longest bone length), at least 2, so contours are
+ *             evenly spaced over the body. Shared joint contours count in both parts.
+ *   rays      rays per contour (all parts), in [GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_MAX_RAYS].
+ *   bulge     muscle bulge gain b in [0, GCS_CLASSIC_MAX_BULGE]: radii of a part's contours scale by
+ *             1 + b · flex · sin(π t), flex = bend of the part's distal joint / π (the swing angle
+ *             of the child part's bone relative to this part, twist excluded).
+ * Recommended defaults (the paper's leg comparison: ≈ 500 points on the thigh, ≈ 400 on the shank):
+ * contours 25, rays 20 — 500 points on the longest bone (the thigh on a human), the shank
+ * 25 · shank/thigh length · 20 (500 on the default human, whose thigh and shank are equally long).
+ *
+ * Deforming: contour centres lie on the posed segment between the part's posed joints; the end
+ * normal is the posed bone direction, or at a shared joint the bisector N_o = normalize(N_u + N_l);
+ * inner contours interpolate the end normals linearly (normalised); a contour's frame is the
+ * bone's full rotation (its twist included) then the minimal rotation from the bone direction to
+ * the contour normal (a shared contour takes the mean of both sides' frames: half the twist).
+ * Tube normals are area-weighted from the deformed tube triangles; caps use the contour normal.
+ * Uniform scale in S_j (mesh-node transforms) scales the radii. Nothing is allocated per frame.
+ *
+ * Its output mesh is its own: the rings of the tubes first (chains laid out root → leaf, so a
+ * part's rings are contiguous and a shared ring ends one part and starts the next), then the cap
+ * vertices, then the carried input vertices grouped by part. Triangles: tube quads (2 each,
+ * outward), caps, then carried input triangles. gcs_deformer_source_vertex is null.
+ * If no part can be resampled the model still builds (every part rigid; the report says so).
+ * Errors: GCS_ERR_INVALID_ARGUMENT (null rig), GCS_ERR_OUT_OF_RANGE (a count or the bulge outside
+ * its limits; the message states them), GCS_ERR_OUT_OF_MEMORY.
+ * Statistics: GCS_STAT_SECTIONS = contours (shared ones once), GCS_STAT_PARTS = parts.
  */
 GcsDeformer* gcs_build_classic(const GcsRig* rig, uint32_t contours, uint32_t rays, float bulge);
-/* Changes the bulge gain of a classic deformer without rebuilding. Returns 1, or 0 on error. */
+/* Changes the bulge gain of a classic deformer without rebuilding (takes effect at the next
+   deform). Returns 1, or 0 on error (not a classic deformer; bulge outside [0, GCS_CLASSIC_MAX_BULGE]). */
 int gcs_classic_set_bulge(GcsDeformer* deformer, float bulge);
 /*
- * Per-part report of a classic model: partCount × 4 int32 per part:
+ * Per-part report of a classic model: partCount × 4 int32 per part, parts in joint order:
  *   [joint id, resampled (1) or carried rigidly (0), first output vertex, output vertex count].
- * gcs_classic_part_count gives partCount. Null for other deformers.
+ * Resampled part: its rings, contours × rays vertices, proximal ring first (a shared joint ring is
+ * in both neighbours' ranges). Rigid part: its carried input vertices. Not in any range: cap
+ * vertices, and input vertices of resampled parts carried by triangles of a rigid neighbour.
+ * gcs_classic_part_count gives partCount. Null (and 0) for other deformers.
  */
 uint32_t gcs_classic_part_count(const GcsDeformer* deformer);
 const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
 /*
- * Detail loss of resampling: distance from each original vertex of a resampled part to the
- * resampled surface, as a percentage of model height. which = 0: RMS, 1: max. NaN for others.
+ * Detail loss of resampling (the paper's Fig. 5): for each input vertex of a resampled part, the
+ * distance to the bind-pose resampled surface (the nearest triangle among its part's tube cells
+ * within ±2 contour intervals and ±2 ray sectors, following shared contours into the neighbour,
+ * and its part's caps), as a percentage of model height. which = 0: RMS, 1: max. 0 when nothing
+ * is resampled; NaN for other deformers or another `which`. Computed on the first call (it is not
+ * part of the build time).
  */
 float gcs_classic_detail_loss(const GcsDeformer* deformer, uint32_t which);
 

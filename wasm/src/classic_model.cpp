@@ -13,7 +13,8 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 constexpr float kMinBoneFraction = 0.03f;  // a cylinder-like part is at least 3 % of the height long
 constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried rigidly
-constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
+constexpr float kOutlierFactor = 3.0f;
+constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°     // a hit farther than 3 × the contour's median is a miss
 
 // Same welding as the GCS model: vertices at one bind position belong to one part.
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
@@ -382,6 +383,19 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           if (m.parts[P.child].resampled) dirty[P.child] = 1;
         }
       }
+      if (any) continue;
+      // Once the ray tests have settled: a part whose bone turns by more than 45° from its
+      // resampled parent's bone is not a continuation of that limb (a foot on a shank): rigid.
+      for (uint32_t j = 0; j < J; ++j) {
+        ClassicPart& P = m.parts[j];
+        if (!P.resampled || P.parent < 0 || !m.parts[P.parent].resampled) continue;
+        if (glm::dot(P.axis, m.parts[P.parent].axis) >= kMaxBendCos) continue;
+        P.resampled = false;
+        P.reason = CLASSIC_BENT;
+        any = true;
+        dirty[P.parent] = 1;
+        if (m.parts[P.child].resampled) dirty[P.child] = 1;
+      }
       if (!any) break;
     }
 
@@ -719,9 +733,10 @@ float ClassicModel::detailLoss(uint32_t which) const {
           best = std::min(best, pointTriangleDistance(x, centre, bindPositions[cap.first + r],
                                                       bindPositions[cap.first + (r + 1) % k]));
       }
-      if (!std::isfinite(best)) {  // far from every cell: fall back to the whole part
-        for (int di = 0; di + 1 < n; ++di)
-          for (int dr = 0; dr < int(k); ++dr) testCell(P, di, dr, best, x);
+      if (!std::isfinite(best)) {  // beyond a tube end with no neighbour: the cells at that end
+        int end = std::max(0, std::min(n - 2, interval));
+        for (int di = -2; di <= 2; ++di)
+          for (int dr = -2; dr <= 2; ++dr) testCell(P, end + di, sector + dr, best, x);
       }
       sum += double(best) * double(best);
       worst = std::max(worst, best);

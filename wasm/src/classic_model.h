@@ -57,7 +57,8 @@ enum ClassicRigidReason : uint8_t {
   CLASSIC_LEAF = 1,          // no child part (head, hands, feet, finger tips)
   CLASSIC_BRANCHING = 2,     // several child parts (pelvis, chest, a hand with fingers)
   CLASSIC_TOO_SHORT = 3,     // bone shorter than 3 % of the model height (incl. zero length)
-  CLASSIC_RAYS_MISS = 4      // too many rays miss the part's own triangles (or none hits)
+  CLASSIC_RAYS_MISS = 4,     // too many rays miss the part's own triangles (or none hits)
+  CLASSIC_BENT = 5           // bone turned > 45° from its resampled parent's bone (a foot on a shank)
 };
 
 class ClassicModel final : public Deformer {
