@@ -3,7 +3,7 @@
 // tangentially (projecting back onto the surface) and compute area-weighted normals.
 import { BodyField } from './field.js';
 import { BodyModel } from './model.js';
-import { gridAxis, polygonize } from './polygonize.js';
+import { gridAxis, largestComponent, polygonize } from './polygonize.js';
 
 export interface WeldedSurface {
   positions: Float64Array;
@@ -27,27 +27,110 @@ function run(field: BodyField, model: BodyModel, h0: number) {
   const axis = (a: 0 | 1 | 2, cs: number[]) => gridAxis(model.bboxMin[a], model.bboxMax[a], spacing(h0, cs));
   // a small per-axis offset keeps the grid from aligning with the symmetry plane x = 0
   const xs = axis(0, model.densify.x).map((v) => v + 0.000123);
-  return polygonize(f, xs, axis(1, model.densify.y), axis(2, model.densify.z));
+  return largestComponent(polygonize(f, xs, axis(1, model.densify.y), axis(2, model.densify.z)));
 }
 
-/** Polygonise with about `target` vertices (within ~0.5 %). */
+/**
+ * Polygonise with exactly `target` vertices, as one genus-0 piece: calibrate the grid to land
+ * a little below the target (the count is a noisy function of the grid spacing), then split
+ * the longest edges to make up the difference.
+ */
 export function polygonizeBody(field: BodyField, model: BodyModel, target: number) {
   // vertices ∝ h0^-2. Calibrate on a cheap coarse run when the target is large.
-  let h0 = 0.012 * Math.sqrt(15000 / target);
+  const aim = 0.94 * target;
+  let h0 = 0.025 * Math.sqrt(15000 / aim);
   if (target > 40000) {
-    const hc = 0.012 * Math.sqrt(15000 / 30000);
+    const hc = 0.025 * Math.sqrt(15000 / 30000);
     const r = run(field, model, hc);
-    h0 = hc * Math.sqrt(r.vertexCount / target);
+    h0 = hc * Math.sqrt(r.vertexCount / aim);
   }
-  let best = run(field, model, h0);
-  for (let it = 0; it < 8; it++) {
-    const err = best.vertexCount / target - 1;
-    if (Math.abs(err) < 0.004) break;
-    h0 *= Math.sqrt(best.vertexCount / target);
+  const ok = (r: { vertexCount: number }) => r.vertexCount <= target && r.vertexCount >= 0.86 * target;
+  // closed and edge-manifold by construction; genus 0 iff V − T/2 = 2 (coarse grids can bridge narrow gaps)
+  const sphere = (r: { vertexCount: number; indices: Uint32Array }) => r.vertexCount - r.indices.length / 6 === 2;
+  let best: ReturnType<typeof run> | null = null;
+  let wiggle = 0;
+  for (let it = 0; it < 20 && !best; it++) {
     const r = run(field, model, h0);
-    if (Math.abs(r.vertexCount / target - 1) < Math.abs(err)) best = r;
+    if (sphere(r) && ok(r)) best = r;
+    else if (!ok(r) && it < 8) h0 *= Math.sqrt(r.vertexCount / aim);
+    else { wiggle++; h0 *= 1 + 0.002 * wiggle * (wiggle % 2 ? 1 : -1); }
   }
-  return best;
+  if (!best) throw new Error('human: could not polygonise the body as one closed genus-0 surface');
+  return splitToCount(field, best.positions, best.indices, target);
+}
+
+/** Split the longest edges (midpoint, projected onto the surface) until there are `target` vertices. */
+function splitToCount(field: BodyField, positions: Float64Array, indices: Uint32Array, target: number) {
+  let pos = positions, idx = indices;
+  let nv = pos.length / 3;
+  const g = [0, 0, 0];
+  while (nv < target) {
+    const need = target - nv;
+    const nh = idx.length;
+    const len = new Float64Array(nh);
+    let cnt = 0;
+    for (let h = 0; h < nh; h++) {
+      const t = h - (h % 3), a = idx[h], b = idx[t + ((h + 1) % 3)];
+      if (a > b) { len[h] = -1; continue; }
+      len[h] = Math.hypot(pos[3 * b] - pos[3 * a], pos[3 * b + 1] - pos[3 * a + 1], pos[3 * b + 2] - pos[3 * a + 2]);
+      cnt++;
+    }
+    const sorted = Float64Array.from(len).sort();
+    const K = Math.min(cnt, need * 3);
+    const thr = sorted[nh - K];
+    const cand: number[] = [];
+    for (let h = 0; h < nh; h++) if (len[h] >= thr && len[h] > 0) cand.push(h);
+    cand.sort((p, q) => len[q] - len[p]);
+    const M = 4294967296;
+    const twinKey = new Map<number, number>(); // key b·M + a → candidate half-edge
+    for (const h of cand) { const t = h - (h % 3); twinKey.set(idx[t + ((h + 1) % 3)] * M + idx[h], h); }
+    const twin = new Map<number, number>();
+    for (let h = 0; h < nh; h++) {
+      const t = h - (h % 3), a = idx[h], b = idx[t + ((h + 1) % 3)];
+      if (a < b) continue;
+      const c = twinKey.get(a * M + b);
+      if (c !== undefined) twin.set(c, h);
+    }
+    const used = new Uint8Array(nh / 3);
+    const newPos: number[] = [];
+    const newTri: number[] = [];
+    const out = Uint32Array.from(idx);
+    let made = 0;
+    for (const h of cand) {
+      if (made >= need) break;
+      const u = twin.get(h);
+      if (u === undefined) continue;
+      const t = (h / 3) | 0, s = (u / 3) | 0;
+      if (used[t] || used[s]) continue;
+      used[t] = used[s] = 1;
+      const a = idx[h], b = idx[3 * t + ((h + 1) % 3)], c = idx[3 * t + ((h + 2) % 3)];
+      const d = idx[3 * s + ((u + 2) % 3)];
+      const m = nv + made;
+      let x = (pos[3 * a] + pos[3 * b]) / 2, y = (pos[3 * a + 1] + pos[3 * b + 1]) / 2, z = (pos[3 * a + 2] + pos[3 * b + 2]) / 2;
+      for (let k = 0; k < 3; k++) {
+        const fv = field.eval(x, y, z);
+        gradient(field, x, y, z, 1e-4, g);
+        const g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (g2 < 1e-20) break;
+        const sc = Math.min(1, 0.004 / Math.abs((fv * 4e-4) / Math.sqrt(g2) || 1e-9)) * (fv * 4e-4) / g2;
+        x -= sc * g[0]; y -= sc * g[1]; z -= sc * g[2];
+      }
+      newPos.push(x, y, z);
+      // (a,b,c) → (a,m,c) + (m,b,c);  twin (b,a,d) → (b,m,d) + (m,a,d)
+      out[3 * t] = a; out[3 * t + 1] = m; out[3 * t + 2] = c;
+      newTri.push(m, b, c);
+      out[3 * s] = b; out[3 * s + 1] = m; out[3 * s + 2] = d;
+      newTri.push(m, a, d);
+      made++;
+    }
+    const np = new Float64Array(pos.length + newPos.length);
+    np.set(pos); np.set(newPos, pos.length);
+    const ni = new Uint32Array(out.length + newTri.length);
+    ni.set(out); ni.set(newTri, out.length);
+    pos = np; idx = ni; nv += made;
+    if (made === 0) break;
+  }
+  return { positions: pos, indices: idx, vertexCount: nv };
 }
 
 function gradient(field: BodyField, x: number, y: number, z: number, e: number, out: number[]): void {

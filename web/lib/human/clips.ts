@@ -52,7 +52,7 @@ const walk: PoseFn = (phi) => {
   const arm = (f: number) => ({
     shoulder: 3 - 15 * Math.sin(f),
     elbow: 14 + 8 * (1 - Math.sin(f)),
-    twist: 25 - 15 * Math.sin(f),
+    twist: 22 - 13 * Math.sin(f),
   });
   limbs(rot, 'Left', { ...leg(phi), ...arm(phi) });
   limbs(rot, 'Right', { ...leg(phi + Math.PI), ...arm(phi + Math.PI) });

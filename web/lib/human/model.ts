@@ -153,8 +153,8 @@ export function buildBodyModel(pose: Pose): BodyModel {
     armPrims.push(cone(F, LA, elbow, wrist, 0.036, 0.025));
     armPrims.push(ellipsoid(F, LA, at(elbow, 0.075, 0.003, 0.004), [0.04, 0.085, 0.036], d, fwd)); // forearm muscles
     // hand hanging with the palm towards the thigh: width along z, thickness along `side`
-    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.07, 0.002, 0.003), [0.019, 0.065, 0.044], d, fwd)); // palm
-    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.145, 0.0, 0.0), [0.014, 0.05, 0.038], d, fwd)); // fingers
+    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.07, 0.002, 0.003), [0.021, 0.068, 0.044], d, fwd)); // palm
+    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.135, 0.0, 0.0), [0.017, 0.055, 0.038], d, fwd)); // fingers
     armPrims.push(cone(Hd, LA, at(wrist, 0.03, -0.008, 0.03), at(wrist, 0.1, -0.012, 0.05), 0.014, 0.01)); // thumb
     left.ends.push(['LeftHand', tip]);
     left.joints.push(['LeftShoulder', clav], ['LeftArm', sh], ['LeftForeArm', elbow], ['LeftHand', wrist]);

@@ -123,3 +123,28 @@ export function polygonize(f: ScalarField, xs: Float64Array, ys: Float64Array, z
   }
   return { positions: pos.slice(0, 3 * nv), indices: idx.slice(0, nt), vertexCount: nv };
 }
+
+/** Keep only the largest connected piece (thin parts can leave islands on coarse grids). */
+export function largestComponent(r: PolyResult): PolyResult {
+  const nv = r.vertexCount, idx = r.indices;
+  const par = new Int32Array(nv).map((_, i) => i);
+  const find = (a: number): number => { while (par[a] !== a) { par[a] = par[par[a]]; a = par[a]; } return a; };
+  for (let t = 0; t < idx.length; t += 3) {
+    let a = find(idx[t]), b = find(idx[t + 1]);
+    if (a !== b) par[a] = b;
+    a = find(idx[t + 1]); b = find(idx[t + 2]);
+    if (a !== b) par[a] = b;
+  }
+  const size = new Int32Array(nv);
+  for (let v = 0; v < nv; v++) size[find(v)]++;
+  let best = 0;
+  for (let v = 0; v < nv; v++) if (size[v] > size[best]) best = v;
+  if (size[best] === nv) return r;
+  const map = new Int32Array(nv).fill(-1);
+  let n = 0;
+  const pos = new Float64Array(3 * size[best]);
+  for (let v = 0; v < nv; v++) if (find(v) === best) { map[v] = n; pos.set(r.positions.subarray(3 * v, 3 * v + 3), 3 * n); n++; }
+  const out: number[] = [];
+  for (let t = 0; t < idx.length; t += 3) if (map[idx[t]] >= 0) out.push(map[idx[t]], map[idx[t + 1]], map[idx[t + 2]]);
+  return { positions: pos, indices: Uint32Array.from(out), vertexCount: n };
+}
