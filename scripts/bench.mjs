@@ -1,0 +1,362 @@
+// npm run bench [-- --sizes 10000,100000,1000000] [--quick] [--json] [--sections N]
+// Speed of every deformer on the default human (the paper's Table 1: 17,023 vertices, walk and
+// run) and at larger sizes, against the same GCS in plain JavaScript, a wasm memcpy of the bytes a
+// frame touches, and three.js's SkinnedMesh.applyBoneTransform. design.md §7; docs/benchmarks.md.
+import * as THREE from 'three';
+import { initGcsSkin } from '../dist/index.js';
+import { rigInputFromSkinnedMesh, SkinDeformer } from '../dist/three.js';
+import { createHuman } from '../dist/human/index.js';
+import { rootOf, sampleClip } from '../dist/cli/gltf-node.js';
+import { errorInfo, median, timeFrames } from '../dist/cli/measure.js';
+import { JsGcs } from './bench/js-gcs.mjs';
+import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';
+
+const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
+  const n = Number(x.replace(/k$/i, '000').replace(/m$/i, '000000'));
+  if (!Number.isInteger(n) || n < 2000 || n > 2000000) throw new Error(`--sizes: '${x}' is not a vertex count from 2000 to 2000000`);
+  return n;
+}));
+let args;
+try {
+  args = parseArgs(process.argv.slice(2), {
+    json: { type: 'flag', default: false },
+    markdown: { type: 'flag', default: false },
+    quick: { type: 'flag', default: false },
+    sizes: { parse: sizesArg, default: null },
+    sections: { parse: (s) => Number(s), default: 6 },
+  });
+} catch (e) {
+  console.error(`bench: ${e.message}`);
+  process.exit(2);
+}
+if (args.help) {
+  console.log(`usage: npm run bench -- [--sizes 10k,100k,1m|none] [--quick] [--json] [--markdown] [--sections N]
+  --sizes     vertex counts of the scaling table (default 10k,100k,1m; --quick: 10k)
+  --quick     shorter timing, small sizes only
+  --json      machine-readable results on stdout
+  --markdown  tables as markdown (for docs/benchmarks.md)`);
+  process.exit(0);
+}
+const quick = args.quick;
+const sizes = args.sizes ?? (quick ? [10000] : [10000, 100000, 1000000]);
+const sections = args.sections;
+const log = args.json ? (...a) => console.error(...a) : (...a) => console.log(...a);
+const fmtTable = args.markdown ? markdownTable : table;
+const METHODS = [
+  { key: 'gcs', label: 'GCS', build: (rig) => rig.buildGcs({ sections }) },
+  { key: 'gcs-smooth', label: 'GCS smooth', build: (rig) => rig.buildGcs({ sections, smooth: true }) },
+  { key: 'classic', label: 'classic', build: (rig) => rig.buildClassic({}) },
+  { key: 'lbs', label: 'LBS', build: (rig) => rig.buildLbs() },
+  { key: 'dqs', label: 'DQS', build: (rig) => rig.buildDqs() },
+];
+const PAPER = { vertices: 17023, walk: { ms: 24.817, adjusted: 0.4 }, run: { ms: 47.953, adjusted: 0.8 } };
+const budget = (base) => ({ minSamples: quick ? 60 : 300, minMs: quick ? base / 4 : base, maxMs: quick ? base : 4 * base });
+
+const gcs = await initGcsSkin();
+const results = { machine: machine(), sections, table1: null, comparisons: null, adapter: null, rebuild: null, sizes: [], targets: [] };
+
+/** Frames of a clip at 60 fps (at least 30), as skin-matrix arrays. */
+function framesOf(mesh, clip) {
+  return sampleClip(mesh, clip, Math.max(30, Math.round(clip.duration * 60)));
+}
+
+/** The wasm memcpy of the bytes one GCS frame reads and writes (rest positions + normals in, positions + normals out). */
+function timeMemcpy(vertexCount, timing) {
+  const bytes = vertexCount * 24;
+  const core = gcs.core;
+  const src = core.gcs_alloc(bytes), dst = core.gcs_alloc(bytes);
+  if (!src || !dst) throw new Error('out of wasm memory for the memcpy bound');
+  try {
+    return { bytes, ...timeFrames(1, () => core.gcs_copy_bytes(dst, src, bytes), timing) };
+  } finally {
+    core.gcs_free(src);
+    core.gcs_free(dst);
+  }
+}
+
+/** three.js's CPU skinning: applyBoneTransform on every vertex position (normals not included). */
+function timeApplyBoneTransform(human, clip, frameCount, maxMs) {
+  const mesh = human.mesh;
+  const root = rootOf(mesh);
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clip).play();
+  const position = mesh.geometry.getAttribute('position');
+  const n = position.count;
+  const out = new Float32Array(n * 3);
+  const v = new THREE.Vector3();
+  const samples = [];
+  const pass = (target) => {
+    for (let i = 0; i < n; i++) {
+      v.fromBufferAttribute(position, i);
+      mesh.applyBoneTransform(i, v);
+      target[3 * i] = v.x; target[3 * i + 1] = v.y; target[3 * i + 2] = v.z;
+    }
+  };
+  mixer.setTime(0);
+  root.updateMatrixWorld(true);
+  mesh.skeleton.update();
+  for (let w = 0; w < 2; w++) pass(out); // warm-up: let the JIT optimise before timing
+  const start = performance.now();
+  for (let f = 0; f < frameCount; f++) {
+    mixer.setTime((clip.duration * f) / frameCount);
+    root.updateMatrixWorld(true);
+    mesh.skeleton.update();
+    const t0 = performance.now();
+    pass(out);
+    samples.push(performance.now() - t0);
+    if (f >= 2 && performance.now() - start > maxMs) break;
+  }
+  const skin = skinOfCurrentPose(mesh); // before stopping: stopping restores the bind pose
+  mixer.stopAllAction();
+  return { medianMs: median(samples), samples: samples.length, positions: out, skin };
+}
+
+function maxDiff(a, b) {
+  let d = 0;
+  for (let i = 0; i < a.length; i++) d = Math.max(d, Math.abs(a[i] - b[i]));
+  return d;
+}
+
+function buildAll(rig) {
+  const built = {};
+  for (const m of METHODS) {
+    const t0 = performance.now();
+    try {
+      built[m.key] = { deformer: m.build(rig), buildMs: performance.now() - t0 };
+    } catch (e) {
+      built[m.key] = { error: errorInfo(e) };
+    }
+  }
+  return built;
+}
+
+function disposeAll(built) {
+  for (const b of Object.values(built)) b.deformer?.dispose();
+}
+
+// ---------------------------------------------------------------- Table 1: the default human
+log(`bench: building the default human…`);
+const human = createHuman();
+const clips = Object.fromEntries(human.clips.map((c) => [c.name, c]));
+const input = rigInputFromSkinnedMesh(human.mesh);
+const rig = gcs.createRig(input);
+const V = rig.vertexCount;
+const T = input.indices.length / 3;
+log(`bench: human ${V} vertices, ${T} triangles, ${rig.jointCount} joints (paper: 17,023 vertices)`);
+const built = buildAll(rig);
+const frames = { walk: framesOf(human.mesh, clips.walk), run: framesOf(human.mesh, clips.run) };
+const table1 = { vertices: V, triangles: T, joints: rig.jointCount, parts: built.gcs.deformer?.partCount ?? null,
+  sectionCount: built.gcs.deformer?.sectionCount ?? null, methods: {} };
+for (const m of METHODS) {
+  const b = built[m.key];
+  if (!b.deformer) { table1.methods[m.key] = { error: b.error }; log(`bench: ${m.label}: n/a (${b.error.code}: ${b.error.message})`); continue; }
+  const row = { buildMs: b.buildMs };
+  for (const clipName of ['walk', 'run']) {
+    const fr = frames[clipName];
+    const d = b.deformer;
+    let adjusted = 0;
+    if (m.key.startsWith('gcs')) {
+      for (const skin of fr) { d.deform(skin); adjusted += d.adjustedShare; }
+    }
+    const t = timeFrames(fr.length, (f) => d.deform(fr[f]), budget(400));
+    row[clipName] = { medianMs: t.medianMs, p95Ms: t.p95Ms, samples: t.samples };
+    if (m.key.startsWith('gcs')) row[clipName].adjustedShare = adjusted / fr.length;
+  }
+  table1.methods[m.key] = row;
+  log(`bench: ${m.label}: walk ${ms(row.walk.medianMs)} ms, run ${ms(row.run.medianMs)} ms`);
+}
+results.table1 = table1;
+
+// ---------------------------------------------------------------- the same run: JS, memcpy, three.js
+const comparisons = {};
+const gcsD = built.gcs.deformer;
+if (gcsD) {
+  const js = new JsGcs(gcsD, input.parents, input.inverseBindMatrices);
+  let worst = 0;
+  for (const clipName of ['walk', 'run'])
+    for (const skin of frames[clipName]) {
+      gcsD.deform(skin);
+      js.deform(skin);
+      worst = Math.max(worst, maxDiff(gcsD.positions, js.positions), maxDiff(gcsD.normals, js.normals));
+    }
+  const verified = worst <= 1e-4;
+  log(`bench: plain-JS GCS matches wasm within ${worst.toExponential(2)} (${verified ? 'ok' : 'MISMATCH: ratio not reported'})`);
+  const jsT = verified ? timeFrames(frames.walk.length, (f) => js.deform(frames.walk[f]), budget(400)) : null;
+  comparisons.js = { maxDiff: worst, verified, medianMs: jsT?.medianMs ?? null, p95Ms: jsT?.p95Ms ?? null };
+}
+comparisons.memcpy = timeMemcpy(V, budget(200));
+{
+  const a = timeApplyBoneTransform(human, clips.walk, quick ? 10 : 30, quick ? 500 : 2000);
+  let check = null;
+  const lbs = built.lbs.deformer;
+  if (lbs) {
+    // Same pose (the last timed frame) through our LBS: the two must agree.
+    lbs.deform(a.skin);
+    check = maxDiff(lbs.positions, a.positions);
+  }
+  comparisons.applyBoneTransform = { medianMs: a.medianMs, samples: a.samples, maxDiffToLbs: check };
+}
+results.comparisons = comparisons;
+
+function skinOfCurrentPose(mesh) {
+  const out = new Float32Array(mesh.skeleton.bones.length * 16);
+  const m = new THREE.Matrix4();
+  mesh.skeleton.bones.forEach((bone, j) => {
+    m.multiplyMatrices(bone.matrixWorld, mesh.skeleton.boneInverses[j]).premultiply(mesh.bindMatrixInverse).multiply(mesh.bindMatrix);
+    out.set(m.elements, 16 * j);
+  });
+  return out;
+}
+
+// Full adapter update: SkinDeformer.update() (world matrices, skin matrices, deform, attribute flags).
+{
+  const root = rootOf(human.mesh);
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips.walk).play();
+  const skin = new SkinDeformer(gcs, human.mesh, { method: 'gcs', gcs: { sections } });
+  const n = frames.walk.length;
+  const t = timeFrames(n, (f) => skin.update(), { ...budget(300), warmup: n });
+  // The mixer itself (three.js's animation evaluation), for scale.
+  const tm = timeFrames(n, (f) => mixer.setTime((clips.walk.duration * f) / n), budget(200));
+  results.adapter = { updateMs: t.medianMs, mixerMs: tm.medianMs };
+  skin.dispose();
+  mixer.stopAllAction();
+}
+
+// Rebuild times (the section slider, the classic resampling): median of several builds.
+{
+  const reps = quick ? 3 : 9;
+  const times = [];
+  for (let i = 0; i < reps; i++) {
+    const t0 = performance.now();
+    const d = rig.buildGcs({ sections: 3 + (i % 6) });
+    times.push(performance.now() - t0);
+    d.dispose();
+  }
+  const same = [];
+  for (let i = 0; i < reps; i++) {
+    const t0 = performance.now();
+    const d = rig.buildGcs({ sections });
+    same.push(performance.now() - t0);
+    d.dispose();
+  }
+  const rebuild = { gcsMs: median(times), gcsSameMs: median(same), classicMs: null, classicError: null };
+  const classic = [];
+  try {
+    for (let i = 0; i < (quick ? 2 : 5); i++) {
+      const t0 = performance.now();
+      const d = rig.buildClassic({});
+      classic.push(performance.now() - t0);
+      d.dispose();
+    }
+    rebuild.classicMs = median(classic);
+  } catch (e) {
+    rebuild.classicError = errorInfo(e);
+  }
+  results.rebuild = rebuild;
+}
+disposeAll(built);
+rig.dispose();
+
+// ---------------------------------------------------------------- sizes
+for (const size of sizes) {
+  log(`bench: human at ${size} vertices…`);
+  const h = createHuman({ vertices: size });
+  const inp = rigInputFromSkinnedMesh(h.mesh);
+  const r = gcs.createRig(inp);
+  const b = buildAll(r);
+  const walk = h.clips.find((c) => c.name === 'walk');
+  const fr = sampleClip(h.mesh, walk, size >= 500000 ? 12 : 30);
+  const row = { vertices: r.vertexCount, methods: {} };
+  const big = size >= 500000;
+  const timing = { minSamples: big ? 15 : quick ? 40 : 100, minMs: quick ? 100 : 300, maxMs: big ? 1500 : 1200 };
+  for (const m of METHODS) {
+    const d = b[m.key].deformer;
+    if (!d) { row.methods[m.key] = { error: b[m.key].error }; continue; }
+    const t = timeFrames(fr.length, (f) => d.deform(fr[f]), { ...timing, warmup: Math.min(fr.length, 4) });
+    row.methods[m.key] = { medianMs: t.medianMs, p95Ms: t.p95Ms, buildMs: b[m.key].buildMs };
+  }
+  if (b.gcs.deformer) {
+    const js = new JsGcs(b.gcs.deformer, inp.parents, inp.inverseBindMatrices);
+    const t = timeFrames(fr.length, (f) => js.deform(fr[f]), { ...timing, warmup: 2 });
+    row.js = { medianMs: t.medianMs };
+  }
+  row.memcpy = timeMemcpy(r.vertexCount, timing);
+  row.applyBoneTransform = { medianMs: timeApplyBoneTransform(h, walk, big ? 3 : 8, big ? 3000 : 1500).medianMs };
+  results.sizes.push(row);
+  disposeAll(b);
+  r.dispose();
+  log(`bench: ${size}: GCS ${ms(row.methods.gcs?.medianMs)} ms, memcpy ${ms(row.memcpy.medianMs)} ms`);
+}
+
+// ---------------------------------------------------------------- targets
+const g = results.table1.methods.gcs ?? {};
+const gcsMs = g.walk ? Math.max(g.walk.medianMs, g.run.medianMs) : null;
+const walkMs = g.walk?.medianMs ?? null;
+const million = results.sizes.find((s) => s.vertices >= 900000);
+const target = (name, value, goal, met, note = '') => results.targets.push({ name, value, unit: goal.endsWith('×') ? 'ratio' : 'ms', goal, met, note });
+target('GCS ms/frame at 17 k vertices (walk, run)', gcsMs, '≤ 0.05 ms', gcsMs !== null && gcsMs <= 0.05);
+target('GCS ms/frame at 1 M vertices', million?.methods.gcs?.medianMs ?? null, '≤ 5 ms',
+  million ? million.methods.gcs.medianMs <= 5 : null, million ? '' : 'not run (add 1m to --sizes)');
+const memRatio = walkMs !== null ? walkMs / comparisons.memcpy.medianMs : null;
+target('GCS / memcpy of the same bytes (17 k)', memRatio, '≤ 2×', memRatio !== null && memRatio <= 2);
+const jsRatio = comparisons.js?.medianMs && walkMs ? comparisons.js.medianMs / walkMs : null;
+target('plain-JS GCS / wasm GCS (17 k)', jsRatio, '≥ 3×', jsRatio !== null && jsRatio >= 3, comparisons.js?.verified === false ? 'JS did not match wasm' : '');
+const tRatio = walkMs ? comparisons.applyBoneTransform.medianMs / walkMs : null;
+target('applyBoneTransform / wasm GCS (17 k)', tRatio, '≥ 30×', tRatio !== null && tRatio >= 30);
+target('GCS rebuild (section slider, 17 k)', results.rebuild.gcsMs, '≤ 5 ms', results.rebuild.gcsMs <= 5);
+target('classic resampling (17 k)', results.rebuild.classicMs, '≤ 30 ms',
+  results.rebuild.classicMs === null ? null : results.rebuild.classicMs <= 30,
+  results.rebuild.classicError ? `n/a: ${results.rebuild.classicError.code}: ${results.rebuild.classicError.message}` : '');
+
+// ---------------------------------------------------------------- output
+if (args.json) {
+  console.log(JSON.stringify(results, null, 2));
+  process.exit(0);
+}
+const pct = (x) => (x === undefined || x === null ? '' : `${(100 * x).toFixed(0)} %`);
+const mc = results.machine;
+console.log(`\ngcs-skin bench — ${mc.cpu}, ${mc.cores} cores, node ${mc.node}; GCS ${sections} sections per part\n`);
+console.log(`Table 1 (the paper's): default human, ${V} vertices, ${T} triangles, ${table1.joints} joints, ` +
+  `${table1.parts} parts, ${table1.sectionCount} GCS sections; ms per frame (deform only)`);
+const rows = [['method', 'walk median', 'walk p95', 'adjusted', 'run median', 'run p95', 'adjusted', 'build ms']];
+rows.push(['paper 2004 (17,023 v)', ms(PAPER.walk.ms), '', pct(PAPER.walk.adjusted), ms(PAPER.run.ms), '', pct(PAPER.run.adjusted), '']);
+for (const m of METHODS) {
+  const x = table1.methods[m.key];
+  if (x.error) { rows.push([m.label, 'n/a', '', '', 'n/a', '', '', `${x.error.code}`]); continue; }
+  rows.push([m.label, ms(x.walk.medianMs), ms(x.walk.p95Ms), pct(x.walk.adjustedShare), ms(x.run.medianMs), ms(x.run.p95Ms), pct(x.run.adjustedShare), ms(x.buildMs)]);
+}
+console.log(fmtTable(rows));
+for (const m of METHODS) if (table1.methods[m.key].error) console.log(`  ${m.label}: n/a — ${table1.methods[m.key].error.message}`);
+
+console.log(`\nSame run, walk, ${V} vertices:`);
+const c = comparisons;
+const rows2 = [['reference', 'median ms', 'wasm GCS is', 'note']];
+if (c.js) rows2.push(['GCS in plain JavaScript', ms(c.js.medianMs), c.js.medianMs ? `${(c.js.medianMs / walkMs).toFixed(1)}× faster` : 'n/a',
+  `same positions within ${c.js.maxDiff.toExponential(1)}`]);
+rows2.push([`wasm memcpy of ${(c.memcpy.bytes / 1024).toFixed(0)} KiB`, ms(c.memcpy.medianMs), `${(walkMs / c.memcpy.medianMs).toFixed(2)}× the memcpy`, 'bytes read = bytes written']);
+rows2.push(['three.js applyBoneTransform', ms(c.applyBoneTransform.medianMs), `${(c.applyBoneTransform.medianMs / walkMs).toFixed(0)}× faster`,
+  `positions only; vs our LBS ${c.applyBoneTransform.maxDiffToLbs === null ? 'n/a' : c.applyBoneTransform.maxDiffToLbs.toExponential(1)}`]);
+rows2.push(['SkinDeformer.update() (GCS)', ms(results.adapter.updateMs), '', 'world + skin matrices + deform']);
+rows2.push(['AnimationMixer.setTime', ms(results.adapter.mixerMs), '', 'three.js, for scale']);
+console.log(fmtTable(rows2));
+
+console.log(`\nRebuild, median: GCS ${ms(results.rebuild.gcsMs)} ms (section counts 3–8; same count ${ms(results.rebuild.gcsSameMs)} ms), ` +
+  `classic resampling ${results.rebuild.classicMs === null ? `n/a (${results.rebuild.classicError.code}: ${results.rebuild.classicError.message})` : `${ms(results.rebuild.classicMs)} ms`}`);
+
+if (results.sizes.length) {
+  console.log('\nScaling (walk; median ms per frame):');
+  const rows3 = [['vertices', ...METHODS.map((m) => m.label), 'GCS in JS', 'memcpy', 'applyBoneTransform', 'GCS ns/vertex']];
+  for (const s of results.sizes)
+    rows3.push([String(s.vertices), ...METHODS.map((m) => ms(s.methods[m.key]?.medianMs)), ms(s.js?.medianMs), ms(s.memcpy.medianMs),
+      ms(s.applyBoneTransform.medianMs), s.methods.gcs?.medianMs ? ((1e6 * s.methods.gcs.medianMs) / s.vertices).toFixed(2) : 'n/a']);
+  console.log(fmtTable(rows3));
+}
+
+console.log('\nTargets:');
+const rows4 = [['target', 'value', 'goal', 'result']];
+for (const t of results.targets) {
+  const v = t.value === null ? 'n/a' : t.unit === 'ratio' ? `${t.value.toFixed(2)}×` : `${ms(t.value)} ms`;
+  rows4.push([t.name, v, t.goal, t.met === null ? `n/a ${t.note}` : t.met ? 'met' : `MISSED ${t.note}`]);
+}
+console.log(fmtTable(rows4));
