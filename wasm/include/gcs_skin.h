@@ -260,7 +260,8 @@ const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
  * Detail loss of resampling (the paper's Fig. 5): for each input vertex of a resampled part, the
  * distance to the bind-pose resampled surface (the nearest triangle among its part's tube cells
  * within ±2 contour intervals and ±2 ray sectors, following shared contours into the neighbour,
- * and its part's caps), as a percentage of model height. which = 0: RMS, 1: max. 0 when nothing
+ * and its part's caps; a vertex farther than 0.5 % of the height from those is tested against
+ * every tube and cap triangle), as a percentage of model height. which = 0: RMS, 1: max. 0 when nothing
  * is resampled; NaN for other deformers or another `which`. Computed on the first call (it is not
  * part of the build time).
  */

@@ -14,6 +14,7 @@ constexpr float kPi = 3.14159265358979f;
 constexpr float kMinBoneFraction = 0.03f;  // a cylinder-like part is at least 3 % of the height long
 constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried rigidly
 constexpr float kOutlierFactor = 3.0f;
+constexpr float kMaxExtension = 0.5f;      // a tube end passes a rigid neighbour's joint by ≤ ½ bone
 constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°     // a hit farther than 3 × the contour's median is a miss
 
 // Same welding as the GCS model: vertices at one bind position belong to one part.
@@ -335,6 +336,17 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       P.contourCount = std::min(P.contourCount, contourSetting);
     }
 
+    // Extent of each candidate's own vertices along its bone (for tube ends at rigid neighbours).
+    for (uint32_t j = 0; j < J; ++j) m.parts[j].ownTMin = 0.0f, m.parts[j].ownTMax = 1.0f;
+    for (uint32_t g = 0; g < representative.size(); ++g) {
+      uint32_t v = representative[g];
+      ClassicPart& P = m.parts[partOf[v]];
+      if (!P.candidate) continue;
+      float t = glm::dot(rig.positions[v] - rig.jointCentres[P.joint], P.axis) / P.length;
+      P.ownTMin = std::max(-kMaxExtension, std::min(P.ownTMin, t));
+      P.ownTMax = std::min(1.0f + kMaxExtension, std::max(P.ownTMax, t));
+    }
+
     // 4. Cast rays per candidate part; parts with too many misses fall back to rigid, which changes
     // their neighbours' end normals, so those are recast (only parts are ever removed: it ends).
     std::vector<std::vector<float>> hits(J);
@@ -349,7 +361,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     auto contourFrame = [&](const ClassicPart& P, float t, const glm::vec3& nProx, const glm::vec3& nDist,
                             glm::vec3& centre, glm::vec3& n, glm::vec3& u) {
       centre = rig.jointCentres[P.joint] + t * P.length * P.axis;
-      n = glm::normalize((1.0f - t) * nProx + t * nDist);
+      float tc = glm::clamp(t, 0.0f, 1.0f);
+      n = glm::normalize((1.0f - tc) * nProx + tc * nDist);
       u = orthonormal(minRotate(P.axis, n, P.u), n);
     };
     for (int pass = 0; pass < 64; ++pass) {
@@ -360,21 +373,28 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         dirty[j] = 0;
         P.proxShared = P.parent >= 0 && m.parts[P.parent].resampled;
         P.distShared = m.parts[P.child].resampled;
+        P.tLo = P.proxShared ? 0.0f : P.ownTMin;
+        P.tHi = P.distShared ? 1.0f : P.ownTMax;
         glm::vec3 nProx, nDist;
         endNormals(P, nProx, nDist);
         const uint32_t mm = P.contourCount;
         hits[j].assign(size_t(mm) * k, -1.0f);
-        uint32_t hitCount = 0;
+        uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
         for (uint32_t i = 0; i < mm; ++i) {
-          float t = float(i) / float(mm - 1);
+          float t = P.tLo + (P.tHi - P.tLo) * float(i) / float(mm - 1);
           glm::vec3 O, n, u;
           contourFrame(P, t, nProx, nDist, O, n, u);
           float* rad = &hits[j][size_t(i) * k];
           castContour(rig, &triList[triFirst[j]], triFirst[j + 1] - triFirst[j], O, n, u, glm::cross(n, u), k,
                       m.cosTable.data(), m.sinTable.data(), rad);
-          hitCount += rejectOutliers(rad, k, scratch);
+          uint32_t h = rejectOutliers(rad, k, scratch);
+          hitCount += h;
+          if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
         }
-        float miss = 1.0f - float(hitCount) / float(mm * k);
+        // The miss rule looks at the contours between the joints (past a joint, skin of the
+        // rigid neighbour is expected to be missing); all contours if none lies between them.
+        float miss = inRangeRays ? 1.0f - float(inRangeHits) / float(inRangeRays)
+                                 : 1.0f - float(hitCount) / float(mm * k);
         if (hitCount == 0 || miss > kMaxMissShare) {
           P.resampled = false;
           P.reason = CLASSIC_RAYS_MISS;
@@ -427,7 +447,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           }
           ClassicContour c;
           c.part = j;
-          c.t = float(i) / float(mm - 1);
+          c.t = P.tLo + (P.tHi - P.tLo) * float(i) / float(mm - 1);
           contourFrame(P, c.t, nProx, nDist, c.centre, c.normal, c.u);
           c.first = vertex;
           vertex += k;
@@ -620,11 +640,12 @@ void ClassicModel::deform(const glm::mat4* skin) {
       scale = 0.5f * (P.scale + Q.scale);
     } else {
       centre = P.posedA + c.t * (P.posedB - P.posedA);
-      n = (1.0f - c.t) * P.nProx + c.t * P.nDist;
+      float tc = glm::clamp(c.t, 0.0f, 1.0f);  // past a joint: the end normal, no bulge
+      n = (1.0f - tc) * P.nProx + tc * P.nDist;
       float len = glm::length(n);
       n = len > 1e-6f ? n / len : P.posedDir;
       u = orthonormal(minRotate(P.posedDir, n, P.posedU), n);
-      scale = P.scale * (1.0f + bulge * P.flex * std::sin(kPi * c.t));
+      scale = P.scale * (1.0f + bulge * P.flex * std::sin(kPi * tc));
     }
     glm::vec3 w = glm::cross(n, u);
     const float* rad = &radii[c.radii];
@@ -659,7 +680,8 @@ void ClassicModel::deform(const glm::mat4* skin) {
   for (const ClassicCap& cap : caps) {
     const ClassicContour& c = contours[cap.contour];
     const ClassicPart& P = parts[c.part];
-    glm::vec3 n = (1.0f - c.t) * P.nProx + c.t * P.nDist;
+    float tc = glm::clamp(c.t, 0.0f, 1.0f);
+    glm::vec3 n = (1.0f - tc) * P.nProx + tc * P.nDist;
     n = cap.sign * glm::normalize(n);
     glm::vec3 centre = P.posedA + c.t * (P.posedB - P.posedA);
     std::memcpy(&positions[size_t(cap.first) * 3], &positions[size_t(c.first) * 3], size_t(k) * 3 * sizeof(float));
@@ -686,7 +708,8 @@ float ClassicModel::detailLoss(uint32_t which) const {
   if (!lossDone) {
     // For each original vertex of a resampled part, the nearest bind-pose tube triangle among the
     // cells around its own (contour interval ±2, ray sector ±2, following shared contours into the
-    // neighbouring part) and the part's caps.
+    // neighbouring part) and the part's caps; a vertex farther than 0.5 % of the height from all of
+    // those is tested against every tube and cap triangle of the model.
     const uint32_t k = rays;
     const float step = 2.0f * kPi / float(k);
     double sum = 0.0;
@@ -718,7 +741,7 @@ float ClassicModel::detailLoss(uint32_t which) const {
       glm::vec3 rel = x - jointCentres[P.joint];
       float t = glm::dot(rel, P.axis) / P.length;
       int n = int(P.contours.size());
-      int interval = int(std::floor(t * float(n - 1)));
+      int interval = int(std::floor((t - P.tLo) / (P.tHi - P.tLo) * float(n - 1)));
       interval = std::max(-n, std::min(2 * n, interval));
       float angle = std::atan2(glm::dot(rel, glm::cross(P.axis, P.u)), glm::dot(rel, P.u));
       if (angle < 0.0f) angle += 2.0f * kPi;
@@ -737,6 +760,11 @@ float ClassicModel::detailLoss(uint32_t which) const {
         int end = std::max(0, std::min(n - 2, interval));
         for (int di = -2; di <= 2; ++di)
           for (int dr = -2; dr <= 2; ++dr) testCell(P, end + di, sector + dr, best, x);
+      }
+      if (best > 5e-3f * height) {  // far from the cells around it: every tube and cap triangle
+        for (uint32_t t = 0; t < uint32_t(indices.size()) && indices[t] < carriedFirst; t += 3)
+          best = std::min(best, pointTriangleDistance(x, bindPositions[indices[t]], bindPositions[indices[t + 1]],
+                                                      bindPositions[indices[t + 2]]));
       }
       sum += double(best) * double(best);
       worst = std::max(worst, best);

@@ -40,6 +40,10 @@ struct ClassicPart {
   glm::vec3 u{1.0f, 0.0f, 0.0f};     // bind reference direction ⟂ axis (parallel-transported)
   glm::vec3 direction{0.0f, 1.0f, 0.0f};  // bind direction of any part (for the bend of its joint)
   uint32_t contourCount = 0;         // m_j (including shared end contours)
+  // Contours span t in [tLo, tHi]: [0, 1] between shared joints; past a joint with a rigid
+  // neighbour, the tube extends over the part's own vertices (up to half a bone) so that no skin
+  // of the part is left uncovered between the tube and the rigid part.
+  float tLo = 0.0f, tHi = 1.0f, ownTMin = 0.0f, ownTMax = 1.0f;
   bool proxShared = false, distShared = false;
   std::vector<uint32_t> contours;    // contour ids, proximal → distal
   uint32_t first = 0, count = 0;     // reported output range
