@@ -9,9 +9,6 @@
 #include "reference_deformers.h"
 #include "rig.h"
 
-struct GcsRig {
-  gcs::Rig rig;
-};
 
 using gcs::fail;
 

@@ -4,10 +4,6 @@
 #include "classic_model.h"
 #include "error.h"
 
-struct GcsRig {
-  gcs::Rig rig;
-};
-
 namespace {
 gcs::ClassicModel* asClassic(const GcsDeformer* d) {
   return d && d->impl && d->impl->kind() == GCS_KIND_CLASSIC ? static_cast<gcs::ClassicModel*>(d->impl) : nullptr;

@@ -40,3 +40,8 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 bool allFinite(const float* values, size_t count);
 
 }  // namespace gcs
+
+// The opaque handle of the C API is the validated rig.
+struct GcsRig {
+  gcs::Rig rig;
+};
