@@ -75,18 +75,30 @@ function splitToCount(field: BodyField, positions: Float64Array, indices: Uint32
       len[h] = Math.hypot(pos[3 * b] - pos[3 * a], pos[3 * b + 1] - pos[3 * a + 1], pos[3 * b + 2] - pos[3 * a + 2]);
       cnt++;
     }
-    const sorted = Float64Array.from(len).sort();
+    // length threshold for the ~3·need longest edges, from a sorted sample
     const K = Math.min(cnt, need * 3);
-    const thr = sorted[nh - K];
+    const stride = Math.max(1, Math.floor(nh / 200000));
+    const sample = new Float64Array(Math.ceil(nh / stride));
+    let ns = 0;
+    for (let h = 0; h < nh; h += stride) if (len[h] > 0) sample[ns++] = len[h];
+    const sorted = sample.subarray(0, ns).sort();
+    const thr = sorted[Math.max(0, Math.floor(ns * (1 - K / cnt)) - 1)];
     const cand: number[] = [];
     for (let h = 0; h < nh; h++) if (len[h] >= thr && len[h] > 0) cand.push(h);
     cand.sort((p, q) => len[q] - len[p]);
     const M = 4294967296;
     const twinKey = new Map<number, number>(); // key b·M + a → candidate half-edge
-    for (const h of cand) { const t = h - (h % 3); twinKey.set(idx[t + ((h + 1) % 3)] * M + idx[h], h); }
+    const isEnd = new Uint8Array(nv);
+    for (const h of cand) {
+      const t = h - (h % 3), b = idx[t + ((h + 1) % 3)];
+      twinKey.set(b * M + idx[h], h);
+      isEnd[b] = 1;
+    }
     const twin = new Map<number, number>();
     for (let h = 0; h < nh; h++) {
-      const t = h - (h % 3), a = idx[h], b = idx[t + ((h + 1) % 3)];
+      const a = idx[h];
+      if (!isEnd[a]) continue;
+      const t = h - (h % 3), b = idx[t + ((h + 1) % 3)];
       if (a < b) continue;
       const c = twinKey.get(a * M + b);
       if (c !== undefined) twin.set(c, h);
@@ -165,18 +177,11 @@ export function relax(field: BodyField, pos: Float64Array, idx: Uint32Array, ite
       const dn = dx * nx + dy * ny + dz * nz;
       dx -= dn * nx; dy -= dn * ny; dz -= dn * nz;
       let px = x + 0.5 * dx, py = y + 0.5 * dy, pz = z + 0.5 * dz;
-      // one Newton step back onto f = 0
+      // back onto f = 0 along the normal (|∇f| ≈ gl / 4e; the stencil sums 4 samples at offset e)
       const fv = field.eval(px, py, pz);
-      gradient(field, px, py, pz, 1e-4, g);
-      // stencil sum ≈ 4e·∇f, so the Newton step f·∇f/|∇f|² = f·g·4e/|g|²
-      const g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-      if (g2 > 1e-20) {
-        const s = (fv * 4e-4) / g2;
-        let mx = s * g[0], my = s * g[1], mz = s * g[2];
-        const ml = Math.hypot(mx, my, mz), cap = 0.004;
-        if (ml > cap) { mx *= cap / ml; my *= cap / ml; mz *= cap / ml; }
-        px -= mx; py -= my; pz -= mz;
-      }
+      let m = (fv * 4e-4) / gl;
+      if (m > 0.004) m = 0.004; else if (m < -0.004) m = -0.004;
+      px -= m * nx; py -= m * ny; pz -= m * nz;
       pos[3 * v] = px; pos[3 * v + 1] = py; pos[3 * v + 2] = pz;
     }
   }

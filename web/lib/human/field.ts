@@ -1,10 +1,10 @@
-// Signed distance (approximate) of the body: an order-independent n-ary smooth union per
-// blend group, then between groups. Primitives that cannot influence a region are culled via
-// a coarse acceleration grid; the value at a point depends only on the point (deterministic),
-// which is what the polygoniser needs for a crack-free surface.
+// Signed distance (approximate) of the body: a smooth union (quadratic smooth-min, C¹) folded
+// over each blend group's primitives, then over the groups. Fold steps that cannot matter in a
+// region are skipped via a coarse acceleration grid without changing the function; the value
+// at a point depends only on the point, which the polygoniser needs for a crack-free surface.
 import { BodyModel, GROUP_K, PRIM_ELLIPSOID, TOP_K } from './model.js';
 
-const ACCEL = 0.04;
+const ACCEL = 0.025;
 
 export class BodyField {
   readonly n: number;
@@ -15,11 +15,9 @@ export class BodyField {
   readonly ngroups: number;
   private readonly o: [number, number, number];
   private readonly dims: [number, number, number];
-  private readonly cellStart: Int32Array;
-  private readonly cellList: Int32Array;
-  private readonly dist: Float64Array;
-  private readonly gval: Float64Array;
-  private readonly gmin: Float64Array;
+  private readonly lists: (Int32Array | undefined)[];
+  private readonly progs: (Int32Array | undefined)[];
+  private readonly scratch: Float64Array;
 
   constructor(model: BodyModel) {
     const prims = model.prims;
@@ -30,34 +28,35 @@ export class BodyField {
     this.P = new Float64Array(this.n * 16);
     prims.forEach((p, i) => this.P.set(p.p, i * 16));
     this.ngroups = GROUP_K.length;
-    this.dist = new Float64Array(this.n);
-    this.gval = new Float64Array(this.ngroups);
-    this.gmin = new Float64Array(this.ngroups);
 
     const m = 0.1;
     this.o = [model.bboxMin[0] - m, model.bboxMin[1] - m, model.bboxMin[2] - m];
     this.dims = [0, 1, 2].map((a) => Math.ceil((model.bboxMax[a] + m - this.o[a]) / ACCEL)) as [number, number, number];
     const [dx, dy, dz] = this.dims;
-    const ncell = dx * dy * dz;
-    const lists: number[][] = [];
-    const all = Array.from({ length: this.n }, (_, i) => i);
+    this.lists = new Array(dx * dy * dz);
+    this.progs = new Array(dx * dy * dz);
+    this.scratch = new Float64Array(this.n);
+  }
+
+  /** Primitives that can influence the value somewhere in accel cell c (built on first use). */
+  private list(c: number): Int32Array {
+    let l = this.lists[c];
+    if (l) return l;
+    const [dx, dy] = this.dims;
+    const i = c % dx, j = Math.floor(c / dx) % dy, k = Math.floor(c / (dx * dy));
+    const x = this.o[0] + (i + 0.5) * ACCEL, y = this.o[1] + (j + 0.5) * ACCEL, z = this.o[2] + (k + 0.5) * ACCEL;
+    const d = this.scratch;
+    let mn = Infinity;
+    for (let p = 0; p < this.n; p++) { d[p] = this.prim(p, x, y, z); if (d[p] < mn) mn = d[p]; }
+    // a primitive matters where it is within its blend radius of the nearest one; the
+    // distances change by at most the half-diagonal across the cell (with slack for the
+    // approximate ellipsoid distance)
     const half = (ACCEL * Math.sqrt(3)) / 2;
-    const kmax = Math.max(...GROUP_K) + TOP_K;
-    const d = new Float64Array(this.n);
-    for (let k = 0; k < dz; k++) for (let j = 0; j < dy; j++) for (let i = 0; i < dx; i++) {
-      const x = this.o[0] + (i + 0.5) * ACCEL, y = this.o[1] + (j + 0.5) * ACCEL, z = this.o[2] + (k + 0.5) * ACCEL;
-      let mn = Infinity;
-      for (const p of all) { d[p] = this.prim(p, x, y, z); if (d[p] < mn) mn = d[p]; }
-      // generous margin: the ellipsoid distance is only approximate away from its surface
-      const keep = all.filter((p) => d[p] - 2 * half <= mn + 2 * half + 1.5 * kmax);
-      lists.push(keep);
-    }
-    this.cellStart = new Int32Array(ncell + 1);
-    let tot = 0;
-    for (let c = 0; c < ncell; c++) { this.cellStart[c] = tot; tot += lists[c].length; }
-    this.cellStart[ncell] = tot;
-    this.cellList = new Int32Array(tot);
-    for (let c = 0; c < ncell; c++) this.cellList.set(lists[c], this.cellStart[c]);
+    const keep: number[] = [];
+    for (let p = 0; p < this.n; p++) if (d[p] <= mn + 3 * half + GROUP_K[this.group[p]] + TOP_K) keep.push(p);
+    l = Int32Array.from(keep);
+    this.lists[c] = l;
+    return l;
   }
 
   /** Distance to primitive i (approximate for ellipsoids). */
@@ -104,37 +103,78 @@ export class BodyField {
     return i + dx * (j + dy * k);
   }
 
+  /**
+   * The evaluation program of accel cell c: the smooth union is a fixed left fold per group
+   * (primitives in model order), then a fold over the groups. A fold step smin(acc, d) is
+   * exactly acc when d ≥ acc + k (or exactly d when acc ≥ d + k), so using interval bounds over
+   * the cell, steps that cannot matter are dropped without changing the function: the result
+   * is the same C¹ function everywhere, only cheaper. Layout: [nGroups, (group, count, prims…)…].
+   */
+  private prog(c: number): Int32Array {
+    let pr = this.progs[c];
+    if (pr) return pr;
+    const [dx, dy] = this.dims;
+    const i = c % dx, j = Math.floor(c / dx) % dy, k = Math.floor(c / (dx * dy));
+    const x = this.o[0] + (i + 0.5) * ACCEL, y = this.o[1] + (j + 0.5) * ACCEL, z = this.o[2] + (k + 0.5) * ACCEL;
+    const slack = 1.5 * (ACCEL * Math.sqrt(3)) / 2;
+    const groups: { g: number; lo: number; hi: number; prims: number[] }[] = [];
+    for (let g = 0; g < this.ngroups; g++) {
+      const kg = GROUP_K[g];
+      let lo = Infinity, hi = Infinity;
+      let kept: number[] = [];
+      for (let p = 0; p < this.n; p++) {
+        if (this.group[p] !== g) continue;
+        const d = this.prim(p, x, y, z), plo = d - slack, phi = d + slack;
+        if (kept.length === 0) { kept = [p]; lo = plo; hi = phi; }
+        else if (plo >= hi + kg) continue;
+        else if (lo >= phi + kg) { kept = [p]; lo = plo; hi = phi; }
+        else { kept.push(p); lo = Math.min(lo, plo) - kg / 4; hi = Math.min(hi, phi); }
+      }
+      if (kept.length) groups.push({ g, lo, hi, prims: kept });
+    }
+    let kept: typeof groups = [];
+    let lo = Infinity, hi = Infinity;
+    for (const G of groups) {
+      if (kept.length === 0) { kept = [G]; lo = G.lo; hi = G.hi; }
+      else if (G.lo >= hi + TOP_K) continue;
+      else if (lo >= G.hi + TOP_K) { kept = [G]; lo = G.lo; hi = G.hi; }
+      else { kept.push(G); lo = Math.min(lo, G.lo) - TOP_K / 4; hi = Math.min(hi, G.hi); }
+    }
+    const out = [kept.length];
+    for (const G of kept) out.push(G.g, G.prims.length, ...G.prims);
+    pr = Int32Array.from(out);
+    this.progs[c] = pr;
+    return pr;
+  }
+
   /** Signed distance of the body surface (negative inside). */
   eval(x: number, y: number, z: number): number {
-    const c = this.cell(x, y, z);
-    const s = this.cellStart[c], e = this.cellStart[c + 1];
-    const L = this.cellList, dist = this.dist, grp = this.group, gmin = this.gmin, gval = this.gval;
-    gmin.fill(Infinity);
-    for (let q = s; q < e; q++) {
-      const i = L[q];
-      const d = this.prim(i, x, y, z);
-      dist[i] = d;
-      if (d < gmin[grp[i]]) gmin[grp[i]] = d;
+    const P = this.prog(this.cell(x, y, z));
+    let q = 0;
+    const ng = P[q++];
+    let top = 0;
+    for (let gi = 0; gi < ng; gi++) {
+      const g = P[q++], cnt = P[q++], k = GROUP_K[g];
+      let acc = this.prim(P[q++], x, y, z);
+      for (let r = 1; r < cnt; r++) {
+        const d = this.prim(P[q++], x, y, z);
+        const h = k - Math.abs(acc - d);
+        acc = (acc < d ? acc : d) - (h > 0 ? (h * h) / (4 * k) : 0);
+      }
+      if (gi === 0) top = acc;
+      else {
+        const h = TOP_K - Math.abs(top - acc);
+        top = (top < acc ? top : acc) - (h > 0 ? (h * h) / (4 * TOP_K) : 0);
+      }
     }
-    gval.fill(0);
-    for (let q = s; q < e; q++) {
-      const i = L[q], g = grp[i], k = GROUP_K[g];
-      const h = 1 - (dist[i] - gmin[g]) / k;
-      if (h > 0) gval[g] += h * h * (k / 4);
-    }
-    let top = Infinity;
-    for (let g = 0; g < this.ngroups; g++) {
-      if (gmin[g] === Infinity) continue;
-      gval[g] = gmin[g] - (gval[g] - GROUP_K[g] / 4);
-      if (gval[g] < top) top = gval[g];
-    }
-    let acc = 0;
-    for (let g = 0; g < this.ngroups; g++) {
-      if (gmin[g] === Infinity) continue;
-      const h = 1 - (gval[g] - top) / TOP_K;
-      if (h > 0) acc += h * h * (TOP_K / 4);
-    }
-    return top - (acc - TOP_K / 4);
+    return top;
+  }
+
+  /** Distances of the primitives that can matter at a point (written to out[i]); returns their indices. */
+  nearDistances(x: number, y: number, z: number, out: Float64Array): Int32Array {
+    const L = this.list(this.cell(x, y, z));
+    for (let q = 0; q < L.length; q++) out[L[q]] = this.prim(L[q], x, y, z);
+    return L;
   }
 
   /** Per-primitive distances at a point (all primitives), written to out. */

@@ -84,7 +84,7 @@ export function createHumanData(options: HumanOptions = {}): HumanData {
   const field = new BodyField(model);
   const welded = seams ? Math.round(vertices * WELDED_FRACTION) : vertices;
   const poly = polygonizeBody(field, model, welded);
-  relax(field, poly.positions, poly.indices, 2);
+  relax(field, poly.positions, poly.indices, welded > 200000 ? 2 : 3);
   const wn = vertexNormals(poly.positions, poly.indices);
   const sw = computeWeights(field, poly.positions, poly.indices);
   const cut = cutSeams(poly.positions, poly.indices, seams ? vertices - poly.vertexCount : 0);

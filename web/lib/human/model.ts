@@ -41,7 +41,7 @@ export interface Primitive {
 
 // Blend groups: smooth union inside a group with the group's radius, then a tighter union
 // between groups (so arms do not web onto the torso, legs not onto each other).
-export const GROUP_K = [0.055, 0.02, 0.028, 0.028, 0.035, 0.035];
+export const GROUP_K = [0.09, 0.02, 0.028, 0.028, 0.035, 0.035];
 export const TOP_K = 0.022;
 const G_TORSO = 0, G_HEAD = 1, G_ARM_L = 2, G_ARM_R = 3, G_LEG_L = 4, G_LEG_R = 5;
 
@@ -115,10 +115,10 @@ export function buildBodyModel(pose: Pose): BodyModel {
   ends.set(J('Head'), [0, 1.77, 0.01]);
 
   const T = G_TORSO, H = G_HEAD;
-  prims.push(ellipsoid(J('Hips'), T, [0, 0.945, -0.005], [0.158, 0.115, 0.105]));
+  prims.push(ellipsoid(J('Hips'), T, [0, 0.95, -0.005], [0.155, 0.13, 0.102]));
   prims.push(ellipsoid(J('Hips'), T, [0, 0.9, -0.035], [0.15, 0.085, 0.095])); // buttocks / lower pelvis
-  prims.push(ellipsoid(J('Spine'), T, [0, 1.1, 0.005], [0.142, 0.14, 0.097]));
-  prims.push(ellipsoid(J('Chest'), T, [0, 1.285, 0.0], [0.152, 0.15, 0.108]));
+  prims.push(ellipsoid(J('Spine'), T, [0, 1.1, 0.0], [0.14, 0.18, 0.095]));
+  prims.push(ellipsoid(J('Chest'), T, [0, 1.28, 0.0], [0.152, 0.17, 0.105]));
   prims.push(ellipsoid(J('Chest'), T, [0, 1.38, -0.008], [0.168, 0.07, 0.095])); // upper chest / shoulder line
   prims.push(ellipsoid(J('Chest'), T, [0, 1.3, 0.045], [0.12, 0.075, 0.07])); // pectorals
   prims.push(cone(J('Neck'), T, [0, 1.42, -0.015], [0, 1.6, 0.0], 0.058, 0.05));

@@ -62,7 +62,16 @@ export function polygonize(f: ScalarField, xs: Float64Array, ys: Float64Array, z
   const nx = xs.length, ny = ys.length, nz = zs.length;
   const cx = nx - 1, cy = ny - 1, cz = nz - 1;
   const bx = Math.ceil(cx / B), by = Math.ceil(cy / B), bz = Math.ceil(cz / B);
-  const vmap = new Map<number, number>();
+  // open-addressing hash: grid-edge key → vertex index
+  let hcap = 1 << 16;
+  let hkeys = new Float64Array(hcap).fill(-1);
+  let hvals = new Int32Array(hcap);
+  const slot = (key: number, keys: Float64Array, cap: number) => {
+    const lo = key % 4294967296, hi = (key - lo) / 4294967296;
+    let h = (Math.imul(lo | 0, 0x9e3779b1) ^ Math.imul(hi | 0, 0x85ebca6b)) & (cap - 1);
+    while (keys[h] !== -1 && keys[h] !== key) h = (h + 1) & (cap - 1);
+    return h;
+  };
   let pos = new Float64Array(3 * 65536);
   let nv = 0;
   let idx = new Uint32Array(6 * 65536);
@@ -79,7 +88,8 @@ export function polygonize(f: ScalarField, xs: Float64Array, ys: Float64Array, z
     const mx = (xs[i0] + xs[i1]) / 2, my = (ys[j0] + ys[j1]) / 2, mz = (zs[k0] + zs[k1]) / 2;
     const hd = 0.5 * Math.hypot(xs[i1] - xs[i0], ys[j1] - ys[j0], zs[k1] - zs[k0]);
     const fc = f(mx, my, mz);
-    if (Math.abs(fc) > 2 * hd + 0.01) continue;
+    // no surface in the block if |f| at its centre exceeds the half-diagonal (f is about 1-Lipschitz; 1.5 for slack)
+    if (Math.abs(fc) > 1.5 * hd + 0.003) continue;
     // sample block corners
     for (let k = k0; k <= k1; k++) for (let j = j0; j <= j1; j++) for (let i = i0; i <= i1; i++) {
       let v = f(xs[i], ys[j], zs[k]);
@@ -101,10 +111,20 @@ export function polygonize(f: ScalarField, xs: Float64Array, ys: Float64Array, z
         for (let e = 0; e < tab.length; e += 2) {
           const ca = tab[e], cb = tab[e + 1];
           const key = (g + gOff[ca]) * 8 + (ca ^ cb);
-          let vi = vmap.get(key);
-          if (vi === undefined) {
+          let hs = slot(key, hkeys, hcap);
+          let vi: number;
+          if (hkeys[hs] === key) vi = hvals[hs];
+          else {
             vi = nv++;
-            vmap.set(key, vi);
+            if (2 * nv > hcap) {
+              const ok = hkeys, ov = hvals;
+              hcap *= 2;
+              hkeys = new Float64Array(hcap).fill(-1);
+              hvals = new Int32Array(hcap);
+              for (let q = 0; q < ok.length; q++) if (ok[q] !== -1) { const z = slot(ok[q], hkeys, hcap); hkeys[z] = ok[q]; hvals[z] = ov[q]; }
+              hs = slot(key, hkeys, hcap);
+            }
+            hkeys[hs] = key; hvals[hs] = vi;
             if (3 * nv > pos.length) { const np = new Float64Array(pos.length * 2); np.set(pos); pos = np; }
             const va = cv[ca], vb = cv[cb];
             let s = va / (va - vb);

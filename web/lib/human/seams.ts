@@ -57,15 +57,18 @@ export function cutSeams(pos: Float64Array, idx: Uint32Array, targetDuplicates: 
   if (targetDuplicates <= 0) {
     keys = new Float64Array(nt);
   } else {
-    // duplicates decrease with the cell size: bisect on log(size)
-    let lo = Math.log(0.01), hi = Math.log(4);
-    for (let it = 0; it < 22; it++) {
-      const mid = (lo + hi) / 2;
-      const d = countCopies(cellKeys(pos, idx, Math.exp(mid)), vt, nv);
-      if (Math.abs(d - targetDuplicates) <= Math.max(2, 0.01 * targetDuplicates)) { lo = hi = mid; break; }
-      if (d > targetDuplicates) lo = mid; else hi = mid;
+    // duplicates fall roughly as 1/size: secant steps on log–log, then bisection if needed
+    const tol = Math.max(2, 0.01 * targetDuplicates);
+    let lo = Math.log(0.005), hi = Math.log(4);
+    let x = Math.log(0.3), found = false;
+    for (let it = 0; it < 30 && !found; it++) {
+      const d = countCopies(cellKeys(pos, idx, Math.exp(x)), vt, nv);
+      if (Math.abs(d - targetDuplicates) <= tol) { found = true; break; }
+      if (d > targetDuplicates) lo = Math.max(lo, x); else hi = Math.min(hi, x);
+      const next = it < 6 && d > 0 ? x + Math.log(d / targetDuplicates) : (lo + hi) / 2;
+      x = next > lo && next < hi ? next : (lo + hi) / 2;
     }
-    keys = cellKeys(pos, idx, Math.exp((lo + hi) / 2));
+    keys = cellKeys(pos, idx, Math.exp(x));
   }
 
   // charts: connected components of triangles sharing an edge and a cell

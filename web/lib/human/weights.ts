@@ -2,8 +2,9 @@
 // distance to a bone is its distance to the nearest primitive of that bone. The nearest bone
 // dominates, and bones whose primitives are almost as near (within SIGMA) share the weight
 // with a quadratic falloff: this blends across each joint over a band that scales with the
-// limb's radius. Only bones close in the hierarchy (parent, child, grandparent, grandchild)
-// may share, so a thigh does not pull on the other thigh and a hand not on the hip.
+// limb's radius. Only the dominant bone's parent and children may share, so a thigh does not
+// pull on the other thigh, nor an arm on the chest; neighbour averaging then smooths the
+// borders between dominance regions.
 import { BodyField } from './field.js';
 import { JOINT_NAMES, JOINT_PARENTS } from './model.js';
 
@@ -18,8 +19,7 @@ export function computeWeights(field: BodyField, pos: Float64Array, idx: Uint32A
   const nb = JOINT_NAMES.length;
   const nv = pos.length / 3;
   const par = JOINT_PARENTS;
-  const near = (a: number, b: number) =>
-    a === b || par[a] === b || par[b] === a || (par[a] >= 0 && par[par[a]] === b) || (par[b] >= 0 && par[par[b]] === a);
+  const near = (a: number, b: number) => a === b || par[a] === b || par[b] === a;
   const allowed = new Uint8Array(nb * nb);
   for (let a = 0; a < nb; a++) for (let b = 0; b < nb; b++) allowed[a * nb + b] = near(a, b) ? 1 : 0;
 
@@ -27,9 +27,10 @@ export function computeWeights(field: BodyField, pos: Float64Array, idx: Uint32A
   const d = new Float64Array(field.n);
   const db = new Float64Array(nb);
   for (let v = 0; v < nv; v++) {
-    field.allDistances(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], d);
+    // primitives beyond their blend radius of the nearest one are culled: their bones get no weight
+    const L = field.nearDistances(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], d);
     db.fill(Infinity);
-    for (let i = 0; i < field.n; i++) { const b = field.bone[i]; if (d[i] < db[b]) db[b] = d[i]; }
+    for (let q = 0; q < L.length; q++) { const i = L[q], b = field.bone[i]; if (d[i] < db[b]) db[b] = d[i]; }
     let dom = 0;
     for (let b = 1; b < nb; b++) if (db[b] < db[dom]) dom = b;
     for (let b = 0; b < nb; b++) {
@@ -38,8 +39,8 @@ export function computeWeights(field: BodyField, pos: Float64Array, idx: Uint32A
       if (h > 0) W[v * nb + b] = h * h;
     }
   }
-  // two passes of neighbour averaging smooth out the seams of the dominance regions
-  smooth(W, nb, idx, nv, 2);
+  // a few passes of neighbour averaging smooth out the seams of the dominance regions
+  smooth(W, nb, idx, nv, 3);
   return topFour(W, nb, nv);
 }
 
