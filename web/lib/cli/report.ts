@@ -85,7 +85,7 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
   try {
     model = await loadGltfFile(file);
   } catch (e) {
-    throw new ReportError(`cannot read ${file}: ${(e as Error).message.split('\n')[0]}`);
+    throw new ReportError(`cannot read ${file}: ${(e as Error).message.replace(/\s*\n\s*/g, ' ').trim()}`);
   }
   if (!model.skinnedMeshes.length) throw new ReportError(`${file} has no skinned mesh (no skin, joints and weights): nothing to deform`);
   let clips = model.clips;
