@@ -13,36 +13,9 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 constexpr float kMinBoneFraction = 0.03f;  // a cylinder-like part is at least 3 % of the height long
 constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried rigidly
-constexpr float kOutlierFactor = 3.0f;
+constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
 constexpr float kMaxExtension = 0.5f;      // a tube end passes a rigid neighbour's joint by ≤ ½ bone
-constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°     // a hit farther than 3 × the contour's median is a miss
-
-// Same welding as the GCS model: vertices at one bind position belong to one part.
-std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
-  struct Key {
-    uint32_t x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    size_t operator()(const Key& k) const {
-      return size_t(k.x * 73856093u) ^ size_t(k.y * 19349663u) ^ size_t(k.z * 83492791u);
-    }
-  };
-  std::unordered_map<Key, uint32_t, Hash> seen;
-  seen.reserve(rig.vertexCount * 2);
-  std::vector<uint32_t> group(rig.vertexCount);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    Key k;
-    glm::vec3 p = rig.positions[v] + glm::vec3(0.0f);
-    std::memcpy(&k.x, &p.x, 4);
-    std::memcpy(&k.y, &p.y, 4);
-    std::memcpy(&k.z, &p.z, 4);
-    auto it = seen.emplace(k, uint32_t(representative.size()));
-    if (it.second) representative.push_back(v);
-    group[v] = it.first->second;
-  }
-  return group;
-}
+constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°
 
 glm::vec3 anyPerpendicular(const glm::vec3& a) {
   glm::vec3 g = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);

@@ -9,34 +9,6 @@
 namespace gcs {
 namespace {
 
-// Vertices that sit at the same bind-pose position (UV or normal seams split them in glTF) are
-// treated as one: same part, same section, so a seam can never open.
-std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
-  struct Key {
-    uint32_t x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    size_t operator()(const Key& k) const {
-      return size_t(k.x * 73856093u) ^ size_t(k.y * 19349663u) ^ size_t(k.z * 83492791u);
-    }
-  };
-  std::unordered_map<Key, uint32_t, Hash> seen;
-  seen.reserve(rig.vertexCount * 2);
-  std::vector<uint32_t> group(rig.vertexCount);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    Key k;
-    glm::vec3 p = rig.positions[v] + glm::vec3(0.0f);  // +0 folds -0 into 0
-    std::memcpy(&k.x, &p.x, 4);
-    std::memcpy(&k.y, &p.y, 4);
-    std::memcpy(&k.z, &p.z, 4);
-    auto it = seen.emplace(k, uint32_t(representative.size()));
-    if (it.second) representative.push_back(v);
-    group[v] = it.first->second;
-  }
-  return group;
-}
-
 float segmentDistance2(const glm::vec3& x, const glm::vec3& a, const glm::vec3& b) {
   glm::vec3 ab = b - a;
   float len2 = glm::dot(ab, ab);

@@ -36,6 +36,11 @@ bool buildRig(const float* positions, const float* normals, uint32_t vertexCount
 void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                     std::vector<glm::vec3>& normals);
 
+// Vertices at the same bind-pose position (UV or normal seams split them in glTF) are one
+// surface point: returns each vertex's group id and fills `representative` (first vertex of
+// each group). Both models group by it, so a seam can never open.
+std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
+
 // Checks that `count` floats are all finite.
 bool allFinite(const float* values, size_t count);
 
