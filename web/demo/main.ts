@@ -176,9 +176,9 @@ async function init(): Promise<void> {
   scene.fog = new THREE.Fog(0x242a35, 7, 16);
 
   camera = new THREE.PerspectiveCamera(30, 1, 0.05, 100);
-  camera.position.set(1.7, 1.45, 4.1);
+  camera.position.set(1.9, 1.5, 4.9);
   controls = new OrbitControls(camera, renderer.domElement);
-  controls.target.set(0, 0.9, 0);
+  controls.target.set(0, 0.95, 0);
   controls.enableDamping = true;
   controls.minDistance = 0.5;
   controls.maxDistance = 20;
@@ -213,7 +213,7 @@ async function init(): Promise<void> {
   scene.add(gcsGroup, classicGroup);
 
   stats = new Stats();
-  stats.dom.style.cssText = 'position:fixed;right:10px;bottom:30px;z-index:10;opacity:0.85;cursor:pointer';
+  stats.dom.style.cssText = 'position:fixed;right:10px;bottom:96px;z-index:10;opacity:0.85;cursor:pointer';
   document.body.appendChild(stats.dom);
 
   initGui();
@@ -273,7 +273,10 @@ function initGui(): void {
 }
 
 function setClipOptions(names: string[]): void {
+  // lil-gui's options() re-adds the controller at the end of its folder: put it back first.
   clipController = clipController.options(names.length ? names : ['(none)']).name('clip').onChange(playClip);
+  const el = (clipController as unknown as { domElement: HTMLElement }).domElement;
+  el.parentElement?.prepend(el);
 }
 
 function gcsOptions(): GcsOptions {
@@ -601,6 +604,7 @@ function rebuildGcs(ch: Character): void {
   } catch (e) {
     showMessage(`GCS model: ${describeError(e)}`);
   }
+  updateLabels();
   updateReadouts();
 }
 
@@ -633,9 +637,13 @@ function rebuildClassic(ch: Character): void {
 function views(): ViewKind[] {
   return params.lbsView ? ['gcs', 'classic', 'lbs'] : ['gcs', 'classic'];
 }
+/** Width of the control column on the right (the GUI overlays the views on narrow windows). */
+function sidebarWidth(): number {
+  return window.innerWidth >= 900 ? 290 : 0;
+}
 function viewRects(): { kind: ViewKind; x: number; width: number }[] {
   const list = views();
-  const w = window.innerWidth;
+  const w = window.innerWidth - sidebarWidth();
   return list.map((kind, i) => {
     const x = Math.round((i * w) / list.length);
     return { kind, x, width: Math.round(((i + 1) * w) / list.length) - x };
@@ -643,8 +651,12 @@ function viewRects(): { kind: ViewKind; x: number; width: number }[] {
 }
 
 function onWindowResize(): void {
-  renderer.setSize(window.innerWidth, window.innerHeight);
+  const side = sidebarWidth();
+  document.documentElement.style.setProperty('--sidebar', `${side}px`);
+  $('sidebar').hidden = side === 0;
+  renderer.setSize(window.innerWidth - side, window.innerHeight);
   updateLabels();
+  updateReadouts();
 }
 
 const esc = (s: string) => s.replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' })[c]!);
@@ -654,8 +666,8 @@ function updateLabels(): void {
   const ch = current;
   let html = '';
   rects.forEach((r, i) => {
-    const last = i === rects.length - 1;
-    const maxWidth = Math.max(180, Math.min(420, r.width - (last ? 320 : 30)));
+    const overlaid = i === rects.length - 1 && sidebarWidth() === 0; // the GUI covers its right part
+    const maxWidth = Math.max(160, Math.min(440, r.width - (overlaid ? 300 : 20)));
     let body = '';
     if (r.kind === 'gcs') {
       body = '<h2>GCS — generalized cross-sections</h2><div class="sub">Li, Wang, Mao · ' +
@@ -666,7 +678,7 @@ function updateLabels(): void {
       body = '<h2>Classic cross-sections</h2><div class="sub">Shen, Magnenat-Thalmann, Thalmann 1994 · ' +
         `${params.contours} contours × ${params.rays} rays per limb</div>`;
       if (ch?.classicError) body += `<div class="err">Not available: ${esc(ch.classicError)}</div>`;
-      else if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly (not resampled): ${esc(ch.rigidParts.join(', '))}</div>`;
+      else if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly, not resampled: ${esc(ch.rigidParts.join(', '))}</div>`;
       if (params.colourBySection && !ch?.classicError) body += '<div class="sub">colour = resampled part · grey = rigid part</div>';
     } else {
       body = '<h2>three.js skinning (LBS)</h2><div class="sub">the source SkinnedMesh itself, for reference</div>';
@@ -724,20 +736,29 @@ function collectReadouts(): Readouts {
 
 function updateReadouts(): void {
   const r = (lastReadouts = collectReadouts());
-  const fmt = (n: number | undefined) => (n === undefined || !Number.isFinite(n) ? '—' : Math.round(n).toLocaleString('en'));
-  const ms = (n: number | undefined) => (n === undefined || !Number.isFinite(n) ? '—' : n < 10 ? n.toFixed(2) : n.toFixed(1));
-  const lbs = params.lbsView;
-  const row = (name: string, a: string, b: string, c: string) => `<tr><th>${name}</th><td>${a}</td><td>${b}</td>${lbs ? `<td>${c}</td>` : ''}</tr>`;
-  const clip = current?.action ? ` · ${esc(current.action.getClip().name)}` : '';
-  readoutsEl.innerHTML = `<div class="model">${esc(r.character || '—')}${clip}</div><table>` +
-    row('', '<b>GCS</b>', '<b>classic</b>', '<b>LBS</b>') +
-    row('deform ms / frame', ms(r.gcs?.ms), ms(r.classic?.ms), 'GPU') +
-    row('vertices', fmt(r.gcs?.vertices), fmt(r.classic?.vertices), fmt(r.lbs?.vertices)) +
-    row('triangles', fmt(r.gcs?.triangles), fmt(r.classic?.triangles), fmt(r.lbs?.triangles)) +
-    row('sections / contours', fmt(r.gcs?.sections), fmt(r.classic?.contours), '—') +
-    row('adjusted sections', r.gcs ? `${(r.gcs.adjustedShare * 100).toFixed(0)} %` : '—', '—', '—') +
-    row('detail loss rms / max', '0 (exact)', r.classic ? `${r.classic.detailLoss.rms.toFixed(2)} / ${r.classic.detailLoss.max.toFixed(2)} % h` : '—', '0') +
-    '</table>';
+  const n = (v: number) => Math.round(v).toLocaleString('en');
+  const ms = (v: number) => (!Number.isFinite(v) ? '—' : v < 10 ? v.toFixed(2) : v.toFixed(1));
+  const rows: Record<ViewKind, string[]> = { gcs: [], classic: [], lbs: [] };
+  if (r.gcs) {
+    rows.gcs.push(`deform <b>${ms(r.gcs.ms)} ms</b> / frame · ${n(r.gcs.vertices)} vertices · ${n(r.gcs.triangles)} triangles`);
+    rows.gcs.push(`<b>${n(r.gcs.sections)}</b> sections · <b>${(r.gcs.adjustedShare * 100).toFixed(0)} %</b> adjusted this frame · rest pose exact`);
+  }
+  if (r.classic) {
+    rows.classic.push(`deform <b>${ms(r.classic.ms)} ms</b> / frame · ${n(r.classic.vertices)} vertices · ${n(r.classic.triangles)} triangles`);
+    rows.classic.push(`<b>${n(r.classic.contours)}</b> contours · resampling detail loss <b>${r.classic.detailLoss.rms.toFixed(2)} %</b> rms, ` +
+      `<b>${r.classic.detailLoss.max.toFixed(2)} %</b> max (of height)`);
+  }
+  if (r.lbs) rows.lbs.push(`skinned on the GPU by three.js · ${n(r.lbs.vertices)} vertices · ${n(r.lbs.triangles)} triangles`);
+  const clip = current?.action ? current.action.getClip().name : '';
+  let html = '';
+  viewRects().forEach((v, i) => {
+    const lines = rows[v.kind].slice();
+    if (i === 0 && r.character) lines.unshift(`<b>${esc(r.character)}</b>${clip ? ` · ${esc(clip)}` : ''}`);
+    if (lines.length)
+      html += `<div class="readout" data-view="${v.kind}" style="left:${v.x + 10}px;max-width:${v.width - 20}px">` +
+        lines.map((l) => `<div class="row">${l}</div>`).join('') + '</div>';
+  });
+  readoutsEl.innerHTML = html;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -838,6 +859,11 @@ Object.assign(window, {
     readouts: () => collectReadouts(),
     views: () => viewRects(),
     time: () => current?.mixer.time ?? 0,
+    /** Pauses (through the GUI's checkbox), optionally at clip time t seconds. */
+    pause: (t?: number) => {
+      pausedController.setValue(true);
+      if (t !== undefined) current?.mixer.setTime(t);
+    },
     /** Settles when every queued load has finished. */
     idle: () => queue.then(() => undefined),
   },

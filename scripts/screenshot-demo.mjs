@@ -1,0 +1,60 @@
+#!/usr/bin/env node
+// Screenshots of the demo page for the README: builds the demo, serves it with `vite preview`
+// and photographs it in headless Chromium (SwiftShader).
+//
+//   node scripts/screenshot-demo.mjs            → docs/demo.png, docs/demo-sections.png
+//   node scripts/screenshot-demo.mjs --out DIR  → the same files in DIR
+import { existsSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { build, preview } from 'vite';
+import { chromium } from 'playwright-core';
+
+const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
+const outIndex = process.argv.indexOf('--out');
+const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+if (!existsSync(chromiumPath)) {
+  console.error(`screenshot-demo: ${chromiumPath} not found (set CHROMIUM=/path/to/chromium)`);
+  process.exit(1);
+}
+
+const configFile = join(root, 'web/demo/vite.config.ts');
+const dist = mkdtempSync(join(tmpdir(), 'gcs-demo-'));
+await build({ configFile, logLevel: 'error', build: { outDir: dist, emptyOutDir: true } });
+const server = await preview({ configFile, logLevel: 'error', build: { outDir: dist }, preview: { host: '127.0.0.1', port: 0 } });
+const url = server.resolvedUrls.local[0];
+
+const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
+  executablePath: chromiumPath,
+  headless: true,
+  viewport: { width: 1440, height: 800 },
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+});
+mkdirSync(outDir, { recursive: true });
+try {
+  const shots = [
+    { file: 'demo.png', query: '?lbs=1' },
+    { file: 'demo-sections.png', query: '?colour=1&sections=8' },
+  ];
+  for (const shot of shots) {
+    const page = await context.newPage();
+    page.on('pageerror', (e) => console.error('page error:', e.message));
+    await page.goto(url + shot.query);
+    await page.waitForFunction(() => window.__demo !== undefined);
+    await page.evaluate(() => window.__demo.ready);
+    // A stride of the walk with legs apart, then hold it so every view shows the same pose.
+    await page.waitForFunction(() => window.__demo.time() > 0.9, null, { timeout: 60000 });
+    await page.evaluate(() => window.__demo.pause(0.32));
+    await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
+    await page.screenshot({ path: join(outDir, shot.file) });
+    console.log('wrote', join(outDir, shot.file));
+    await page.close();
+  }
+} finally {
+  await context.close();
+  await server.close();
+  rmSync(dist, { recursive: true, force: true });
+}

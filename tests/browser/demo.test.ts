@@ -1,0 +1,206 @@
+// The demo page in headless Chromium: both views render, animate, follow the GUI's section
+// slider, load a dropped character, and keep the old one when a file is broken.
+import { readFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { BrowserContext, Page } from 'playwright-core';
+import { analyse, existsSync, launchChromium, MODELS_DIR, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+
+const reason = skipReason();
+if (reason) console.log(reason);
+
+/** The 3D part of each view: below the labels, above the readouts. */
+async function viewRegions(page: Page): Promise<Rect[]> {
+  const { views, height } = await page.evaluate(() => ({ views: window.__demo.views(), height: window.innerHeight }));
+  return views.map((v) => ({ x: v.x + 8, y: 140, width: v.width - 16, height: height - 140 - 80 }));
+}
+
+async function frames(page: Page, n: number): Promise<void> {
+  const f = await page.evaluate(() => window.__demo.frame());
+  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
+}
+
+/** Clicks a lil-gui checkbox by its label. */
+async function toggle(page: Page, name: string): Promise<void> {
+  await page.locator('.lil-gui .controller.boolean').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('input').click();
+}
+
+/** Drops files on the page as a user would (a synthetic drop event carrying a DataTransfer). */
+async function drop(page: Page, files: { name: string; bytes: Buffer }[]): Promise<void> {
+  await page.evaluate(async (list) => {
+    const dt = new DataTransfer();
+    for (const f of list) dt.items.add(new File([Uint8Array.from(atob(f.b64), (c) => c.charCodeAt(0))], f.name));
+    const canvas = document.querySelector('canvas')!;
+    canvas.dispatchEvent(new DragEvent('dragenter', { dataTransfer: dt, bubbles: true, cancelable: true }));
+    canvas.dispatchEvent(new DragEvent('dragover', { dataTransfer: dt, bubbles: true, cancelable: true }));
+    canvas.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+    await new Promise((r) => setTimeout(r, 50));
+    await window.__demo.idle();
+  }, files.map((f) => ({ name: f.name, b64: f.bytes.toString('base64') })));
+}
+
+describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
+  let server: DemoServer;
+  let context: BrowserContext;
+  let page: Page;
+  const pageErrors: string[] = [];
+
+  beforeAll(async () => {
+    const t0 = performance.now();
+    [server, context] = await Promise.all([startDemo(), launchChromium()]);
+    page = await context.newPage();
+    page.on('pageerror', (e) => pageErrors.push(e.message));
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.__demo !== undefined);
+    await page.evaluate(() => window.__demo.ready);
+    await frames(page, 3);
+    console.log(`demo served in ${server.startMs.toFixed(0)} ms; page ready (human built, first frames) after ${(performance.now() - t0).toFixed(0)} ms`);
+  });
+
+  afterAll(async () => {
+    await context?.close();
+    await server?.close();
+  });
+
+  test('the page starts walking the default human, with both views labelled', async () => {
+    const state = await page.evaluate(() => ({
+      error: window.__demo.error(), character: window.__demo.character(), sections: window.__demo.sectionCount(),
+      views: window.__demo.views().map((v) => v.kind), classicError: window.__demo.classicError(), rigid: window.__demo.rigidParts(),
+    }));
+    expect(state.error).toBe('');
+    expect(state.character).toMatch(/Human/);
+    expect(state.sections).toBeGreaterThan(50);
+    expect(state.views).toEqual(['gcs', 'classic']);
+    await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/GCS/);
+    const classicLabel = await page.locator('.label[data-view=classic]').innerText();
+    expect(classicLabel).toMatch(/Classic cross-sections/);
+    // Either the classic model runs and names the parts it carries rigidly, or it says why it cannot.
+    if (state.classicError) expect(classicLabel).toContain(state.classicError);
+    else {
+      expect(state.rigid.length).toBeGreaterThan(0);
+      expect(classicLabel).toMatch(/Carried rigidly/);
+    }
+    await expect(page.locator('.lil-gui .controller .name', { hasText: 'sections per part' }).isVisible()).resolves.toBe(true);
+  });
+
+  test('both views render a lit character (not blank, many colours in each)', async () => {
+    const regions = await viewRegions(page);
+    const stats = await analyse(page, await page.screenshot(), regions);
+    const classicError = await page.evaluate(() => window.__demo.classicError());
+    stats.forEach((s, i) => {
+      expect(s.colours, `distinct colours in view ${i}`).toBeGreaterThan(150);
+      if (i === 0 || !classicError) expect(s.skin, `share of skin pixels in view ${i}`).toBeGreaterThan(0.02);
+    });
+  });
+
+  test('the picture changes over time (the walk is animated)', async () => {
+    const regions = await viewRegions(page);
+    const t0 = await page.evaluate(() => window.__demo.time());
+    const a = await page.screenshot();
+    await page.waitForTimeout(400);
+    await frames(page, 3);
+    const b = await page.screenshot();
+    const stats = await analyse(page, b, regions, a);
+    expect(await page.evaluate(() => window.__demo.time())).toBeGreaterThan(t0);
+    expect(stats[0].changed).toBeGreaterThan(0.003);
+    if (!(await page.evaluate(() => window.__demo.classicError()))) expect(stats[1].changed).toBeGreaterThan(0.003);
+  });
+
+  test('the section-count slider rebuilds the GCS model live and changes the picture', async () => {
+    const regions = await viewRegions(page);
+    await toggle(page, 'pause');
+    await toggle(page, 'colour by section');
+    try {
+    await frames(page, 3);
+    const before = { count: await page.evaluate(() => window.__demo.sectionCount()), shot: await page.screenshot() };
+    expect(await page.evaluate(() => window.__demo.sectionsPerPart())).toBe(6);
+
+    // Type into the slider's number input, as a user would.
+    const sections = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: 'sections per part' }) });
+    await sections.locator('input').fill('12');
+    await sections.locator('input').press('Enter');
+    await page.waitForFunction((n) => window.__demo.sectionCount() !== n, before.count);
+    await frames(page, 3);
+    const after12 = await page.evaluate(() => ({ perPart: window.__demo.sectionsPerPart(), count: window.__demo.sectionCount() }));
+    expect(after12.perPart).toBe(12);
+    expect(after12.count).toBeGreaterThan(before.count);
+    const shot12 = await page.screenshot();
+    const diff = await analyse(page, shot12, regions, before.shot);
+    expect(diff[0].changed, 'GCS view changed').toBeGreaterThan(0.005);
+    expect(diff[1].changed, 'classic view unchanged (paused, not rebuilt)').toBeLessThan(0.002);
+    await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/12 sections per part/);
+
+    // Drag on the slider track itself: near its left end is few sections.
+    const box = (await sections.locator('.slider').boundingBox())!;
+    await page.mouse.click(box.x + 1, box.y + box.height / 2);
+    await page.waitForFunction(() => window.__demo.sectionsPerPart() <= 4);
+    await page.waitForFunction((n) => window.__demo.sectionCount() < n, before.count);
+    await frames(page, 2);
+    } finally {
+      await toggle(page, 'colour by section');
+      await toggle(page, 'pause');
+      await page.evaluate(() => window.__demo.setSections(6));
+      await frames(page, 2);
+    }
+  });
+
+  test('a broken file, a mesh without skin and a .gltf with external buffers give clear messages; the character stays', async () => {
+    const character = await page.evaluate(() => window.__demo.character());
+
+    await drop(page, [{ name: 'broken.glb', bytes: Buffer.from('this is not a glTF file at all') }]);
+    let error = await page.evaluate(() => window.__demo.error());
+    expect(error).toMatch(/broken\.glb/);
+    await expect(page.locator('#message').isVisible()).resolves.toBe(true);
+    expect(await page.evaluate(() => window.__demo.character())).toBe(character);
+
+    // A valid glTF with one triangle and no skin, through the "load file…" input.
+    const triangle = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
+    const noSkin = {
+      asset: { version: '2.0' }, scenes: [{ nodes: [0] }], nodes: [{ mesh: 0 }],
+      meshes: [{ primitives: [{ attributes: { POSITION: 0 } }] }],
+      accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 0] }],
+      bufferViews: [{ buffer: 0, byteLength: 36 }],
+      buffers: [{ byteLength: 36, uri: `data:application/octet-stream;base64,${triangle.toString('base64')}` }],
+    };
+    await page.locator('#file').setInputFiles({ name: 'triangle.gltf', mimeType: 'model/gltf+json', buffer: Buffer.from(JSON.stringify(noSkin)) });
+    await page.waitForFunction(() => /triangle\.gltf/.test(window.__demo.error()));
+    await page.evaluate(() => window.__demo.idle());
+    error = await page.evaluate(() => window.__demo.error());
+    expect(error).toMatch(/no skinned mesh/);
+    expect(await page.evaluate(() => window.__demo.character())).toBe(character);
+
+    const external = { ...noSkin, buffers: [{ byteLength: 36, uri: 'triangle.bin' }] };
+    await drop(page, [{ name: 'external.gltf', bytes: Buffer.from(JSON.stringify(external)) }]);
+    error = await page.evaluate(() => window.__demo.error());
+    expect(error).toMatch(/external files \(triangle\.bin\)/);
+    expect(await page.evaluate(() => window.__demo.character())).toBe(character);
+
+    // The old character still animates.
+    const t = await page.evaluate(() => window.__demo.time());
+    await frames(page, 3);
+    expect(await page.evaluate(() => window.__demo.time())).toBeGreaterThan(t);
+    await page.locator('#message-close').click();
+  });
+
+  const model = ['CesiumMan.glb', 'Soldier.glb'].map((f) => join(MODELS_DIR, f)).find((f) => existsSync(f));
+  test.skipIf(!model)(`a character dropped on the page loads (${model ?? `skipped: no CesiumMan.glb or Soldier.glb in ${MODELS_DIR}`})`, async () => {
+    const name = model!.split('/').pop()!;
+    await drop(page, [{ name, bytes: readFileSync(model!) }]);
+    const state = await page.evaluate(() => ({ error: window.__demo.error(), character: window.__demo.character(), sections: window.__demo.sectionCount() }));
+    expect(state.error).toBe('');
+    expect(state.character).toBe(name);
+    expect(state.sections).toBeGreaterThan(10);
+    await frames(page, 3);
+    const regions = await viewRegions(page);
+    const a = await page.screenshot();
+    await page.waitForTimeout(300);
+    await frames(page, 3);
+    const stats = await analyse(page, await page.screenshot(), regions, a);
+    expect(stats[0].colours).toBeGreaterThan(150);
+    expect(stats[0].changed).toBeGreaterThan(0.002);
+  });
+
+  test('no uncaught errors in the page', () => {
+    expect(pageErrors).toEqual([]);
+  });
+});

@@ -1,0 +1,142 @@
+// Shared by the browser tests: build and serve the demo, launch headless Chromium, read pixels.
+import { existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { createServer as createNetServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import type { BrowserContext, Page } from 'playwright-core';
+
+export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
+export const MODELS_DIR = resolve(ROOT, '../shared/models');
+export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
+
+/** Why the browser tests cannot run here, or null when they can. */
+export function skipReason(): string | null {
+  return existsSync(CHROMIUM) ? null : `browser tests skipped: no Chromium at ${CHROMIUM} (apt-get install chromium, or set CHROMIUM=/path)`;
+}
+
+async function freePort(): Promise<number> {
+  return new Promise((resolvePort, reject) => {
+    const srv = createNetServer();
+    srv.once('error', reject);
+    srv.listen(0, '127.0.0.1', () => {
+      const { port } = srv.address() as { port: number };
+      srv.close(() => resolvePort(port));
+    });
+  });
+}
+
+export interface DemoServer {
+  url: string;
+  /** ms from start until the page can be served */
+  startMs: number;
+  close(): Promise<void>;
+}
+
+/**
+ * Serves the demo. 'preview' (default): `vite build` into a temp dir + `vite preview`;
+ * 'dev': the dev server (set DEMO_SERVER=dev). Measured here: build + preview ≈ 1.5 s and the
+ * first page is ready at once; the dev server starts faster but its first page load transforms
+ * three.js on demand and is slower overall.
+ */
+export async function startDemo(mode = process.env.DEMO_SERVER === 'dev' ? 'dev' : 'preview'): Promise<DemoServer> {
+  const t0 = performance.now();
+  const vite = await import('vite');
+  const configFile = join(ROOT, 'web/demo/vite.config.ts');
+  const port = await freePort();
+  if (mode === 'dev') {
+    const server = await vite.createServer({ configFile, logLevel: 'error', server: { host: '127.0.0.1', port, strictPort: true } });
+    await server.listen();
+    return { url: `http://127.0.0.1:${port}/`, startMs: performance.now() - t0, close: () => server.close() };
+  }
+  const outDir = mkdtempSync(join(tmpdir(), 'gcs-demo-build-'));
+  await vite.build({ configFile, logLevel: 'error', build: { outDir, emptyOutDir: true } });
+  const server = await vite.preview({ configFile, logLevel: 'error', build: { outDir }, preview: { host: '127.0.0.1', port, strictPort: true } });
+  return {
+    url: `http://127.0.0.1:${port}/`,
+    startMs: performance.now() - t0,
+    close: async () => {
+      await new Promise<void>((r) => server.httpServer.close(() => r()));
+      rmSync(outDir, { recursive: true, force: true });
+    },
+  };
+}
+
+export async function launchChromium(): Promise<BrowserContext> {
+  const { chromium } = await import('playwright-core');
+  return chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
+    executablePath: CHROMIUM,
+    headless: true,
+    viewport: { width: 1280, height: 720 },
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+}
+
+export interface Rect { x: number; y: number; width: number; height: number }
+export interface RegionStats {
+  /** distinct colours, quantised to 5 bits a channel */
+  colours: number;
+  /** share of pixels that look like skin (red well above blue), as the default material is */
+  skin: number;
+  /** share of pixels that differ (any channel by > 24) from the same pixel of `before` */
+  changed: number;
+}
+
+/**
+ * Decodes PNG screenshots inside the page (createImageBitmap + OffscreenCanvas, no npm PNG
+ * package) and measures regions of them.
+ */
+export async function analyse(page: Page, png: Buffer, regions: Rect[], before?: Buffer): Promise<RegionStats[]> {
+  return page.evaluate(async ({ png, before, regions }) => {
+    const decode = async (b64: string) => {
+      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+      const ctx = canvas.getContext('2d')!;
+      ctx.drawImage(bitmap, 0, 0);
+      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
+    };
+    const a = await decode(png);
+    const b = before ? await decode(before) : null;
+    return regions.map((r) => {
+      const colours = new Set<number>();
+      let skin = 0, changed = 0, total = 0;
+      for (let y = Math.max(0, r.y); y < Math.min(a.height, r.y + r.height); y++) {
+        for (let x = Math.max(0, r.x); x < Math.min(a.width, r.x + r.width); x++) {
+          const i = 4 * (y * a.width + x);
+          const R = a.data[i], G = a.data[i + 1], B = a.data[i + 2];
+          colours.add(((R >> 3) << 10) | ((G >> 3) << 5) | (B >> 3));
+          if (R > 110 && R - B > 40) skin++;
+          if (b && (Math.abs(R - b.data[i]) > 24 || Math.abs(G - b.data[i + 1]) > 24 || Math.abs(B - b.data[i + 2]) > 24)) changed++;
+          total++;
+        }
+      }
+      return { colours: colours.size, skin: skin / Math.max(1, total), changed: changed / Math.max(1, total) };
+    });
+  }, { png: png.toString('base64'), before: before?.toString('base64'), regions });
+}
+
+export { existsSync };
+
+/** The demo's testing hook (web/demo/main.ts, window.__demo). */
+export interface DemoHook {
+  ready: Promise<void>;
+  frame(): number;
+  busy(): boolean;
+  error(): string;
+  character(): string;
+  sectionCount(): number;
+  sectionsPerPart(): number;
+  setSections(n: number): void;
+  classicError(): string | null;
+  rigidParts(): string[];
+  readouts(): unknown;
+  views(): { kind: string; x: number; width: number }[];
+  time(): number;
+  pause(t?: number): void;
+  idle(): Promise<void>;
+}
+declare global {
+  interface Window { __demo: DemoHook }
+}
