@@ -36,7 +36,7 @@ const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir()
 mkdirSync(outDir, { recursive: true });
 try {
   const shots = [
-    { file: 'demo.png', query: '?lbs=1' },
+    { file: 'demo.png', query: '' },
     { file: 'demo-sections.png', query: '?colour=1&sections=8' },
   ];
   for (const shot of shots) {

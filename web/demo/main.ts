@@ -678,7 +678,7 @@ function updateLabels(): void {
       body = '<h2>Classic cross-sections</h2><div class="sub">Shen, Magnenat-Thalmann, Thalmann 1994 · ' +
         `${params.contours} contours × ${params.rays} rays per limb</div>`;
       if (ch?.classicError) body += `<div class="err">Not available: ${esc(ch.classicError)}</div>`;
-      else if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly, not resampled: ${esc(ch.rigidParts.join(', '))}</div>`;
+      else if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly, not resampled: ${esc(summariseBones(ch.rigidParts))}</div>`;
       if (params.colourBySection && !ch?.classicError) body += '<div class="sub">colour = resampled part · grey = rigid part</div>';
     } else {
       body = '<h2>three.js skinning (LBS)</h2><div class="sub">the source SkinnedMesh itself, for reference</div>';
@@ -687,6 +687,17 @@ function updateLabels(): void {
     if (i > 0) html += `<div class="divider" style="left:${r.x - 1}px"></div>`;
   });
   labelsEl.innerHTML = html;
+}
+
+/** A short list of bone names: no common prefix (e.g. "mixamorig"), fingers counted, at most 10. */
+function summariseBones(names: string[]): string {
+  let prefix = names.length > 1 ? names[0] : '';
+  for (const n of names) while (prefix && !n.startsWith(prefix)) prefix = prefix.slice(0, -1);
+  const short = names.map((n) => n.slice(prefix.length) || n);
+  const fingers = short.filter((n) => /thumb|index|middle|ring|pinky|finger/i.test(n));
+  const rest = short.filter((n) => !fingers.includes(n));
+  if (fingers.length) rest.push(`${fingers.length} finger bones`);
+  return rest.length > 10 ? `${rest.slice(0, 10).join(', ')} and ${rest.length - 10} more` : rest.join(', ');
 }
 
 interface Readouts {
