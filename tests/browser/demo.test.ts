@@ -25,6 +25,13 @@ async function toggle(page: Page, name: string): Promise<void> {
   await page.locator('.lil-gui .controller.boolean').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('input').click();
 }
 
+/** Sets a lil-gui number controller by typing into its input. */
+async function setNumber(page: Page, name: string, value: number): Promise<void> {
+  const input = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('input');
+  await input.fill(String(value));
+  await input.press('Enter');
+}
+
 /** Drops files on the page as a user would (a synthetic drop event carrying a DataTransfer). */
 async function drop(page: Page, files: { name: string; bytes: Buffer }[]): Promise<void> {
   await page.evaluate(async (list) => {
@@ -144,6 +151,37 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     }
   });
 
+  test('the other controls: clip, third (three.js LBS) view, classic contours and bulge', async () => {
+    await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^clip$/ }) }).locator('select').selectOption('run');
+    await page.waitForFunction(() => window.__demo.clip() === 'run');
+
+    await toggle(page, 'three.js LBS view');
+    await frames(page, 2);
+    expect((await page.evaluate(() => window.__demo.views())).map((v) => v.kind)).toEqual(['gcs', 'classic', 'lbs']);
+    await expect(page.locator('.label[data-view=lbs]').innerText()).resolves.toMatch(/three\.js skinning/);
+    const stats = await analyse(page, await page.screenshot(), await viewRegions(page));
+    expect(stats[2].colours, 'the LBS view renders').toBeGreaterThan(150);
+    expect(stats[2].skin).toBeGreaterThan(0.02);
+    await toggle(page, 'three.js LBS view');
+
+    if (!(await page.evaluate(() => window.__demo.classicError()))) {
+      const contours = () => page.evaluate(() => (window.__demo.readouts() as { classic: { contours: number } }).classic.contours);
+      const builds = await page.evaluate(() => window.__demo.classicBuilds());
+      const before = await contours();
+      await setNumber(page, 'contours', 10);
+      await page.waitForFunction((n) => window.__demo.classicBuilds() > n, builds);
+      expect(await contours()).toBeLessThan(before);
+      const afterContours = await page.evaluate(() => window.__demo.classicBuilds());
+      await setNumber(page, 'muscle bulge', 2);
+      await frames(page, 2);
+      expect(await page.evaluate(() => window.__demo.classicBuilds()), 'bulge changes without a rebuild').toBe(afterContours);
+      await setNumber(page, 'muscle bulge', 0.3);
+      await setNumber(page, 'contours', 25);
+    }
+    await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^clip$/ }) }).locator('select').selectOption('walk');
+    expect(await page.evaluate(() => window.__demo.error())).toBe('');
+  });
+
   test('a broken file, a mesh without skin and a .gltf with external buffers give clear messages; the character stays', async () => {
     const character = await page.evaluate(() => window.__demo.character());
 
@@ -198,6 +236,19 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     const stats = await analyse(page, await page.screenshot(), regions, a);
     expect(stats[0].colours).toBeGreaterThan(150);
     expect(stats[0].changed).toBeGreaterThan(0.002);
+  });
+
+  test('?model= with a URL that fails says so and falls back to the default human', async () => {
+    const other = await context.newPage();
+    other.on('pageerror', (e) => pageErrors.push(e.message));
+    await other.goto(`${server.url}?model=missing/nothing-here.glb`);
+    await other.waitForFunction(() => window.__demo !== undefined);
+    await other.evaluate(() => window.__demo.ready);
+    await other.evaluate(() => window.__demo.idle());
+    expect(await other.evaluate(() => window.__demo.error())).toMatch(/nothing-here\.glb/);
+    await expect(other.locator('#message').isVisible()).resolves.toBe(true);
+    expect(await other.evaluate(() => window.__demo.character())).toMatch(/Human/);
+    await other.close();
   });
 
   test('no uncaught errors in the page', () => {

@@ -134,6 +134,8 @@ export interface DemoHook {
   readouts(): unknown;
   views(): { kind: string; x: number; width: number }[];
   time(): number;
+  clip(): string;
+  classicBuilds(): number;
   pause(t?: number): void;
   idle(): Promise<void>;
 }

@@ -100,6 +100,8 @@ let lastTime = performance.now();
 let lastReadout = 0;
 const timing = { gcs: NaN, classic: NaN };
 let busy = 0;
+/** Builds of the classic model so far (a bulge change must not add one). */
+let classicBuilds = 0;
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 const fileInput = $<HTMLInputElement>('file');
@@ -233,7 +235,11 @@ async function init(): Promise<void> {
   const model = query.get('model');
   if (model) {
     await enqueue(() => loadUrl(model));
-    if (!current) await enqueue(() => loadHuman());
+    if (!current) {
+      const reason = messageText.textContent;
+      await enqueue(() => loadHuman());
+      showMessage(`${reason} Showing the default human instead.`);
+    }
   } else {
     await enqueue(() => loadHuman());
   }
@@ -560,6 +566,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
 
 function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; error: string | null } {
   const skins: SkinDeformer[] = [];
+  classicBuilds++;
   try {
     for (const src of sources) skins.push(new SkinDeformer(gcs, src, { method: 'classic', classic: classicOptions(), material: classicMaterial }));
     return { skins, error: null };
@@ -611,6 +618,7 @@ function rebuildGcs(ch: Character): void {
 function rebuildClassic(ch: Character): void {
   pendingClassic = false;
   if (ch.classic.length) {
+    classicBuilds++;
     try {
       for (const s of ch.classic) {
         s.rebuild('classic', { classic: classicOptions() });
@@ -870,6 +878,8 @@ Object.assign(window, {
     readouts: () => collectReadouts(),
     views: () => viewRects(),
     time: () => current?.mixer.time ?? 0,
+    clip: () => current?.action?.getClip().name ?? '',
+    classicBuilds: () => classicBuilds,
     /** Pauses (through the GUI's checkbox), optionally at clip time t seconds. */
     pause: (t?: number) => {
       pausedController.setValue(true);
