@@ -38,6 +38,7 @@ try {
   const shots = [
     { file: 'demo.png', query: '' },
     { file: 'demo-sections.png', query: '?colour=1&sections=8' },
+    ...(process.env.EXTRA ? [{ file: 'extra.png', query: process.env.EXTRA }] : []),
   ];
   for (const shot of shots) {
     const page = await context.newPage();
