@@ -820,12 +820,17 @@ function animate(): void {
     ch.mixer.timeScale = params.speed;
     if (!params.paused) ch.mixer.update(dt);
     try {
+      // One world-matrix pass for the shared skeletons, then every deformer skips its own.
+      let root: THREE.Object3D | undefined = ch.gcs[0]?.source ?? ch.classic[0]?.source;
+      while (root?.parent) root = root.parent;
+      root?.updateMatrixWorld();
+      const noWorldUpdate = { updateMatrixWorld: false };
       let t0 = performance.now();
-      for (const s of ch.gcs) s.update();
+      for (const s of ch.gcs) s.update(noWorldUpdate);
       timing.gcs = ema(timing.gcs, performance.now() - t0);
       if (ch.classic.length) {
         t0 = performance.now();
-        for (const s of ch.classic) s.update();
+        for (const s of ch.classic) s.update(noWorldUpdate);
         timing.classic = ema(timing.classic, performance.now() - t0);
       }
     } catch (e) {

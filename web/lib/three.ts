@@ -148,10 +148,15 @@ export class SkinDeformer {
     this.update();
   }
 
-  /** Poses from the skeleton and deforms. Call once per frame, after the mixer. */
-  update(): void {
+  /**
+   * Poses from the skeleton and deforms. Call once per frame, after the mixer. By default it
+   * first updates the world matrices of the source's scene graph (the bones as the mixer left
+   * them); pass `{ updateMatrixWorld: false }` when several deformers share a scene and the
+   * caller has already done that once this frame.
+   */
+  update(options: { updateMatrixWorld?: boolean } = {}): void {
     const source = this.source;
-    this.root.updateMatrixWorld(); // bones' world matrices as the mixer left them
+    if (options.updateMatrixWorld !== false) this.root.updateMatrixWorld();
     const bones = source.skeleton.bones;
     const inverses = source.skeleton.boneInverses;
     const skin = this.skin;
