@@ -42,15 +42,17 @@ test('the npm tarball installs into an empty folder, imports and deforms', () =>
     const rig = gcs.createRig({ positions, indices, joints, weights, parents: [-1, 0],
       inverseBindMatrices: [...id, 1,0,0,0, 0,1,0,0, 0,0,1,0, 0,-0.75,0,1] });
     const d = rig.buildGcs({ sections: 4 });
+    const paper = rig.buildGcs({ sections: 4, criterion: 'axial' });
     d.deform([...id, ...id]);
     let code = null;
     try { rig.buildGcs({ sections: 1 }); } catch (e) { code = e instanceof GcsError ? e.code : String(e); }
-    console.log(JSON.stringify({ vertices: d.vertexCount, sections: d.sectionCount, first: Array.from(d.positions.slice(0, 3)), code }));
+    console.log(JSON.stringify({ vertices: d.vertexCount, sections: d.sectionCount, paperSections: paper.sectionCount, first: Array.from(d.positions.slice(0, 3)), code }));
   `);
   const out = execFileSync(process.execPath, ['main.mjs'], { cwd: app, encoding: 'utf8' });
   const result = JSON.parse(out.trim().split('\n').pop()!);
   expect(result.vertices).toBe(16);
-  expect(result.sections).toBeGreaterThan(2);
+  expect(result.sections).toBe(2); // weights criterion: two rigid cores (every weight is 1.0)
+  expect(result.paperSections).toBeGreaterThan(2); // the paper's rule: a shared section and inner ones
   expect(result.first.every(Number.isFinite)).toBe(true);
   expect(result.code).toBe('SECTION_COUNT');
 }, 240000);

@@ -73,7 +73,7 @@ describe('model settings', () => {
     expectGcsError(() => rig.buildGcs({ sections: 4.5 }), 'SECTION_COUNT', /whole number/);
     expectGcsError(() => rig.buildGcs({ influenceWidth: 0 }), 'OUT_OF_RANGE', /\(0, 1\]/);
     expectGcsError(() => rig.buildGcs({ influenceWidth: NaN }), 'OUT_OF_RANGE', /\(0, 1\]/);
-    expectGcsError(() => rig.buildGcs({ criterion: 'z' as 'y' }), 'INVALID_ARGUMENT', /'y' or 'axial'/);
+    expectGcsError(() => rig.buildGcs({ criterion: 'z' as 'y' }), 'INVALID_ARGUMENT', /'weights', 'y' or 'axial'/);
     expectGcsError(() => rig.build('nope' as 'gcs'), 'INVALID_ARGUMENT', /unknown deformer kind/);
     // The rig is still usable after every rejection.
     const d = rig.buildGcs({ sections: 5 });

@@ -36,7 +36,7 @@ describe('GCS on a two-bone tube', () => {
   test('bent 90°: each section follows the ω schedule; the SGS turns by exactly half', () => {
     const tube = makeTube();
     const rig = gcs.createRig(tube.input);
-    const d = rig.buildGcs({ sections: 6 });
+    const d = rig.buildGcs({ sections: 6, criterion: 'axial' });
     const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
     d.deform(tubeSkin(bend));
     const sections = d.sections();
@@ -86,7 +86,7 @@ describe('GCS on a two-bone tube', () => {
     const tube = makeTube();
     const rig = gcs.createRig(tube.input);
     const w = 0.3;
-    const d = rig.buildGcs({ sections: 12, influenceWidth: w });
+    const d = rig.buildGcs({ sections: 12, criterion: 'axial', influenceWidth: w });
     const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
     d.deform(tubeSkin(bend));
     const sections = d.sections();
@@ -156,7 +156,7 @@ describe('GCS on a two-bone tube', () => {
     const bend = rotationAbout(tube.joint, Z, Math.PI / 2);
     // Largest change of direction between consecutive longitudinal edges of one column.
     const maxKink = (smooth: boolean) => {
-      const d = rig.buildGcs({ sections: 4, smooth });
+      const d = rig.buildGcs({ sections: 4, criterion: 'axial', smooth });
       d.deform(tubeSkin(bend));
       const out = new Float32Array(tube.input.positions.length);
       const src = d.sourceVertex!, pos = d.positions;
@@ -194,7 +194,7 @@ describe('GCS on a two-bone tube', () => {
     };
     const jointRing = Math.round((tube.rings - 1) / 2);
     for (const twistSpread of [false, true]) {
-      const d = rig.buildGcs({ sections: 8, twistSpread });
+      const d = rig.buildGcs({ sections: 8, criterion: 'axial', twistSpread });
       d.deform(tubeSkin(twist));
       const sections = d.sections();
       const m = d.sectionMatrices();

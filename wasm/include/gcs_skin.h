@@ -99,8 +99,9 @@ float gcs_rig_height(const GcsRig* rig);
 typedef struct GcsDeformer GcsDeformer;
 
 typedef enum GcsCriterion {
-  GCS_CRITERION_Y = 0,     /* the paper's: bin by the bind-pose Y coordinate */
-  GCS_CRITERION_AXIAL = 1  /* ours: bin by the projection on the bone axis (works in T-pose) */
+  GCS_CRITERION_Y = 0,       /* the paper's: bin by the bind-pose Y coordinate */
+  GCS_CRITERION_AXIAL = 1,   /* the paper's rule, binned by the projection on the bone axis (T-poses) */
+  GCS_CRITERION_WEIGHTS = 2  /* the default: bin by skin weights; sections are rigid blends (design.md §2a) */
 } GcsCriterion;
 
 typedef enum GcsDeformerKind {
@@ -112,18 +113,43 @@ typedef enum GcsDeformerKind {
 
 /*
  * Builds a generalized cross-section model from a rig.
- *   sections        sections per part (2 shared sections + sections−2 inner), in
- *                   [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS].
- *   criterion       a GcsCriterion.
- *   influenceWidth  fraction of a part over which joint influence ramps, in (0, 1]; 1 = the paper.
- *   smooth          nonzero: each vertex blends the two nearest sections' transforms.
- *   twistSpread     nonzero: a joint's twist about its bone is spread along the child part.
+ *   sections        level of detail, in [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS].
+ *                   Weights criterion: the grid step of the skin weights is 1 / (2·(sections − 2))
+ *                   (6 → eighths; 3 → only rigid cores and even splits).
+ *                   Y / axial: sections per part (2 shared + sections − 2 inner).
+ *   criterion       a GcsCriterion (values above GCS_CRITERION_WEIGHTS are rejected).
+ *   influenceWidth  Y / axial: fraction of a part over which joint influence ramps, in (0, 1];
+ *                   1 = the paper. Checked but unused by the weights criterion.
+ *   smooth          nonzero: each vertex blends its section's transform with a neighbouring
+ *                   section's (Y / axial: the sections bracketing its axial coordinate; weights: the
+ *                   next bin along its weight farthest from its section's mean), normals renormalised.
+ *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
+ *
+ * Weights criterion (design.md §2a): welded vertices (same bind-pose position) are binned by their
+ * weights (influences < 0.5 % dropped, renormalised; the non-dominant ones rounded to the grid, the
+ * dominant one taking the rest). A bin with one joint is its rigid core: transform exactly S_j, so
+ * geometry bound 100 % to a bone moves exactly with it. The bin where two joints share the weight
+ * evenly is their shared section (one transform for both parts). Every other bin moves by the
+ * dual-quaternion blend of its joints at its members' mean weights (for a parent/child pair: a
+ * fraction of the child's rotation about the joint centre, the paper's rule), with the scale parts
+ * of the S_j blended linearly and applied first.
+ * Y / axial criteria (the paper, design.md §2b–3): parts by dominant weight, shared sections from
+ * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
+ * transform S_p · D_j^α · D_k^β on the rigid parts of the S_j (scale applied first).
+ *
+ * Scale: every S_j may carry a scale (uniform ×100 in cm rigs, 0 for a hidden bone, non-uniform):
+ * positions follow it; normals stay unit length (a collapsed bone keeps its rotated rest normals).
+ * Output is finite for every finite input.
  * The output mesh is the rig's vertices reordered section by section (see
  * gcs_deformer_source_vertex) with the rig's triangles remapped (gcs_deformer_indices).
  */
 GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
                            float influenceWidth, int smooth, int twistSpread);
-/* Linear blend skinning and dual-quaternion skinning; output in the rig's vertex order. */
+/* Linear blend skinning and dual-quaternion skinning; output in the rig's vertex order.
+   LBS: positions by Σ w_j S_j, normals by the same matrix then unit length (as three.js), the rest
+   normal turned by the first joint's rotation where that matrix has collapsed.
+   DQS: the rigid part of each S_j as a dual quaternion (blended, normalised), its scale part
+   (Rᵀ·S, 3×3) blended linearly and applied first; unit normals. */
 GcsDeformer* gcs_build_lbs(const GcsRig* rig);
 GcsDeformer* gcs_build_dqs(const GcsRig* rig);
 
@@ -171,7 +197,11 @@ float gcs_deformer_stat(const GcsDeformer* deformer, uint32_t stat);
  *   gcs_gcs_section_of_vertex   output vertexCount uint32: section id of each output vertex.
  *   gcs_gcs_section_info        sectionCount × 8 floats per section:
  *                               [first vertex, vertex count, part joint, distal joint or -1,
- *                                kind (0 inner, 1 shared section), mean t, alpha, beta]
+ *                                kind (0 inner, 1 shared section, 2 rigid core), t, alpha, beta]
+ *                               Y / axial: part = the part's joint, distal = the child part its
+ *                               branch leads to, t = mean axial coordinate, alpha/beta = fractions.
+ *                               Weights: part = dominant joint, distal = second joint, alpha/beta =
+ *                               their mean weights, t = beta.
  * Null for deformers that are not GCS.
  */
 const uint32_t* gcs_gcs_section_of_vertex(const GcsDeformer* deformer);

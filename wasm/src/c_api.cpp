@@ -70,6 +70,10 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
                            float influenceWidth, int smooth, int twistSpread) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
+  if (criterion > GCS_CRITERION_WEIGHTS) {  // checked before the value becomes an enum
+    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)", criterion);
+    return nullptr;
+  }
   gcs::GcsSettings settings;
   settings.sections = sections;
   settings.criterion = GcsCriterion(criterion);
@@ -127,7 +131,7 @@ const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* d) {
 }
 
 float gcs_deformer_stat(const GcsDeformer* d, uint32_t stat) {
-  return d ? d->impl->stat(GcsStat(stat)) : std::nanf("");
+  return d && stat <= GCS_STAT_ADJUSTED_SECTIONS ? d->impl->stat(GcsStat(stat)) : std::nanf("");
 }
 
 static const gcs::GcsDeformerImpl* asGcs(const GcsDeformer* d) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <tuple>
 #include <unordered_map>
 #include "error.h"
 
@@ -25,6 +26,294 @@ struct Branch {
   glm::vec3 axis{0.0f, 1.0f, 0.0f};
   float sProximal = 0.0f, sDistal = 1.0f;
 };
+
+// Writes the output mesh section by section (a counting sort of the vertices by section) given
+// each welded group's section; m.sections[i].count/first are filled here. Returns, for each rig
+// vertex, its output index.
+std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
+                                     const std::vector<uint32_t>& sectionOfGroup) {
+  const uint32_t S = uint32_t(m.sections.size());
+  for (Section& sec : m.sections) sec.count = 0;
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++m.sections[sectionOfGroup[group[v]]].count;
+  uint32_t first = 0;
+  for (Section& sec : m.sections) sec.first = first, first += sec.count;
+  m.allocateOutput(rig.vertexCount);
+  m.restPositions.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
+  m.restNormals.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
+  m.sourceVertex.resize(rig.vertexCount);
+  m.sectionOfVertex.resize(rig.vertexCount);
+  std::vector<uint32_t> cursor(S);
+  for (uint32_t i = 0; i < S; ++i) cursor[i] = m.sections[i].first;
+  std::vector<uint32_t> outputOf(rig.vertexCount);
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+    uint32_t sec = sectionOfGroup[group[v]];
+    uint32_t o = cursor[sec]++;
+    outputOf[v] = o;
+    m.sourceVertex[o] = v;
+    m.sectionOfVertex[o] = sec;
+    for (int c = 0; c < 3; ++c) {
+      m.restPositions[3 * o + c] = rig.positions[v][c];
+      m.restNormals[3 * o + c] = rig.normals[v][c];
+    }
+  }
+  m.indices.resize(rig.indices.size());
+  for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
+  return outputOf;
+}
+
+// Bounding spheres (for the adjusted-section statistic), the introspection table, the per-frame
+// buffers, and the rest pose in the output.
+void finishModel(GcsDeformerImpl& m) {
+  const uint32_t S = uint32_t(m.sections.size());
+  m.sectionInfo.resize(size_t(S) * 8);
+  for (uint32_t i = 0; i < S; ++i) {
+    Section& sec = m.sections[i];
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) {
+      glm::vec3 p(m.restPositions[3 * o], m.restPositions[3 * o + 1], m.restPositions[3 * o + 2]);
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    sec.centre = 0.5f * (lo + hi);
+    sec.radius = 0.5f * glm::length(hi - lo);
+    float* info = &m.sectionInfo[size_t(i) * 8];
+    info[0] = float(sec.first);
+    info[1] = float(sec.count);
+    info[2] = float(sec.part);
+    info[3] = float(sec.distal);
+    info[4] = sec.rigid ? 2.0f : sec.shared ? 1.0f : 0.0f;
+    info[5] = sec.t;
+    info[6] = sec.alpha;
+    info[7] = sec.beta;
+  }
+  m.poses.resize(m.jointCount);
+  m.sectionMatrices.assign(S, glm::mat4(1.0f));
+  m.normalMatrices.assign(S, glm::mat4(1.0f));
+  m.renormalise.assign(S, 0);
+  uint32_t most = 1;
+  for (const Section& sec : m.sections) most = std::max(most, sec.influenceCount);
+  m.blendPoseScratch.resize(most);
+  std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
+  std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
+}
+
+// A section key of the weights criterion: up to 4 (joint, quantised weight) pairs sorted by joint.
+struct WeightKey {
+  uint32_t joint[4] = {~0u, ~0u, ~0u, ~0u};
+  uint32_t q[4] = {0, 0, 0, 0};
+  uint32_t n = 0;
+  bool operator==(const WeightKey& o) const {
+    if (n != o.n) return false;
+    for (uint32_t i = 0; i < n; ++i)
+      if (joint[i] != o.joint[i] || q[i] != o.q[i]) return false;
+    return true;
+  }
+  // Drops zero entries, sorts by joint, and makes a single joint the rigid core (q = Q).
+  void canonical(uint32_t Q) {
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; ++i)
+      if (q[i] > 0) joint[k] = joint[i], q[k] = q[i], ++k;
+    for (uint32_t i = k; i < 4; ++i) joint[i] = ~0u, q[i] = 0;
+    n = k;
+    for (uint32_t i = 1; i < n; ++i)
+      for (uint32_t j = i; j > 0 && joint[j] < joint[j - 1]; --j) std::swap(joint[j], joint[j - 1]), std::swap(q[j], q[j - 1]);
+    if (n == 1) q[0] = Q;
+  }
+  uint32_t slot(uint32_t j) const {
+    for (uint32_t i = 0; i < n; ++i)
+      if (joint[i] == j) return i;
+    return ~0u;
+  }
+  // The joint with the largest quantised weight (ties: the lowest id).
+  uint32_t dominant() const {
+    uint32_t best = 0;
+    for (uint32_t i = 1; i < n; ++i)
+      if (q[i] > q[best]) best = i;
+    return best;
+  }
+};
+struct WeightKeyHash {
+  size_t operator()(const WeightKey& k) const {
+    uint64_t h = 0x9e3779b97f4a7c15ull ^ k.n;
+    for (uint32_t i = 0; i < k.n; ++i) {
+      h ^= (uint64_t(k.joint[i]) << 20 | k.q[i]) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+      h *= 0xbf58476d1ce4e5b9ull;
+    }
+    return size_t(h ^ (h >> 31));
+  }
+};
+
+// A welded vertex's weights as the criterion reads them: influences below 0.5 % dropped, the
+// same joint listed twice merged, the rest normalised to sum 1.
+uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
+  uint32_t n = 0;
+  float sum = 0.0f;
+  for (int i = 0; i < 4; ++i) {
+    float w = rig.weights[v][i];
+    if (!(w > 0.0f)) continue;
+    uint32_t j = rig.joints[v][i], k = 0;
+    while (k < n && joint[k] != j) ++k;
+    if (k == n) joint[n] = j, weight[n] = 0.0f, ++n;
+    weight[k] += w;
+  }
+  uint32_t kept = 0;
+  float biggest = 0.0f;
+  for (uint32_t i = 0; i < n; ++i) biggest = std::max(biggest, weight[i]);
+  for (uint32_t i = 0; i < n; ++i)
+    if (weight[i] >= 0.005f || weight[i] == biggest) joint[kept] = joint[i], weight[kept] = weight[i], sum += weight[i], ++kept;
+  for (uint32_t i = 0; i < kept; ++i) weight[i] /= sum;
+  return kept;
+}
+
+// The weights criterion (design.md §2a): sections are bins of the welded vertices' skin weights on
+// a grid of step 1/Q, Q = 2 · (sections − 2) (so the even split between two joints is a bin: their
+// shared section). Each section's blend is its members' mean weights on the joints of its key; a
+// key with one joint is that joint's rigid core (transform exactly S_j). Smooth mode: each group
+// also gets the neighbouring bin along its most off-centre weight and the factor towards it.
+void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
+                         std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
+                         std::vector<float>& blendOfGroup) {
+  const uint32_t G = uint32_t(representative.size());
+  const uint32_t Q = 2 * (m.settings.sections - 2);
+  std::vector<WeightKey> keyOfGroup(G);
+  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
+  std::vector<WeightKey> keys;
+  std::vector<uint32_t> keyOf(G);
+  for (uint32_t g = 0; g < G; ++g) {
+    uint32_t joint[4];
+    float weight[4];
+    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    uint32_t d = 0;
+    for (uint32_t i = 1; i < n; ++i)
+      if (weight[i] > weight[d]) d = i;
+    WeightKey key;
+    key.n = n;
+    uint32_t others = 0, largest = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      key.joint[i] = joint[i];
+      if (i == d) continue;
+      key.q[i] = uint32_t(std::floor(weight[i] * float(Q) + 0.5f));
+      others += key.q[i];
+      largest = std::max(largest, key.q[i]);
+    }
+    key.q[d] = std::max(others < Q ? Q - others : 0u, std::max(largest, 1u));
+    key.canonical(Q);
+    keyOfGroup[g] = key;
+    auto it = keyIndex.find(key);
+    if (it == keyIndex.end()) {
+      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
+      keys.push_back(key);
+    }
+    keyOf[g] = it->second;
+  }
+  // Mean weights per key on its own joints.
+  const uint32_t K = uint32_t(keys.size());
+  std::vector<double> sums(size_t(K) * 4, 0.0);
+  for (uint32_t g = 0; g < G; ++g) {
+    uint32_t joint[4];
+    float weight[4];
+    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    const WeightKey& key = keys[keyOf[g]];
+    for (uint32_t i = 0; i < n; ++i) {
+      uint32_t s = key.slot(joint[i]);
+      if (s != ~0u) sums[size_t(keyOf[g]) * 4 + s] += weight[i];
+    }
+  }
+  // Sections ordered by dominant joint, its rigid core first, then by key: a part is contiguous.
+  std::vector<uint32_t> order(K);
+  for (uint32_t k = 0; k < K; ++k) order[k] = k;
+  auto rank = [&](uint32_t k) {
+    const WeightKey& key = keys[k];
+    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
+                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
+  std::vector<uint32_t> sectionOfKey(K);
+  m.sections.resize(K);
+  m.influences.clear();
+  for (uint32_t i = 0; i < K; ++i) {
+    const uint32_t k = order[i];
+    sectionOfKey[k] = i;
+    const WeightKey& key = keys[k];
+    Section& sec = m.sections[i];
+    const uint32_t d = key.dominant();
+    sec.part = key.joint[d];
+    sec.rigid = key.n == 1;
+    sec.influenceFirst = uint32_t(m.influences.size());
+    double total = 0.0;
+    for (uint32_t s = 0; s < key.n; ++s) total += sums[size_t(k) * 4 + s];
+    uint32_t second = ~0u;
+    for (uint32_t s = 0; s < key.n; ++s) {
+      float w = sec.rigid ? 1.0f : float(sums[size_t(k) * 4 + s] / total);
+      m.influences.push_back({key.joint[s], w});
+      if (s != d && (second == ~0u || key.q[s] > key.q[second])) second = s;
+    }
+    sec.influenceCount = key.n;
+    sec.distal = second == ~0u ? -1 : int32_t(key.joint[second]);
+    sec.shared = second != ~0u && key.q[second] == key.q[d];
+    sec.alpha = m.influences[sec.influenceFirst + d].weight;
+    sec.beta = second == ~0u ? 0.0f : m.influences[sec.influenceFirst + second].weight;
+    sec.t = sec.beta;
+  }
+  sectionOfGroup.resize(G);
+  for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = sectionOfKey[keyOf[g]];
+  m.partCount = 0;
+  for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
+  if (!m.settings.smooth) return;
+
+  // Smooth mode: a section's transform is the blend at its mean weights (a rigid core: weight 1 on
+  // its joint). Along the vertex's weight that lies farthest from its section's mean, the
+  // neighbouring bin on that side (weight moved to or from the dominant joint) and the factor of
+  // the vertex between the two means.
+  auto meanWeight = [&](uint32_t section, uint32_t joint) {
+    const Section& sec = m.sections[section];
+    for (uint32_t s = 0; s < sec.influenceCount; ++s)
+      if (m.influences[sec.influenceFirst + s].joint == joint) return m.influences[sec.influenceFirst + s].weight;
+    return 0.0f;
+  };
+  otherOfGroup.resize(G);
+  blendOfGroup.assign(G, 0.0f);
+  for (uint32_t g = 0; g < G; ++g) {
+    const uint32_t own = sectionOfGroup[g];
+    otherOfGroup[g] = own;
+    uint32_t joint[4];
+    float weight[4];
+    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    uint32_t d = 0;
+    for (uint32_t i = 1; i < n; ++i)
+      if (weight[i] > weight[d]) d = i;
+    uint32_t pick = ~0u;
+    float offset = 0.0f;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (i == d) continue;
+      float off = weight[i] - meanWeight(own, joint[i]);
+      if (std::fabs(off) > std::fabs(offset)) offset = off, pick = i;
+    }
+    if (pick == ~0u || offset == 0.0f) continue;
+    WeightKey nb = keyOfGroup[g];
+    const int step = offset > 0.0f ? 1 : -1;
+    uint32_t si = nb.slot(joint[pick]), sd = nb.slot(joint[d]);
+    if (sd == ~0u) continue;
+    if (si == ~0u) {
+      if (step < 0 || nb.n == 4) continue;
+      si = nb.n++;
+      nb.joint[si] = joint[pick];
+      nb.q[si] = 0;
+    }
+    if (step < 0 && nb.q[si] == 0) continue;
+    if (step > 0 && nb.q[sd] == 0) continue;
+    nb.q[si] = uint32_t(int(nb.q[si]) + step);
+    nb.q[sd] = uint32_t(int(nb.q[sd]) - step);
+    nb.canonical(Q);
+    auto it = keyIndex.find(nb);
+    if (it == keyIndex.end()) continue;
+    const uint32_t other = sectionOfKey[it->second];
+    float span = meanWeight(other, joint[pick]) - meanWeight(own, joint[pick]);
+    if (span * offset <= 0.0f) continue;
+    otherOfGroup[g] = other;
+    blendOfGroup[g] = glm::clamp(offset / span, 0.0f, 1.0f);
+  }
+}
 
 }  // namespace
 
@@ -51,8 +340,10 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(settings.influenceWidth));
     return nullptr;
   }
-  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL) {
-    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %d (0 = Y, 1 = axial)", int(settings.criterion));
+  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL &&
+      settings.criterion != GCS_CRITERION_WEIGHTS) {
+    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)",
+         unsigned(settings.criterion));
     return nullptr;
   }
   GcsDeformerImpl* model = nullptr;
@@ -69,6 +360,22 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     std::vector<uint32_t> representative;
     std::vector<uint32_t> group = weldByPosition(rig, representative);
     const uint32_t G = uint32_t(representative.size());
+    if (settings.criterion == GCS_CRITERION_WEIGHTS) {
+      std::vector<uint32_t> sectionOfGroup, otherOfGroup;
+      std::vector<float> blendOfGroup;
+      buildWeightSections(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
+      std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
+      if (settings.smooth) {
+        m.blendOther.resize(rig.vertexCount);
+        m.blendF.resize(rig.vertexCount);
+        for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+          m.blendOther[outputOf[v]] = otherOfGroup[group[v]];
+          m.blendF[outputOf[v]] = blendOfGroup[group[v]];
+        }
+      }
+      finishModel(m);
+      return model;
+    }
     std::vector<uint32_t> partOfGroup(G);
     m.parts.assign(J, PartInfo());
     for (uint32_t g = 0; g < G; ++g) {
@@ -278,60 +585,18 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       sectionOfSlot[sl] = int32_t(m.sections.size());
       m.sections.push_back(sec);
     }
-    const uint32_t S = uint32_t(m.sections.size());
-    m.allocateOutput(rig.vertexCount);
-    m.restPositions.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-    m.restNormals.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-    m.sourceVertex.resize(rig.vertexCount);
-    m.sectionOfVertex.resize(rig.vertexCount);
-    std::vector<uint32_t> cursor(S);
-    for (uint32_t i = 0; i < S; ++i) cursor[i] = m.sections[i].first;
-    std::vector<uint32_t> outputOf(rig.vertexCount);
+    std::vector<uint32_t> sectionOfGroup(G);
+    for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = uint32_t(sectionOfSlot[slotOfGroup[g]]);
+    std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
     std::vector<float> tOfOutput(rig.vertexCount);
-    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-      uint32_t sec = uint32_t(sectionOfSlot[slotOfGroup[group[v]]]);
-      uint32_t o = cursor[sec]++;
-      outputOf[v] = o;
-      m.sourceVertex[o] = v;
-      m.sectionOfVertex[o] = sec;
-      tOfOutput[o] = tOfGroup[group[v]];
-      for (int c = 0; c < 3; ++c) {
-        m.restPositions[3 * o + c] = rig.positions[v][c];
-        m.restNormals[3 * o + c] = rig.normals[v][c];
-      }
-    }
-    m.indices.resize(rig.indices.size());
-    for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
-
-    // Bounding spheres (for the adjusted-section statistic) and the introspection table.
-    m.sectionInfo.resize(size_t(S) * 8);
-    for (uint32_t i = 0; i < S; ++i) {
-      Section& sec = m.sections[i];
-      glm::vec3 lo(INFINITY), hi(-INFINITY);
-      for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) {
-        glm::vec3 p(m.restPositions[3 * o], m.restPositions[3 * o + 1], m.restPositions[3 * o + 2]);
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
-      sec.centre = 0.5f * (lo + hi);
-      sec.radius = 0.5f * glm::length(hi - lo);
-      float* info = &m.sectionInfo[size_t(i) * 8];
-      info[0] = float(sec.first);
-      info[1] = float(sec.count);
-      info[2] = float(sec.part);
-      info[3] = float(sec.distal);
-      info[4] = sec.shared ? 1.0f : 0.0f;
-      info[5] = sec.t;
-      info[6] = sec.alpha;
-      info[7] = sec.beta;
-    }
+    for (uint32_t v = 0; v < rig.vertexCount; ++v) tOfOutput[outputOf[v]] = tOfGroup[group[v]];
 
     // 7. Smooth mode: each inner vertex blends the two sections whose mean t brackets its own t,
     // along its branch: proximal SGS (t = 0), the inner sections, the distal SGS (t = 1).
     if (settings.smooth) {
-      m.blendA.resize(rig.vertexCount);
-      m.blendB.resize(rig.vertexCount);
+      m.blendOther.resize(rig.vertexCount);
       m.blendF.assign(rig.vertexCount, 0.0f);
+      for (uint32_t o = 0; o < rig.vertexCount; ++o) m.blendOther[o] = m.sectionOfVertex[o];
       std::vector<std::pair<float, uint32_t>> chain;
       for (size_t bi = 0; bi < branches.size(); ++bi) {
         const Branch& b = branches[bi];
@@ -351,31 +616,24 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
           if (id < 0) continue;
           const Section& sec = m.sections[id];
           for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) {
+            // The two sections whose mean t brackets the vertex's t; its own is one of them.
             float t = tOfOutput[o];
             size_t k = 0;
             while (k + 1 < chain.size() && chain[k + 1].first < t) ++k;
             uint32_t a = chain[k].second, bsec = k + 1 < chain.size() ? chain[k + 1].second : a;
             float ta = chain[k].first, tb = k + 1 < chain.size() ? chain[k + 1].first : ta;
             float f = tb > ta ? glm::clamp((t - ta) / (tb - ta), 0.0f, 1.0f) : 0.0f;
-            m.blendA[o] = a;
-            m.blendB[o] = bsec;
-            m.blendF[o] = f;
+            if (a == uint32_t(id)) m.blendOther[o] = bsec, m.blendF[o] = f;
+            else if (bsec == uint32_t(id)) m.blendOther[o] = a, m.blendF[o] = 1.0f - f;
           }
         }
-      }
-      for (uint32_t i = 0; i < S; ++i) {  // shared sections: no blend
-        const Section& sec = m.sections[i];
-        if (!sec.shared) continue;
-        for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) m.blendA[o] = m.blendB[o] = i;
       }
     }
 
     m.motions.resize(J);
     m.swings.resize(J);
     m.twists.resize(J);
-    m.sectionMatrices.assign(S, glm::mat4(1.0f));
-    std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
-    std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
+    finishModel(m);
   } catch (const std::bad_alloc&) {
     delete model;
     fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while building the GCS model");
@@ -384,22 +642,72 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
   return model;
 }
 
-void GcsDeformerImpl::deform(const glm::mat4* skin) {
-  const uint32_t J = jointCount;
-  // Relative motion of each part with respect to its parent part: D_j = S_parent^-1 · S_j.
-  for (uint32_t j = 0; j < J; ++j) {
-    if (!parts[j].isPart || parts[j].parent < 0) continue;
-    glm::mat4 d = glm::inverse(skin[parts[j].parent]) * skin[j];
-    motions[j] = motionAbout(d, jointCentres[j]);
-    if (settings.twistSpread) swingTwist(motions[j].rotation, parts[j].twistAxis, swings[j], twists[j]);
-  }
-  adjustedSections = 0;
+namespace {
+// [R | t] of a decomposed skin matrix (its rigid part) and the inverse of such a matrix.
+glm::mat4 rigidOf(const JointPose& p) {
+  glm::mat4 m = glm::mat4_cast(p.rotation);
+  m[3] = glm::vec4(p.translation, 1.0f);
+  return m;
+}
+glm::mat4 rigidInverse(const glm::mat4& m) {
+  glm::mat3 rt = glm::transpose(glm::mat3(m));
+  glm::mat4 out(rt);
+  out[3] = glm::vec4(-(rt * glm::vec3(m[3])), 1.0f);
+  return out;
+}
+}  // namespace
+
+// Weights criterion: each section's transform is the dual-quaternion blend of its joints at its
+// mean weights (a rigid core: S_j itself). O(sections × influences).
+void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, bool sameScale) {
   const uint32_t S = uint32_t(sections.size());
   for (uint32_t i = 0; i < S; ++i) {
     const Section& sec = sections[i];
+    bool renorm = false;
+    if (sec.rigid) {
+      sectionMatrices[i] = skin[sec.part];
+      glm::mat4 n(normalMatrix(poses[sec.part].rotation, poses[sec.part].scale, renorm));
+      n[3][3] = 0.0f;
+      normalMatrices[i] = n;
+    } else {
+      float w[4];
+      for (uint32_t k = 0; k < sec.influenceCount; ++k) {
+        const Influence& in = influences[sec.influenceFirst + k];
+        blendPoseScratch[k] = &poses[in.joint];
+        w[k] = in.weight;
+      }
+      blendPoses(blendPoseScratch.data(), w, sec.influenceCount, sameScale, sectionMatrices[i], normalMatrices[i], renorm);
+    }
+    renormalise[i] = renorm;
+  }
+}
+
+// The paper's rule (Y and axial criteria): M = S_p · D_j^α · D_k^β on the rigid parts of the skin
+// matrices, then the section's scale (the same blend of the joints' scales) applied first.
+void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, bool sameScale) {
+  const uint32_t J = jointCount;
+  // Relative motion of each part with respect to its parent part: D_j = rigid(S_p)^-1 · rigid(S_j).
+  for (uint32_t j = 0; j < J; ++j) {
+    if (!parts[j].isPart || parts[j].parent < 0) continue;
+    glm::mat4 d = rigidInverse(rigidOf(poses[parts[j].parent])) * rigidOf(poses[j]);
+    motions[j] = motionAbout(d, jointCentres[j]);
+    if (settings.twistSpread) swingTwist(motions[j].rotation, parts[j].twistAxis, swings[j], twists[j]);
+  }
+  const uint32_t S = uint32_t(sections.size());
+  for (uint32_t i = 0; i < S; ++i) {
+    const Section& sec = sections[i];
+    bool renorm = false;
+    if (sec.parent < 0 && !(sec.distal >= 0 && sec.beta > 0.0f)) {
+      sectionMatrices[i] = skin[sec.part];
+      glm::mat4 n(normalMatrix(poses[sec.part].rotation, poses[sec.part].scale, renorm));
+      n[3][3] = 0.0f;
+      normalMatrices[i] = n;
+      renormalise[i] = renorm;
+      continue;
+    }
     glm::mat4 m;
     if (sec.parent < 0) {
-      m = skin[sec.part];
+      m = rigidOf(poses[sec.part]);
     } else {
       const Motion& d = motions[sec.part];
       glm::mat4 frac;
@@ -409,7 +717,7 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
       } else {
         frac = fractionMatrix(d, sec.alpha);
       }
-      m = skin[sec.parent] * frac;
+      m = rigidOf(poses[sec.parent]) * frac;
     }
     if (sec.distal >= 0 && sec.beta > 0.0f) {
       const Motion& d = motions[sec.distal];
@@ -418,10 +726,40 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
       else
         m = m * fractionMatrix(d, sec.beta);
     }
-    sectionMatrices[i] = m;
-    // Adjusted: the section's transform differs from its part's rigid S_j by more than the
-    // tolerance anywhere on the section's bounding sphere.
-    glm::mat4 diff = m - skin[sec.part];
+    // Scale: parent, part and distal joint weighted (1 − α, α − β, β), applied first.
+    glm::mat3 k = poses[sec.part].scale;
+    if (!sameScale) {
+      k = (sec.parent >= 0 ? sec.alpha : 1.0f) * k;
+      if (sec.parent >= 0) k += (1.0f - sec.alpha) * poses[sec.parent].scale;
+      if (sec.distal >= 0 && sec.beta > 0.0f) k += sec.beta * (poses[sec.distal].scale - poses[sec.part].scale);
+    }
+    glm::mat3 r(m);
+    glm::mat3 rk = r * k;
+    sectionMatrices[i] = glm::mat4(glm::vec4(rk[0], 0.0f), glm::vec4(rk[1], 0.0f), glm::vec4(rk[2], 0.0f), m[3]);
+    glm::mat4 n(normalMatrix(glm::quat_cast(r), k, renorm));
+    n[3][3] = 0.0f;
+    normalMatrices[i] = n;
+    renormalise[i] = renorm;
+  }
+}
+
+void GcsDeformerImpl::deform(const glm::mat4* skin) {
+  const uint32_t J = jointCount;
+  bool sameScale = true;
+  for (uint32_t j = 0; j < J; ++j) {
+    decompose(skin[j], poses[j]);
+    if (sameScale && j > 0 && poses[j].scale != poses[0].scale) sameScale = false;
+  }
+  if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, sameScale);
+  else sectionTransformsPaper(skin, sameScale);
+
+  // Adjusted: the section's transform differs from its part's rigid S_j by more than the
+  // tolerance anywhere on the section's bounding sphere.
+  adjustedSections = 0;
+  const uint32_t S = uint32_t(sections.size());
+  for (uint32_t i = 0; i < S; ++i) {
+    const Section& sec = sections[i];
+    glm::mat4 diff = sectionMatrices[i] - skin[sec.part];
     glm::vec3 atCentre = glm::vec3(diff * glm::vec4(sec.centre, 1.0f));
     float linear = std::sqrt(glm::dot(glm::vec3(diff[0]), glm::vec3(diff[0])) +
                              glm::dot(glm::vec3(diff[1]), glm::vec3(diff[1])) +
@@ -429,29 +767,15 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
     if (glm::length(atCentre) + linear * sec.radius > adjustTolerance) ++adjustedSections;
   }
 
-  if (!settings.smooth) {
-    for (uint32_t i = 0; i < S; ++i) {
-      const Section& sec = sections[i];
-      size_t o = size_t(sec.first) * 3;
-      transformRun(sectionMatrices[i], &restPositions[o], &restNormals[o], &positions[o], &normals[o], sec.count);
-    }
-    return;
-  }
-  for (uint32_t o = 0; o < vertexCount; ++o) {
-    float f = blendF[o];
-    const glm::mat4& a = sectionMatrices[blendA[o]];
-    const glm::mat4& b = sectionMatrices[blendB[o]];
-    glm::mat4 mm = f == 0.0f ? a : a + f * (b - a);
-    const float* p = &restPositions[3 * size_t(o)];
-    const float* n = &restNormals[3 * size_t(o)];
-    glm::vec3 rp = glm::vec3(mm * glm::vec4(p[0], p[1], p[2], 1.0f));
-    glm::vec3 rn = glm::vec3(mm * glm::vec4(n[0], n[1], n[2], 0.0f));
-    float len = glm::length(rn);
-    if (len > 0.0f) rn /= len;
-    float* op = &positions[3 * size_t(o)];
-    float* on = &normals[3 * size_t(o)];
-    op[0] = rp.x, op[1] = rp.y, op[2] = rp.z;
-    on[0] = rn.x, on[1] = rn.y, on[2] = rn.z;
+  for (uint32_t i = 0; i < S; ++i) {
+    const Section& sec = sections[i];
+    size_t o = size_t(sec.first) * 3;
+    if (settings.smooth)
+      blendRun(sectionMatrices[i], normalMatrices[i], sectionMatrices.data(), normalMatrices.data(), &blendOther[sec.first],
+               &blendF[sec.first], &restPositions[o], &restNormals[o], &positions[o], &normals[o], sec.count);
+    else
+      transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
+                   &positions[o], &normals[o], sec.count);
   }
 }
 

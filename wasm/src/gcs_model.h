@@ -11,15 +11,17 @@
 namespace gcs {
 
 struct GcsSettings {
-  uint32_t sections = 6;                    // per part: 2 shared + sections−2 inner
-  GcsCriterion criterion = GCS_CRITERION_AXIAL;
+  uint32_t sections = 6;                    // level of detail (see gcs_build_gcs)
+  GcsCriterion criterion = GCS_CRITERION_WEIGHTS;
   float influenceWidth = 1.0f;              // (0, 1]
   bool smooth = false;
   bool twistSpread = false;
 };
 
-// One generalized section: a run of output vertices that share one transform per frame,
-//   M = S_parent · D_part^(alpha, tau) · D_distal^beta      (parent < 0: M = S_part · D_distal^beta)
+// One generalized section: a run of output vertices that share one transform per frame.
+// Y/axial criteria: M = S_parent · D_part^(alpha, tau) · D_distal^beta (parent < 0: S_part · D_distal^beta).
+// Weights criterion: M = the dual-quaternion blend of its joints with its mean weights
+// (influences[influenceFirst .. +influenceCount]); a rigid core (rigid = true) is exactly S_part.
 struct Section {
   uint32_t first = 0, count = 0;  // output vertex run
   uint32_t part = 0;              // joint owning the part (for a shared section: the child part)
@@ -30,6 +32,13 @@ struct Section {
   float alpha = 1.0f, beta = 0.0f, tau = 1.0f;
   glm::vec3 centre{0.0f};         // bind-pose bounding sphere, for the "adjusted" test
   float radius = 0.0f;
+  bool rigid = false;             // weights criterion: a rigid core, transform exactly S_part
+  uint32_t influenceFirst = 0, influenceCount = 0;  // weights criterion: its blend
+};
+
+struct Influence {
+  uint32_t joint = 0;
+  float weight = 0.0f;
 };
 
 struct PartInfo {
@@ -53,16 +62,26 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<float> restNormals;
   std::vector<uint32_t> sectionOfVertex;
   std::vector<float> sectionInfo;       // 8 floats per section (see gcs_skin.h)
-  // Smooth mode: per output vertex, two sections and the blend factor towards the second.
-  std::vector<uint32_t> blendA, blendB;
+  std::vector<Influence> influences;    // weights criterion: the sections' blends
+  // Smooth mode: per output vertex, the other section it blends with and the factor towards it
+  // (its own section is the run it sits in).
+  std::vector<uint32_t> blendOther;
   std::vector<float> blendF;
   float adjustTolerance = 0.0f;
 
   // Per-frame state, allocated at build time.
   std::vector<Motion> motions;          // D_j per part joint
   std::vector<glm::quat> swings, twists;
-  std::vector<glm::mat4> sectionMatrices;
+  std::vector<JointPose> poses;         // S_j split into rotation, translation and scale
+  std::vector<glm::mat4> sectionMatrices;   // position transform of each section
+  std::vector<glm::mat4> normalMatrices;    // normal transform of each section (3×3 in a mat4)
+  std::vector<uint8_t> renormalise;         // normals of the section need renormalising
+  std::vector<const JointPose*> blendPoseScratch;
   uint32_t adjustedSections = 0;
+
+ private:
+  void sectionTransformsWeights(const glm::mat4* skin, bool sameScale);
+  void sectionTransformsPaper(const glm::mat4* skin, bool sameScale);
 };
 
 // Builds the GCS model of a rig. Returns null with the error recorded on failure.

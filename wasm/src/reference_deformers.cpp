@@ -34,8 +34,7 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
     d->indices = rig.indices;
     d->sourceVertex.resize(rig.vertexCount);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) d->sourceVertex[v] = v;
-    d->real.resize(rig.jointCount);
-    d->dual.resize(rig.jointCount);
+    d->poses.resize(rig.jointCount);
   } catch (const std::bad_alloc&) {
     delete d;
     fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while building the skinning deformer");
@@ -46,6 +45,11 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
 
 void SkinningDeformer::deform(const glm::mat4* skin) {
   const uint32_t n = vertexCount;
+  bool sameScale = true;
+  for (uint32_t j = 0; j < jointCount; ++j) {
+    decompose(skin[j], poses[j]);
+    if (sameScale && j > 0 && poses[j].scale != poses[0].scale) sameScale = false;
+  }
   if (kind_ == GCS_KIND_LBS) {
     for (uint32_t v = 0; v < n; ++v) {
       const glm::uvec4 j = joints[v];
@@ -56,44 +60,33 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
       const float* p = &restPositions[3 * size_t(v)];
       const float* q = &restNormals[3 * size_t(v)];
       glm::vec3 rp(m * glm::vec4(p[0], p[1], p[2], 1.0f));
-      glm::vec3 rn(m * glm::vec4(q[0], q[1], q[2], 0.0f));
-      float len = glm::length(rn);
-      if (len > 0.0f) rn /= len;
+      glm::vec3 rest(q[0], q[1], q[2]);
+      // As three.js does: the normal by the blended matrix, then unit length. Where the blend has
+      // collapsed (bones scaled to 0), the rest normal turned by the first influence's rotation.
+      glm::vec3 rn = unitOr(glm::vec3(m * glm::vec4(rest, 0.0f)), poses[j[0]].rotation * rest);
       for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
     }
     return;
   }
-  // Dual quaternions (Kavan et al. 2007): per joint, real part r and dual part d = ½ t r.
-  for (uint32_t j = 0; j < jointCount; ++j) {
-    glm::quat r = rotationOf(skin[j]);
-    glm::vec3 t(skin[j][3]);
-    glm::quat tq(0.0f, t.x, t.y, t.z);
-    glm::quat dq = 0.5f * (tq * r);
-    real[j] = glm::vec4(r.x, r.y, r.z, r.w);
-    dual[j] = glm::vec4(dq.x, dq.y, dq.z, dq.w);
-  }
+  // Dual quaternions (Kavan et al. 2007) for the rigid part of each S_j; its scale blended
+  // linearly and applied first (so rigs with scaled matrices work).
+  const JointPose* blend[4];
+  float w4[4];
+  glm::mat4 pm, nm;
   for (uint32_t v = 0; v < n; ++v) {
-    const glm::uvec4 j = joints[v];
-    const glm::vec4 w = weights[v];
-    const glm::vec4 pivot = real[j[0]];
-    glm::vec4 br(0.0f), bd(0.0f);
+    uint32_t k = 0;
     for (int i = 0; i < 4; ++i) {
-      if (w[i] <= 0.0f) continue;
-      // Antipodality: blend every quaternion in the hemisphere of the first influence.
-      float s = glm::dot(real[j[i]], pivot) < 0.0f ? -w[i] : w[i];
-      br += s * real[j[i]];
-      bd += s * dual[j[i]];
+      if (!(weights[v][i] > 0.0f)) continue;
+      blend[k] = &poses[joints[v][i]];
+      w4[k++] = weights[v][i];
     }
-    float len = glm::length(br);
-    br /= len;
-    bd /= len;
-    glm::quat r(br.w, br.x, br.y, br.z), d(bd.w, bd.x, bd.y, bd.z);
-    // Translation t = 2 · d · conj(r).
-    glm::quat tq = 2.0f * (d * glm::conjugate(r));
+    bool renorm = false;
+    blendPoses(blend, w4, k, sameScale, pm, nm, renorm);
     const float* p = &restPositions[3 * size_t(v)];
     const float* q = &restNormals[3 * size_t(v)];
-    glm::vec3 rp = r * glm::vec3(p[0], p[1], p[2]) + glm::vec3(tq.x, tq.y, tq.z);
-    glm::vec3 rn = r * glm::vec3(q[0], q[1], q[2]);
+    glm::vec3 rp(pm * glm::vec4(p[0], p[1], p[2], 1.0f));
+    glm::vec3 rn(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
+    if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one
     for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
   }
 }

@@ -2,6 +2,7 @@
 #pragma once
 #include "deformer.h"
 #include "rig.h"
+#include "transform.h"
 
 namespace gcs {
 
@@ -15,8 +16,9 @@ class SkinningDeformer final : public Deformer {
   std::vector<float> restPositions, restNormals;
   std::vector<glm::uvec4> joints;
   std::vector<glm::vec4> weights;
-  // Per-frame scratch, allocated at build time: per joint, a dual quaternion (DQS).
-  std::vector<glm::vec4> real, dual;
+  // Per-frame scratch, allocated at build time: per joint, S_j split into rotation, translation
+  // (a dual quaternion) and scale.
+  std::vector<JointPose> poses;
 
  private:
   GcsDeformerKind kind_;

@@ -1,6 +1,7 @@
 // Small rigid-transform helpers shared by the deformers: fractional rotations about a centre,
 // swing/twist split, and the per-vertex 3×4 transform of a run of vertices (SIMD where it pays).
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -27,15 +28,133 @@ inline float quatAngle(const glm::quat& q) {
   return 2.0f * std::acos(w);
 }
 
-// Rotation part of an affine matrix as a unit quaternion (columns normalised first so that a
-// uniform scale in the rig does not break the conversion).
+// Rotation part of an affine matrix as a unit quaternion, robust to any scale in the matrix:
+// a uniform scale (Mixamo's ×100), a non-uniform one, a mirror, or a collapse to zero. Columns
+// are normalised (after dividing by the largest entry, so tiny scales do not underflow); when they
+// are not a proper rotation (a mirror, a collapsed axis) the frame is rebuilt from the two longest
+// columns; when every column has collapsed the rotation is the identity.
 inline glm::quat rotationOf(const glm::mat4& m) {
   glm::mat3 r(m);
-  for (int c = 0; c < 3; ++c) {
-    float len = glm::length(r[c]);
-    if (len > 0.0f) r[c] /= len;
+  float big = 0.0f;
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 3; ++i) big = std::fmax(big, std::fabs(r[c][i]));
+  if (!(big > 1e-30f)) return glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  r /= big;
+  float len[3];
+  for (int c = 0; c < 3; ++c) len[c] = glm::length(r[c]);
+  if (len[0] > 1e-4f && len[1] > 1e-4f && len[2] > 1e-4f) {
+    glm::mat3 n(r[0] / len[0], r[1] / len[1], r[2] / len[2]);
+    if (glm::determinant(n) > 0.9f) return glm::normalize(glm::quat_cast(n));
   }
-  return glm::normalize(glm::quat_cast(r));
+  // Rebuild a right-handed frame from the longest column a and the next longest b.
+  int a = 0;
+  for (int c = 1; c < 3; ++c)
+    if (len[c] > len[a]) a = c;
+  int b = (a + 1) % 3, other = (a + 2) % 3;
+  if (len[other] > len[b]) std::swap(b, other);
+  glm::mat3 n(1.0f);
+  n[a] = r[a] / len[a];
+  glm::vec3 vb = r[b] - glm::dot(r[b], n[a]) * n[a];
+  float lb = glm::length(vb);
+  if (!(lb > 1e-4f)) {  // b collapsed or parallel to a: any axis perpendicular to a
+    glm::vec3 helper = std::fabs(n[a].x) < 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+    vb = glm::cross(n[a], helper);
+    lb = glm::length(vb);
+  }
+  n[b] = vb / lb;
+  n[other] = glm::cross(n[(other + 1) % 3], n[(other + 2) % 3]);
+  return glm::normalize(glm::quat_cast(n));
+}
+
+// A vector of unit length in the direction of v, or `fallback` when v has (nearly) vanished.
+// Divides by the largest component first so tiny vectors do not underflow.
+inline glm::vec3 unitOr(const glm::vec3& v, const glm::vec3& fallback) {
+  float big = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
+  if (!(big > 1e-30f)) return fallback;
+  glm::vec3 u = v / big;
+  return u / glm::length(u);
+}
+
+// The cofactor matrix of k (det(k) · k^-T when k is invertible): what maps normals through k.
+inline glm::mat3 cofactor(const glm::mat3& k) {
+  return glm::mat3(glm::cross(k[1], k[2]), glm::cross(k[2], k[0]), glm::cross(k[0], k[1]));
+}
+
+// A skin matrix split as S = [R·K | t] (rotation R, the remaining scale/shear K = Rᵀ·S₃ₓ₃, and the
+// translation t), plus R and t as a unit dual quaternion for blending (Kavan et al. 2007).
+struct JointPose {
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 translation{0.0f};
+  glm::mat3 scale{1.0f};      // K
+  glm::vec4 real{0.0f, 0.0f, 0.0f, 1.0f}, dual{0.0f};  // (x, y, z, w)
+};
+
+inline void decompose(const glm::mat4& s, JointPose& out) {
+  out.rotation = rotationOf(s);
+  out.translation = glm::vec3(s[3]);
+  out.scale = glm::transpose(glm::mat3_cast(out.rotation)) * glm::mat3(s);
+  glm::quat r = out.rotation;
+  glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
+  out.real = glm::vec4(r.x, r.y, r.z, r.w);
+  out.dual = glm::vec4(d.x, d.y, d.z, d.w);
+}
+
+// True when k is s·I with s > 0 up to a relative 1e-4: then normals need only the rotation.
+inline bool isUniformScale(const glm::mat3& k) {
+  float s = (k[0][0] + k[1][1] + k[2][2]) / 3.0f;
+  if (!(s > 0.0f)) return false;
+  float tol = 1e-4f * s;
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 3; ++i)
+      if (std::fabs(k[c][i] - (c == i ? s : 0.0f)) > tol) return false;
+  return true;
+}
+
+// The matrix that carries normals for the affine map x ↦ R·K·x + t: R when K is a positive
+// uniform scale (then unit normals stay unit); otherwise R·cof(K) divided by its largest entry, so
+// the caller must renormalise (`renormalise` is set); R alone when K has collapsed entirely.
+inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, bool& renormalise) {
+  glm::mat3 r = glm::mat3_cast(rotation);
+  if (isUniformScale(k)) {
+    renormalise = false;
+    return r;
+  }
+  glm::mat3 c = cofactor(k);
+  float big = 0.0f;
+  for (int col = 0; col < 3; ++col)
+    for (int i = 0; i < 3; ++i) big = std::fmax(big, std::fabs(c[col][i]));
+  renormalise = true;
+  if (!(big > 1e-30f)) return r;  // every direction collapsed: keep the rotated rest normal
+  return r * (c / big);
+}
+
+// The blend of joint poses with weights w_i (Σ w_i = 1), as dual-quaternion skinning does it:
+// rotation and translation by the normalised linear blend of the dual quaternions (each taken in
+// the hemisphere of the first), scale/shear by the linear blend of the K_i, applied first.
+// `sameScale`: every K_i is the same matrix (then K is taken as is: exact, no rounding of Σ w_i).
+// Writes the position matrix [R·K | t] and the normal matrix (see normalMatrix).
+inline void blendPoses(const JointPose* const* poses, const float* w, uint32_t count, bool sameScale,
+                       glm::mat4& position, glm::mat4& normal, bool& renormalise) {
+  const glm::vec4 pivot = poses[0]->real;
+  glm::vec4 br(0.0f), bd(0.0f);
+  glm::mat3 k(0.0f);
+  for (uint32_t i = 0; i < count; ++i) {
+    float s = glm::dot(poses[i]->real, pivot) < 0.0f ? -w[i] : w[i];
+    br += s * poses[i]->real;
+    bd += s * poses[i]->dual;
+    if (!sameScale) k += w[i] * poses[i]->scale;
+  }
+  if (sameScale) k = poses[0]->scale;
+  float len = glm::length(br);  // ≥ the largest weight: the quaternions share a hemisphere
+  br /= len;
+  bd /= len;
+  glm::quat r(br.w, br.x, br.y, br.z), d(bd.w, bd.x, bd.y, bd.z);
+  glm::quat tq = 2.0f * (d * glm::conjugate(r));
+  glm::mat3 rk = glm::mat3_cast(r) * k;
+  position = glm::mat4(glm::vec4(rk[0], 0.0f), glm::vec4(rk[1], 0.0f), glm::vec4(rk[2], 0.0f),
+                       glm::vec4(tq.x, tq.y, tq.z, 1.0f));
+  normal = glm::mat4(normalMatrix(r, k, renormalise));
+  normal[3] = glm::vec4(0.0f);
 }
 
 inline Motion motionAbout(const glm::mat4& d, const glm::vec3& centre) {
@@ -94,28 +213,42 @@ inline void swingTwist(const glm::quat& q, const glm::vec3& axis, glm::quat& swi
   swing = q * glm::conjugate(twist);
 }
 
-// Transforms `count` interleaved xyz points and normals by one affine matrix m (normals by its
-// 3×3 part, assumed a rotation). Output arrays need one spare float after the last vertex.
-inline void transformRun(const glm::mat4& m, const float* inPos, const float* inNrm,
-                         float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
-  const v128_t c0 = wasm_v128_load(&m[0][0]);
-  const v128_t c1 = wasm_v128_load(&m[1][0]);
-  const v128_t c2 = wasm_v128_load(&m[2][0]);
-  const v128_t c3 = wasm_v128_load(&m[3][0]);
+// x·c0 + y·c1 + z·c2 (+ c3) of the 3 floats at p, in one SIMD register (4th lane unused).
+inline v128_t affine(v128_t c0, v128_t c1, v128_t c2, v128_t c3, const float* p) {
+  return wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(p)),
+                                       wasm_f32x4_mul(c1, wasm_v128_load32_splat(p + 1))),
+                        wasm_f32x4_add(wasm_f32x4_mul(c2, wasm_v128_load32_splat(p + 2)), c3));
+}
+// v divided by the length of its xyz lanes (lane 4 must be 0, as normal matrices make it); a zero
+// vector stays zero. All in SIMD: no lane extraction.
+inline v128_t normalise3(v128_t v) {
+  v128_t sq = wasm_f32x4_mul(v, v);
+  v128_t t = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+  v128_t sum = wasm_f32x4_add(t, wasm_i32x4_shuffle(t, t, 2, 3, 0, 1));
+  return wasm_f32x4_div(v, wasm_f32x4_sqrt(wasm_f32x4_max(sum, wasm_f32x4_splat(1e-30f))));
+}
+#endif
+
+inline void normaliseInPlace(float* n) {
+  float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (len > 0.0f) n[0] /= len, n[1] /= len, n[2] /= len;
+}
+
+// Transforms `count` interleaved xyz points by the affine matrix m and their normals by the 3×3
+// matrix nm (see normalMatrix), renormalising the normals when asked. Output arrays need one spare
+// float after the last vertex (the SIMD path stores 4 lanes per vertex).
+inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormalise, const float* inPos,
+                         const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+#if defined(__wasm_simd128__)
+  const v128_t c0 = wasm_v128_load(&m[0][0]), c1 = wasm_v128_load(&m[1][0]);
+  const v128_t c2 = wasm_v128_load(&m[2][0]), c3 = wasm_v128_load(&m[3][0]);
+  const v128_t n0 = wasm_v128_load(&nm[0][0]), n1 = wasm_v128_load(&nm[1][0]), n2 = wasm_v128_load(&nm[2][0]);
+  const v128_t zero = wasm_f32x4_splat(0.0f);
   for (uint32_t i = 0; i < count; ++i) {
-    const float* p = inPos + 3 * i;
-    const float* n = inNrm + 3 * i;
-    v128_t rp = wasm_f32x4_add(
-        wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(p)),
-                       wasm_f32x4_mul(c1, wasm_v128_load32_splat(p + 1))),
-        wasm_f32x4_add(wasm_f32x4_mul(c2, wasm_v128_load32_splat(p + 2)), c3));
-    v128_t rn = wasm_f32x4_add(
-        wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
-                       wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
-        wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
-    wasm_v128_store(outPos + 3 * i, rp);  // the 4th lane is overwritten by the next vertex
-    wasm_v128_store(outNrm + 3 * i, rn);
+    wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));  // lane 4 spills into the next vertex
+    v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
+    wasm_v128_store(outNrm + 3 * i, renormalise ? normalise3(rn) : rn);
   }
 #else
   for (uint32_t i = 0; i < count; ++i) {
@@ -123,8 +256,55 @@ inline void transformRun(const glm::mat4& m, const float* inPos, const float* in
     const float* n = inNrm + 3 * i;
     for (int r = 0; r < 3; ++r) {
       outPos[3 * i + r] = m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r];
-      outNrm[3 * i + r] = m[0][r] * n[0] + m[1][r] * n[1] + m[2][r] * n[2];
+      outNrm[3 * i + r] = nm[0][r] * n[0] + nm[1][r] * n[1] + nm[2][r] * n[2];
     }
+    if (renormalise) normaliseInPlace(outNrm + 3 * i);
+  }
+#endif
+}
+
+// Smooth mode: vertex i of the run takes lerp(A, B_i, f_i), A the run's own transform and B_i the
+// transform of section other[i] (pos and normal matrices alike), then renormalises the normal (a
+// blend of two rotations is a slightly shortened rotation).
+inline void blendRun(const glm::mat4& pa, const glm::mat4& na, const glm::mat4* positionMatrices,
+                     const glm::mat4* normalMatrices, const uint32_t* other, const float* f,
+                     const float* inPos, const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+#if defined(__wasm_simd128__)
+  const v128_t a0 = wasm_v128_load(&pa[0][0]), a1 = wasm_v128_load(&pa[1][0]);
+  const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
+  const v128_t m0 = wasm_v128_load(&na[0][0]), m1 = wasm_v128_load(&na[1][0]), m2 = wasm_v128_load(&na[2][0]);
+  const v128_t zero = wasm_f32x4_splat(0.0f);
+  for (uint32_t i = 0; i < count; ++i) {
+    const float* pb = &positionMatrices[other[i]][0][0];
+    const float* nb = &normalMatrices[other[i]][0][0];
+    const v128_t t = wasm_f32x4_splat(f[i]);
+    const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb), a0)));
+    const v128_t c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 4), a1)));
+    const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 8), a2)));
+    const v128_t c3 = wasm_f32x4_add(a3, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 12), a3)));
+    const v128_t n0 = wasm_f32x4_add(m0, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb), m0)));
+    const v128_t n1 = wasm_f32x4_add(m1, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb + 4), m1)));
+    const v128_t n2 = wasm_f32x4_add(m2, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb + 8), m2)));
+    wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
+    wasm_v128_store(outNrm + 3 * i, normalise3(affine(n0, n1, n2, zero, inNrm + 3 * i)));
+  }
+#else
+  for (uint32_t i = 0; i < count; ++i) {
+    const glm::mat4& pb = positionMatrices[other[i]];
+    const glm::mat4& nb = normalMatrices[other[i]];
+    const float t = f[i];
+    const float* p = inPos + 3 * i;
+    const float* n = inNrm + 3 * i;
+    for (int r = 0; r < 3; ++r) {
+      float v = 0.0f, w = 0.0f;
+      for (int c = 0; c < 3; ++c) {
+        v += (pa[c][r] + t * (pb[c][r] - pa[c][r])) * p[c];
+        w += (na[c][r] + t * (nb[c][r] - na[c][r])) * n[c];
+      }
+      outPos[3 * i + r] = v + pa[3][r] + t * (pb[3][r] - pa[3][r]);
+      outNrm[3 * i + r] = w;
+    }
+    normaliseInPlace(outNrm + 3 * i);
   }
 #endif
 }

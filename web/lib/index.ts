@@ -41,18 +41,30 @@ export interface RigInput {
   inverseBindMatrices: ArrayLikeNumbers;
 }
 
-export type Criterion = 'y' | 'axial';
+/**
+ * How vertices are grouped into sections:
+ * - 'weights' (default): bins of the skin weights; each section moves by the dual-quaternion blend
+ *   of its joints at its mean weights, a vertex bound 100 % to a joint moves exactly with it.
+ * - 'y': the paper's criterion, bins of the bind-pose Y coordinate, its fractional-rotation rule.
+ * - 'axial': the paper's rule, bins of the projection on the bone axis (for T-posed arms).
+ */
+export type Criterion = 'weights' | 'y' | 'axial';
+export const CRITERIA: readonly Criterion[] = ['y', 'axial', 'weights'];
 
 export interface GcsOptions {
-  /** Sections per part (2 shared + sections−2 inner), 3..256. Default 6. */
+  /**
+   * Level of detail, 3..256. Default 6. Weights criterion: the weight grid step is 1/(2·(sections−2))
+   * (6 → eighths; 3 → rigid cores and even splits only). Y/axial: sections per part
+   * (2 shared + sections−2 inner).
+   */
   sections?: number;
-  /** 'y': the paper's Y-coordinate criterion; 'axial' (default): projection on the bone axis. */
+  /** The section criterion. Default 'weights'. */
   criterion?: Criterion;
-  /** Fraction of a part over which joint influence ramps, (0, 1]. Default 1 (the paper). */
+  /** Y/axial only: fraction of a part over which joint influence ramps, (0, 1]. Default 1 (the paper). */
   influenceWidth?: number;
-  /** Each vertex blends the two nearest sections' transforms. Default false. */
+  /** Each vertex blends its section's transform with the neighbouring section's. Default false. */
   smooth?: boolean;
-  /** Spread a joint's twist along the child part. Default false. */
+  /** Y/axial only: spread a joint's twist along the child part. Default false. */
   twistSpread?: boolean;
 }
 
@@ -71,15 +83,19 @@ const KINDS: DeformerKind[] = ['gcs', 'classic', 'lbs', 'dqs'];
 export interface SectionInfo {
   first: number;
   count: number;
-  /** Joint owning the part (for a shared section: the child part). */
+  /** Joint owning the part (Y/axial: for a shared section, the child part; weights: the dominant joint). */
   part: number;
-  /** Child part joint the section's branch leads to, or -1. */
+  /** Y/axial: the child part joint the section's branch leads to; weights: the second joint; or -1. */
   distal: number;
-  /** A shared generalized section (SGS) between a part and its parent part. */
+  /** A shared generalized section (SGS): between a part and its parent part, or an even weight split. */
   shared: boolean;
-  /** Mean normalised axial coordinate, 0 (proximal) … 1 (distal). */
+  /** Weights criterion: a rigid core, moved exactly by its joint's skin matrix. */
+  rigid: boolean;
+  /** Y/axial: mean normalised axial coordinate, 0 (proximal) … 1 (distal); weights: the second joint's weight. */
   t: number;
+  /** Y/axial: fraction of the part's rotation; weights: the dominant joint's mean weight. */
   alpha: number;
+  /** Y/axial: fraction of the distal joint's rotation; weights: the second joint's mean weight. */
   beta: number;
 }
 
@@ -244,15 +260,15 @@ export class Rig {
   /** Builds a generalized cross-section model (design.md §2). */
   buildGcs(options: GcsOptions = {}): GcsDeformer {
     const sections = options.sections ?? 6;
-    const criterion = options.criterion ?? 'axial';
+    const criterion = options.criterion ?? 'weights';
     const width = options.influenceWidth ?? 1;
     if (!Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
       throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${sections}`);
-    if (criterion !== 'y' && criterion !== 'axial')
-      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'y' or 'axial'; got '${String(criterion)}'`);
+    if (!CRITERIA.includes(criterion))
+      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'weights', 'y' or 'axial'; got '${String(criterion)}'`);
     if (!(width > 0 && width <= 1))
       throw new GcsError('OUT_OF_RANGE', `the influence width must be in (0, 1]; got ${width}`);
-    const h = this.gcs.core.gcs_build_gcs(this.live(), sections, criterion === 'y' ? 0 : 1, width,
+    const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
       options.smooth ? 1 : 0, options.twistSpread ? 1 : 0);
     if (!h) this.gcs.raise('the GCS model could not be built');
     return new GcsDeformer(this.gcs, h, this.jointCount);
@@ -432,7 +448,7 @@ export class GcsDeformer extends Deformer {
     for (let i = 0; i < n; i++) {
       const o = i * 8;
       out.push({ first: info[o], count: info[o + 1], part: info[o + 2], distal: info[o + 3], shared: info[o + 4] === 1,
-        t: info[o + 5], alpha: info[o + 6], beta: info[o + 7] });
+        rigid: info[o + 4] === 2, t: info[o + 5], alpha: info[o + 6], beta: info[o + 7] });
     }
     return out;
   }
