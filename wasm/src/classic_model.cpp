@@ -672,11 +672,8 @@ void ClassicModel::deform(const glm::mat4* skin) {
     if (!P.runCount) continue;
     size_t o = size_t(P.runFirst - carriedFirst) * 3;
     JointPose pose;
-    decompose(skin[j], pose);
-    bool renorm = false;
-    glm::mat4 nm(normalMatrix(pose.rotation, pose.scale, renorm));  // unit normals whatever the scale
-    nm[3][3] = 0.0f;
-    transformRun(skin[j], nm, renorm, &restPositions[o], &restNormals[o], &positions[size_t(P.runFirst) * 3],
+    decompose(skin[j], pose);  // its normal matrix keeps normals unit whatever the scale
+    transformRun(skin[j], pose.normal, pose.renormalise, &restPositions[o], &restNormals[o], &positions[size_t(P.runFirst) * 3],
                  &normals[size_t(P.runFirst) * 3], P.runCount);
   }
 }

@@ -61,10 +61,53 @@ std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const s
   return outputOf;
 }
 
+// Smooth mode: sorts each section's vertices by the section they blend with (a stable counting
+// sort within the section; output arrays and triangle indices follow) and records the runs.
+void groupBlendRuns(GcsDeformerImpl& m) {
+  const uint32_t N = m.vertexCount;
+  std::vector<uint32_t> order(N);  // new output slot → old output index
+  for (uint32_t i = 0; i < N; ++i) order[i] = i;
+  for (const Section& sec : m.sections) {
+    auto begin = order.begin() + sec.first, end = begin + sec.count;
+    std::stable_sort(begin, end, [&](uint32_t a, uint32_t b) { return m.blendOther[a] < m.blendOther[b]; });
+  }
+  std::vector<uint32_t> newIndex(N);
+  for (uint32_t i = 0; i < N; ++i) newIndex[order[i]] = i;
+  auto permute3 = [&](std::vector<float>& a) {
+    std::vector<float> b(a.size(), 0.0f);
+    for (uint32_t i = 0; i < N; ++i)
+      for (int c = 0; c < 3; ++c) b[3 * size_t(i) + c] = a[3 * size_t(order[i]) + c];
+    a.swap(b);
+  };
+  permute3(m.restPositions);
+  permute3(m.restNormals);
+  auto permute = [&](auto& a) {
+    auto b = a;
+    for (uint32_t i = 0; i < N; ++i) b[i] = a[order[i]];
+    a.swap(b);
+  };
+  permute(m.sourceVertex);
+  permute(m.sectionOfVertex);
+  permute(m.blendOther);
+  permute(m.blendF);
+  for (uint32_t& index : m.indices) index = newIndex[index];
+  m.blendRuns.clear();
+  for (uint32_t i = 0; i < uint32_t(m.sections.size()); ++i) {
+    const Section& sec = m.sections[i];
+    for (uint32_t o = sec.first; o < sec.first + sec.count;) {
+      uint32_t end = o;
+      while (end < sec.first + sec.count && m.blendOther[end] == m.blendOther[o]) ++end;
+      m.blendRuns.push_back({o, end - o, i, m.blendOther[o]});
+      o = end;
+    }
+  }
+}
+
 // Bounding spheres (for the adjusted-section statistic), the introspection table, the per-frame
 // buffers, and the rest pose in the output.
 void finishModel(GcsDeformerImpl& m) {
   const uint32_t S = uint32_t(m.sections.size());
+  if (m.settings.smooth) groupBlendRuns(m);
   m.sectionInfo.resize(size_t(S) * 8);
   for (uint32_t i = 0; i < S; ++i) {
     Section& sec = m.sections[i];
@@ -87,6 +130,7 @@ void finishModel(GcsDeformerImpl& m) {
     info[7] = sec.beta;
   }
   m.poses.resize(m.jointCount);
+  m.lastSkin.assign(m.jointCount, glm::mat4(1.0f));
   m.sectionMatrices.assign(S, glm::mat4(1.0f));
   m.normalMatrices.assign(S, glm::mat4(1.0f));
   m.renormalise.assign(S, 0);
@@ -324,8 +368,8 @@ float GcsDeformerImpl::stat(GcsStat which) const {
     case GCS_STAT_SECTIONS: return float(sections.size());
     case GCS_STAT_PARTS: return float(partCount);
     case GCS_STAT_ADJUSTED_SHARE:
-      return sections.empty() ? 0.0f : float(adjustedSections) / float(sections.size());
-    case GCS_STAT_ADJUSTED_SECTIONS: return float(adjustedSections);
+      return sections.empty() ? 0.0f : float(countAdjusted()) / float(sections.size());
+    case GCS_STAT_ADJUSTED_SECTIONS: return float(countAdjusted());
   }
   return std::nanf("");
 }
@@ -659,16 +703,15 @@ glm::mat4 rigidInverse(const glm::mat4& m) {
 
 // Weights criterion: each section's transform is the dual-quaternion blend of its joints at its
 // mean weights (a rigid core: S_j itself). O(sections × influences).
-void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, bool sameScale) {
+void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale) {
   const uint32_t S = uint32_t(sections.size());
   for (uint32_t i = 0; i < S; ++i) {
     const Section& sec = sections[i];
     bool renorm = false;
     if (sec.rigid) {
       sectionMatrices[i] = skin[sec.part];
-      glm::mat4 n(normalMatrix(poses[sec.part].rotation, poses[sec.part].scale, renorm));
-      n[3][3] = 0.0f;
-      normalMatrices[i] = n;
+      normalMatrices[i] = poses[sec.part].normal;
+      renorm = poses[sec.part].renormalise;
     } else {
       float w[4];
       for (uint32_t k = 0; k < sec.influenceCount; ++k) {
@@ -676,7 +719,7 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, bool sameS
         blendPoseScratch[k] = &poses[in.joint];
         w[k] = in.weight;
       }
-      blendPoses(blendPoseScratch.data(), w, sec.influenceCount, sameScale, sectionMatrices[i], normalMatrices[i], renorm);
+      blendPoses(blendPoseScratch.data(), w, sec.influenceCount, scale, sectionMatrices[i], normalMatrices[i], renorm);
     }
     renormalise[i] = renorm;
   }
@@ -684,7 +727,7 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, bool sameS
 
 // The paper's rule (Y and axial criteria): M = S_p · D_j^α · D_k^β on the rigid parts of the skin
 // matrices, then the section's scale (the same blend of the joints' scales) applied first.
-void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, bool sameScale) {
+void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale) {
   const uint32_t J = jointCount;
   // Relative motion of each part with respect to its parent part: D_j = rigid(S_p)^-1 · rigid(S_j).
   for (uint32_t j = 0; j < J; ++j) {
@@ -699,10 +742,8 @@ void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, bool sameSca
     bool renorm = false;
     if (sec.parent < 0 && !(sec.distal >= 0 && sec.beta > 0.0f)) {
       sectionMatrices[i] = skin[sec.part];
-      glm::mat4 n(normalMatrix(poses[sec.part].rotation, poses[sec.part].scale, renorm));
-      n[3][3] = 0.0f;
-      normalMatrices[i] = n;
-      renormalise[i] = renorm;
+      normalMatrices[i] = poses[sec.part].normal;
+      renormalise[i] = poses[sec.part].renormalise;
       continue;
     }
     glm::mat4 m;
@@ -727,8 +768,14 @@ void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, bool sameSca
         m = m * fractionMatrix(d, sec.beta);
     }
     // Scale: parent, part and distal joint weighted (1 − α, α − β, β), applied first.
+    if (scale.uniform) {  // the common case: m's rotation carries the normals as it is
+      sectionMatrices[i] = glm::mat4(scale.s * m[0], scale.s * m[1], scale.s * m[2], m[3]);
+      normalMatrices[i] = glm::mat4(m[0], m[1], m[2], glm::vec4(0.0f));
+      renormalise[i] = 0;
+      continue;
+    }
     glm::mat3 k = poses[sec.part].scale;
-    if (!sameScale) {
+    if (!scale.same) {
       k = (sec.parent >= 0 ? sec.alpha : 1.0f) * k;
       if (sec.parent >= 0) k += (1.0f - sec.alpha) * poses[sec.parent].scale;
       if (sec.distal >= 0 && sec.beta > 0.0f) k += sec.beta * (poses[sec.distal].scale - poses[sec.part].scale);
@@ -737,45 +784,60 @@ void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, bool sameSca
     glm::mat3 rk = r * k;
     sectionMatrices[i] = glm::mat4(glm::vec4(rk[0], 0.0f), glm::vec4(rk[1], 0.0f), glm::vec4(rk[2], 0.0f), m[3]);
     glm::mat4 n(normalMatrix(glm::quat_cast(r), k, renorm));
-    n[3][3] = 0.0f;
+    n[3] = glm::vec4(0.0f);
     normalMatrices[i] = n;
     renormalise[i] = renorm;
   }
 }
 
-void GcsDeformerImpl::deform(const glm::mat4* skin) {
-  const uint32_t J = jointCount;
-  bool sameScale = true;
-  for (uint32_t j = 0; j < J; ++j) {
-    decompose(skin[j], poses[j]);
-    if (sameScale && j > 0 && poses[j].scale != poses[0].scale) sameScale = false;
-  }
-  if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, sameScale);
-  else sectionTransformsPaper(skin, sameScale);
-
-  // Adjusted: the section's transform differs from its part's rigid S_j by more than the
-  // tolerance anywhere on the section's bounding sphere.
-  adjustedSections = 0;
-  const uint32_t S = uint32_t(sections.size());
-  for (uint32_t i = 0; i < S; ++i) {
+// Adjusted: the section's transform differs from its part's rigid S_j by more than the tolerance
+// anywhere on the section's bounding sphere. Over the last frame; cached until the next deform.
+uint32_t GcsDeformerImpl::countAdjusted() const {
+  if (adjustedValid) return adjustedSections;
+  uint32_t adjusted = 0;
+  for (uint32_t i = 0; i < uint32_t(sections.size()); ++i) {
     const Section& sec = sections[i];
-    glm::mat4 diff = sectionMatrices[i] - skin[sec.part];
+    glm::mat4 diff = sectionMatrices[i] - lastSkin[sec.part];
     glm::vec3 atCentre = glm::vec3(diff * glm::vec4(sec.centre, 1.0f));
     float linear = std::sqrt(glm::dot(glm::vec3(diff[0]), glm::vec3(diff[0])) +
                              glm::dot(glm::vec3(diff[1]), glm::vec3(diff[1])) +
                              glm::dot(glm::vec3(diff[2]), glm::vec3(diff[2])));
-    if (glm::length(atCentre) + linear * sec.radius > adjustTolerance) ++adjustedSections;
+    if (glm::length(atCentre) + linear * sec.radius > adjustTolerance) ++adjusted;
   }
+  adjustedSections = adjusted;
+  adjustedValid = true;
+  return adjusted;
+}
 
+void GcsDeformerImpl::deform(const glm::mat4* skin) {
+  const uint32_t J = jointCount;
+  const ScaleState scale = decomposeAll(skin, J, poses.data());
+  if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, scale);
+  else sectionTransformsPaper(skin, scale);
+
+  // The adjusted-section statistic is computed when asked for (stat), from a copy of the skin.
+  std::memcpy(lastSkin.data(), skin, size_t(J) * sizeof(glm::mat4));
+  adjustedValid = false;
+  const uint32_t S = uint32_t(sections.size());
+  if (settings.smooth) {
+    for (const BlendRun& run : blendRuns) {
+      size_t o = size_t(run.first) * 3;
+      const uint32_t a = run.section, b = run.other;
+      if (a == b)
+        transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
+                     &positions[o], &normals[o], run.count);
+      else
+        blendRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, sectionMatrices[b], normalMatrices[b],
+                 renormalise[b] != 0, &blendF[run.first], &restPositions[o], &restNormals[o], &positions[o], &normals[o],
+                 run.count);
+    }
+    return;
+  }
   for (uint32_t i = 0; i < S; ++i) {
     const Section& sec = sections[i];
     size_t o = size_t(sec.first) * 3;
-    if (settings.smooth)
-      blendRun(sectionMatrices[i], normalMatrices[i], sectionMatrices.data(), normalMatrices.data(), &blendOther[sec.first],
-               &blendF[sec.first], &restPositions[o], &restNormals[o], &positions[o], &normals[o], sec.count);
-    else
-      transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
-                   &positions[o], &normals[o], sec.count);
+    transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
+                 &positions[o], &normals[o], sec.count);
   }
 }
 

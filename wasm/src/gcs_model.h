@@ -67,6 +67,12 @@ class GcsDeformerImpl final : public Deformer {
   // (its own section is the run it sits in).
   std::vector<uint32_t> blendOther;
   std::vector<float> blendF;
+  // Smooth mode: runs of vertices of one section that blend with the same other section (vertices
+  // are sorted by it within their section at build time), so the kernel loads both transforms once.
+  struct BlendRun {
+    uint32_t first = 0, count = 0, section = 0, other = 0;
+  };
+  std::vector<BlendRun> blendRuns;
   float adjustTolerance = 0.0f;
 
   // Per-frame state, allocated at build time.
@@ -77,11 +83,14 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<glm::mat4> normalMatrices;    // normal transform of each section (3×3 in a mat4)
   std::vector<uint8_t> renormalise;         // normals of the section need renormalising
   std::vector<const JointPose*> blendPoseScratch;
-  uint32_t adjustedSections = 0;
+  std::vector<glm::mat4> lastSkin;          // the last frame's S_j, for the adjusted statistic
+  mutable uint32_t adjustedSections = 0;
+  mutable bool adjustedValid = false;
 
  private:
-  void sectionTransformsWeights(const glm::mat4* skin, bool sameScale);
-  void sectionTransformsPaper(const glm::mat4* skin, bool sameScale);
+  uint32_t countAdjusted() const;
+  void sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale);
+  void sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale);
 };
 
 // Builds the GCS model of a rig. Returns null with the error recorded on failure.

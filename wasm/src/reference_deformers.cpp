@@ -45,11 +45,7 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
 
 void SkinningDeformer::deform(const glm::mat4* skin) {
   const uint32_t n = vertexCount;
-  bool sameScale = true;
-  for (uint32_t j = 0; j < jointCount; ++j) {
-    decompose(skin[j], poses[j]);
-    if (sameScale && j > 0 && poses[j].scale != poses[0].scale) sameScale = false;
-  }
+  const ScaleState scale = decomposeAll(skin, jointCount, poses.data());
   if (kind_ == GCS_KIND_LBS) {
     for (uint32_t v = 0; v < n; ++v) {
       const glm::uvec4 j = joints[v];
@@ -81,7 +77,7 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
       w4[k++] = weights[v][i];
     }
     bool renorm = false;
-    blendPoses(blend, w4, k, sameScale, pm, nm, renorm);
+    blendPoses(blend, w4, k, scale, pm, nm, renorm);
     const float* p = &restPositions[3 * size_t(v)];
     const float* q = &restNormals[3 * size_t(v)];
     glm::vec3 rp(pm * glm::vec4(p[0], p[1], p[2], 1.0f));

@@ -80,24 +80,25 @@ inline glm::mat3 cofactor(const glm::mat3& k) {
   return glm::mat3(glm::cross(k[1], k[2]), glm::cross(k[2], k[0]), glm::cross(k[0], k[1]));
 }
 
-// A skin matrix split as S = [R·K | t] (rotation R, the remaining scale/shear K = Rᵀ·S₃ₓ₃, and the
-// translation t), plus R and t as a unit dual quaternion for blending (Kavan et al. 2007).
+// A skin matrix split as S = [R·K | t]: rotation R, the remaining scale/shear K = Rᵀ·S₃ₓ₃, and the
+// translation t; R and t also as a unit dual quaternion for blending (Kavan et al. 2007), and the
+// matrix that carries its normals (see normalMatrix).
 struct JointPose {
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 translation{0.0f};
   glm::mat3 scale{1.0f};      // K
   glm::vec4 real{0.0f, 0.0f, 0.0f, 1.0f}, dual{0.0f};  // (x, y, z, w)
+  glm::mat4 normal{1.0f};     // 3×3 in a mat4, 4th row and column 0 (SIMD lane 4 stays 0)
+  bool renormalise = false;
 };
 
-inline void decompose(const glm::mat4& s, JointPose& out) {
-  out.rotation = rotationOf(s);
-  out.translation = glm::vec3(s[3]);
-  out.scale = glm::transpose(glm::mat3_cast(out.rotation)) * glm::mat3(s);
-  glm::quat r = out.rotation;
-  glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
-  out.real = glm::vec4(r.x, r.y, r.z, r.w);
-  out.dual = glm::vec4(d.x, d.y, d.z, d.w);
-}
+// What the scale parts of one frame's poses have in common: blends take shortcuts when every K is
+// the same matrix (`same`), and more when that matrix is s·I, s > 0 (`uniform`).
+struct ScaleState {
+  bool same = true;
+  bool uniform = true;
+  float s = 1.0f;
+};
 
 // True when k is s·I with s > 0 up to a relative 1e-4: then normals need only the rotation.
 inline bool isUniformScale(const glm::mat3& k) {
@@ -128,33 +129,73 @@ inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, boo
   return r * (c / big);
 }
 
+inline void decompose(const glm::mat4& s, JointPose& out) {
+  out.rotation = rotationOf(s);
+  out.translation = glm::vec3(s[3]);
+  out.scale = glm::transpose(glm::mat3_cast(out.rotation)) * glm::mat3(s);
+  glm::quat r = out.rotation;
+  glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
+  out.real = glm::vec4(r.x, r.y, r.z, r.w);
+  out.dual = glm::vec4(d.x, d.y, d.z, d.w);
+  out.normal = glm::mat4(normalMatrix(r, out.scale, out.renormalise));
+  out.normal[3][3] = 0.0f;
+}
+
+// Decomposes every skin matrix of a frame and tells what their scales have in common.
+inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose* poses) {
+  ScaleState st;
+  for (uint32_t j = 0; j < count; ++j) {
+    decompose(skin[j], poses[j]);
+    if (st.same && j > 0 && poses[j].scale != poses[0].scale) st.same = false;
+  }
+  st.uniform = st.same && count > 0 && isUniformScale(poses[0].scale);
+  st.s = st.uniform ? (poses[0].scale[0][0] + poses[0].scale[1][1] + poses[0].scale[2][2]) / 3.0f : 1.0f;
+  if (st.uniform) {  // exact when the scale is the same on every axis (always in the rest pose: 1)
+    const glm::mat3& k = poses[0].scale;
+    if (k[0][0] == k[1][1] && k[1][1] == k[2][2]) st.s = k[0][0];
+  }
+  return st;
+}
+
 // The blend of joint poses with weights w_i (Σ w_i = 1), as dual-quaternion skinning does it:
 // rotation and translation by the normalised linear blend of the dual quaternions (each taken in
 // the hemisphere of the first), scale/shear by the linear blend of the K_i, applied first.
-// `sameScale`: every K_i is the same matrix (then K is taken as is: exact, no rounding of Σ w_i).
 // Writes the position matrix [R·K | t] and the normal matrix (see normalMatrix).
-inline void blendPoses(const JointPose* const* poses, const float* w, uint32_t count, bool sameScale,
+inline void blendPoses(const JointPose* const* poses, const float* w, uint32_t count, const ScaleState& scale,
                        glm::mat4& position, glm::mat4& normal, bool& renormalise) {
   const glm::vec4 pivot = poses[0]->real;
   glm::vec4 br(0.0f), bd(0.0f);
-  glm::mat3 k(0.0f);
   for (uint32_t i = 0; i < count; ++i) {
     float s = glm::dot(poses[i]->real, pivot) < 0.0f ? -w[i] : w[i];
     br += s * poses[i]->real;
     bd += s * poses[i]->dual;
-    if (!sameScale) k += w[i] * poses[i]->scale;
   }
-  if (sameScale) k = poses[0]->scale;
-  float len = glm::length(br);  // ≥ the largest weight: the quaternions share a hemisphere
-  br /= len;
-  bd /= len;
-  glm::quat r(br.w, br.x, br.y, br.z), d(bd.w, bd.x, bd.y, bd.z);
-  glm::quat tq = 2.0f * (d * glm::conjugate(r));
-  glm::mat3 rk = glm::mat3_cast(r) * k;
-  position = glm::mat4(glm::vec4(rk[0], 0.0f), glm::vec4(rk[1], 0.0f), glm::vec4(rk[2], 0.0f),
-                       glm::vec4(tq.x, tq.y, tq.z, 1.0f));
-  normal = glm::mat4(normalMatrix(r, k, renormalise));
+  // Unit quaternion r = br/|br| as a matrix, and t = 2·(bd·conj(br))/|br|² (its vector part), without
+  // normalising br and bd first. |br| ≥ the largest weight: the quaternions share a hemisphere.
+  const float inv2 = 1.0f / glm::dot(br, br);
+  const glm::vec3 rv(br), dv(bd);
+  const glm::vec3 tv = (2.0f * inv2) * (br.w * dv - bd.w * rv - glm::cross(dv, rv));
+  const float xx = br.x * br.x, yy = br.y * br.y, zz = br.z * br.z, xy = br.x * br.y, xz = br.x * br.z,
+              yz = br.y * br.z, wx = br.w * br.x, wy = br.w * br.y, wz = br.w * br.z, k2 = 2.0f * inv2;
+  glm::mat3 rot(1.0f - k2 * (yy + zz), k2 * (xy + wz), k2 * (xz - wy),
+                k2 * (xy - wz), 1.0f - k2 * (xx + zz), k2 * (yz + wx),
+                k2 * (xz + wy), k2 * (yz - wx), 1.0f - k2 * (xx + yy));
+  glm::mat3 rk;
+  if (scale.uniform) {  // the common case (every K = s·I): no per-section scale work
+    rk = scale.s * rot;
+    renormalise = false;
+    normal = glm::mat4(rot);
+  } else {
+    glm::mat3 k(0.0f);
+    if (scale.same) k = poses[0]->scale;
+    else
+      for (uint32_t i = 0; i < count; ++i) k += w[i] * poses[i]->scale;
+    rk = rot * k;
+    normal = glm::mat4(normalMatrix(glm::normalize(glm::quat(br.w, br.x, br.y, br.z)), k, renormalise));
+  }
   normal[3] = glm::vec4(0.0f);
+  position = glm::mat4(glm::vec4(rk[0], 0.0f), glm::vec4(rk[1], 0.0f), glm::vec4(rk[2], 0.0f),
+                       glm::vec4(tv.x, tv.y, tv.z, 1.0f));
 }
 
 inline Motion motionAbout(const glm::mat4& d, const glm::vec3& centre) {
@@ -236,10 +277,11 @@ inline void normaliseInPlace(float* n) {
 }
 
 // Transforms `count` interleaved xyz points by the affine matrix m and their normals by the 3×3
-// matrix nm (see normalMatrix), renormalising the normals when asked. Output arrays need one spare
-// float after the last vertex (the SIMD path stores 4 lanes per vertex).
-inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormalise, const float* inPos,
-                         const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+// matrix nm (see normalMatrix), renormalising the normals when Renormalise. Output arrays need one
+// spare float after the last vertex (the SIMD path stores 4 lanes per vertex).
+template <bool Renormalise>
+inline void transformRunT(const glm::mat4& m, const glm::mat4& nm, const float* inPos, const float* inNrm,
+                          float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
   const v128_t c0 = wasm_v128_load(&m[0][0]), c1 = wasm_v128_load(&m[1][0]);
   const v128_t c2 = wasm_v128_load(&m[2][0]), c3 = wasm_v128_load(&m[3][0]);
@@ -248,7 +290,7 @@ inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormali
   for (uint32_t i = 0; i < count; ++i) {
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));  // lane 4 spills into the next vertex
     v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
-    wasm_v128_store(outNrm + 3 * i, renormalise ? normalise3(rn) : rn);
+    wasm_v128_store(outNrm + 3 * i, Renormalise ? normalise3(rn) : rn);
   }
 #else
   for (uint32_t i = 0; i < count; ++i) {
@@ -258,40 +300,57 @@ inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormali
       outPos[3 * i + r] = m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r];
       outNrm[3 * i + r] = nm[0][r] * n[0] + nm[1][r] * n[1] + nm[2][r] * n[2];
     }
-    if (renormalise) normaliseInPlace(outNrm + 3 * i);
+    if (Renormalise) normaliseInPlace(outNrm + 3 * i);
   }
 #endif
 }
 
-// Smooth mode: vertex i of the run takes lerp(A, B_i, f_i), A the run's own transform and B_i the
-// transform of section other[i] (pos and normal matrices alike), then renormalises the normal (a
-// blend of two rotations is a slightly shortened rotation).
-inline void blendRun(const glm::mat4& pa, const glm::mat4& na, const glm::mat4* positionMatrices,
-                     const glm::mat4* normalMatrices, const uint32_t* other, const float* f,
-                     const float* inPos, const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormalise, const float* inPos,
+                         const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+  if (renormalise) transformRunT<true>(m, nm, inPos, inNrm, outPos, outNrm, count);
+  else transformRunT<false>(m, nm, inPos, inNrm, outPos, outNrm, count);
+}
+
+// Smooth mode, a run of vertices that all blend transform A with the same transform B: vertex i
+// takes lerp(A, B, f[i]) for its position and normal.
+//   Near-rotation blends (NearRotation: both normal matrices rotations less than 35° apart) fix the
+//   normal's length by a cubic approximation of 1/sqrt around 1 (error < 3e-4 there) instead of a
+//   square root and a division. Otherwise the normal is normalised exactly.
+template <bool NearRotation>
+inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4& pb, const glm::mat4& nb,
+                      const float* f, const float* inPos, const float* inNrm, float* outPos, float* outNrm,
+                      uint32_t count) {
 #if defined(__wasm_simd128__)
   const v128_t a0 = wasm_v128_load(&pa[0][0]), a1 = wasm_v128_load(&pa[1][0]);
   const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
+  const v128_t d0 = wasm_f32x4_sub(wasm_v128_load(&pb[0][0]), a0), d1 = wasm_f32x4_sub(wasm_v128_load(&pb[1][0]), a1);
+  const v128_t d2 = wasm_f32x4_sub(wasm_v128_load(&pb[2][0]), a2), d3 = wasm_f32x4_sub(wasm_v128_load(&pb[3][0]), a3);
   const v128_t m0 = wasm_v128_load(&na[0][0]), m1 = wasm_v128_load(&na[1][0]), m2 = wasm_v128_load(&na[2][0]);
+  const v128_t e0 = wasm_f32x4_sub(wasm_v128_load(&nb[0][0]), m0), e1 = wasm_f32x4_sub(wasm_v128_load(&nb[1][0]), m1);
+  const v128_t e2 = wasm_f32x4_sub(wasm_v128_load(&nb[2][0]), m2);
   const v128_t zero = wasm_f32x4_splat(0.0f);
+  const v128_t one = wasm_f32x4_splat(1.0f), half = wasm_f32x4_splat(-0.5f), c38 = wasm_f32x4_splat(0.375f);
   for (uint32_t i = 0; i < count; ++i) {
-    const float* pb = &positionMatrices[other[i]][0][0];
-    const float* nb = &normalMatrices[other[i]][0][0];
-    const v128_t t = wasm_f32x4_splat(f[i]);
-    const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb), a0)));
-    const v128_t c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 4), a1)));
-    const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 8), a2)));
-    const v128_t c3 = wasm_f32x4_add(a3, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(pb + 12), a3)));
-    const v128_t n0 = wasm_f32x4_add(m0, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb), m0)));
-    const v128_t n1 = wasm_f32x4_add(m1, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb + 4), m1)));
-    const v128_t n2 = wasm_f32x4_add(m2, wasm_f32x4_mul(t, wasm_f32x4_sub(wasm_v128_load(nb + 8), m2)));
+    const v128_t t = wasm_v128_load32_splat(f + i);
+    const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
+    const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, d2)), c3 = wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3));
+    const v128_t n0 = wasm_f32x4_add(m0, wasm_f32x4_mul(t, e0)), n1 = wasm_f32x4_add(m1, wasm_f32x4_mul(t, e1));
+    const v128_t n2 = wasm_f32x4_add(m2, wasm_f32x4_mul(t, e2));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
-    wasm_v128_store(outNrm + 3 * i, normalise3(affine(n0, n1, n2, zero, inNrm + 3 * i)));
+    v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
+    if (NearRotation) {
+      v128_t sq = wasm_f32x4_mul(rn, rn);
+      v128_t s2 = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+      v128_t e = wasm_f32x4_sub(wasm_f32x4_add(s2, wasm_i32x4_shuffle(s2, s2, 2, 3, 0, 1)), one);  // |n|² − 1
+      // 1/sqrt(1 + e) ≈ 1 − e/2 + 3e²/8
+      rn = wasm_f32x4_mul(rn, wasm_f32x4_add(one, wasm_f32x4_mul(e, wasm_f32x4_add(half, wasm_f32x4_mul(c38, e)))));
+      wasm_v128_store(outNrm + 3 * i, rn);
+    } else {
+      wasm_v128_store(outNrm + 3 * i, normalise3(rn));
+    }
   }
 #else
   for (uint32_t i = 0; i < count; ++i) {
-    const glm::mat4& pb = positionMatrices[other[i]];
-    const glm::mat4& nb = normalMatrices[other[i]];
     const float t = f[i];
     const float* p = inPos + 3 * i;
     const float* n = inNrm + 3 * i;
@@ -307,6 +366,21 @@ inline void blendRun(const glm::mat4& pa, const glm::mat4& na, const glm::mat4* 
     normaliseInPlace(outNrm + 3 * i);
   }
 #endif
+}
+
+// Chooses the kernel: the cubic length fix when both normal matrices are rotations (no
+// renormalisation flagged) at most 35° apart, so a blend's length² stays above 0.91.
+inline void blendRun(const glm::mat4& pa, const glm::mat4& na, bool renormA, const glm::mat4& pb, const glm::mat4& nb,
+                     bool renormB, const float* f, const float* inPos, const float* inNrm, float* outPos,
+                     float* outNrm, uint32_t count) {
+  bool near = false;
+  if (!renormA && !renormB) {
+    float trace = glm::dot(glm::vec3(na[0]), glm::vec3(nb[0])) + glm::dot(glm::vec3(na[1]), glm::vec3(nb[1])) +
+                  glm::dot(glm::vec3(na[2]), glm::vec3(nb[2]));  // 1 + 2 cos θ
+    near = trace > 1.0f + 2.0f * 0.82f;  // cos θ > 0.82: θ < 35°, cubic error < 3e-4
+  }
+  if (near) blendRunT<true>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
+  else blendRunT<false>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
 }
 
 }  // namespace gcs

@@ -1,0 +1,549 @@
+/**
+ * gcs-skin/measure: the one place where the project measures its deformers (design.md §7). Used by
+ * `gcs-skin report`, `npm run metrics`, `npm run bench` and the tests.
+ *
+ * - Timing: `timeFrames` (median / p95 ms of a per-frame step).
+ * - Fidelity: `FidelityProbe` compares a deformer's output, frame by frame, with what the rig says:
+ *   rigid error (vertices bound ≥ 0.999 to one joint against S_j·x), distance from a scale-aware
+ *   dual-quaternion skinning computed here in JavaScript (independently of the core), flipped and
+ *   stretched triangles, normals off unit length, non-finite values and the seam gap. Distances are
+ *   in % of the character's height.
+ *
+ * Plain TypeScript over typed arrays; no three.js.
+ */
+import type { Deformer, Rig, RigInput } from './index.js';
+import { GcsError } from './errors.js';
+
+// ------------------------------------------------------------------------------------ statistics
+
+export function median(values: ArrayLike<number>): number {
+  return percentile(values, 50);
+}
+
+/** The p-th percentile (0..100, nearest rank on the sorted values); NaN for no values. */
+export function percentile(values: ArrayLike<number>, p: number): number {
+  const n = values.length;
+  if (!n) return NaN;
+  const sorted = Float64Array.from(values as ArrayLike<number>).sort();
+  const rank = Math.min(n - 1, Math.max(0, Math.ceil((p / 100) * n) - 1));
+  return sorted[rank];
+}
+
+// ------------------------------------------------------------------------------------ timing
+
+export interface TimingOptions {
+  /** At least this many timed frames (default 200). */
+  minSamples?: number;
+  /** Keep timing until this much time has passed (default 150 ms)… */
+  minMs?: number;
+  /** …but stop after this much (default 3000 ms), whatever the sample count. */
+  maxMs?: number;
+  /** Frames run before timing (default: one pass over the frames). */
+  warmup?: number;
+}
+
+export interface Timing {
+  medianMs: number;
+  p95Ms: number;
+  samples: number;
+}
+
+/**
+ * Times `step(frameIndex)` once per frame, cycling over `frameCount` frames: the inputs are
+ * precomputed by the caller so only the step itself is timed. Returns median and p95 in ms.
+ */
+export function timeFrames(frameCount: number, step: (frame: number) => void, options: TimingOptions = {}): Timing {
+  const minSamples = options.minSamples ?? 200;
+  const minMs = options.minMs ?? 150;
+  const maxMs = options.maxMs ?? 3000;
+  const warmup = options.warmup ?? frameCount;
+  for (let i = 0; i < warmup; i++) step(i % frameCount);
+  const samples: number[] = [];
+  const start = performance.now();
+  for (let i = 0; ; i++) {
+    const t0 = performance.now();
+    step(i % frameCount);
+    const t1 = performance.now();
+    samples.push(t1 - t0);
+    const elapsed = t1 - start;
+    if ((samples.length >= minSamples && elapsed >= minMs) || elapsed >= maxMs) break;
+  }
+  return { medianMs: median(samples), p95Ms: percentile(samples, 95), samples: samples.length };
+}
+
+// ------------------------------------------------------------------------------------ small helpers
+
+/** J identity matrices: the skin matrices of the bind pose. */
+export function identitySkin(jointCount: number): Float32Array {
+  const skin = new Float32Array(jointCount * 16);
+  for (let j = 0; j < jointCount; j++) skin[16 * j] = skin[16 * j + 5] = skin[16 * j + 10] = skin[16 * j + 15] = 1;
+  return skin;
+}
+
+/** Number of NaN or infinite values in the given arrays. */
+export function countNonFinite(...arrays: ArrayLike<number>[]): number {
+  let bad = 0;
+  for (const a of arrays) for (let i = 0; i < a.length; i++) if (!Number.isFinite(a[i])) bad++;
+  return bad;
+}
+
+/**
+ * Groups of output vertices that coincide at rest (glTF splits vertices along UV and normal
+ * seams): pairs [first of group, other member], flattened. `rest` is xyz per output vertex.
+ */
+export function coincidentPairs(rest: ArrayLike<number>): Uint32Array {
+  const n = Math.floor(rest.length / 3);
+  const f = new Float32Array(3);
+  const u = new Uint32Array(f.buffer);
+  const seen = new Map<string, number>();
+  const pairs: number[] = [];
+  for (let v = 0; v < n; v++) {
+    f[0] = rest[3 * v] + 0; f[1] = rest[3 * v + 1] + 0; f[2] = rest[3 * v + 2] + 0; // +0 folds -0
+    const key = `${u[0]},${u[1]},${u[2]}`;
+    const first = seen.get(key);
+    if (first === undefined) seen.set(key, v);
+    else pairs.push(first, v);
+  }
+  return Uint32Array.from(pairs);
+}
+
+/** Largest distance between vertices that coincide at rest (0 = no seam opens). NaN counts as infinite. */
+export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): number {
+  let gap = 0;
+  for (let i = 0; i < pairs.length; i += 2) {
+    const a = 3 * pairs[i], b = 3 * pairs[i + 1];
+    const dx = positions[a] - positions[b], dy = positions[a + 1] - positions[b + 1], dz = positions[a + 2] - positions[b + 2];
+    const d = Math.sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(d <= gap)) gap = Number.isNaN(d) ? Infinity : d;
+  }
+  return gap;
+}
+
+/**
+ * The rest positions of a deformer's output vertices: the rig's bind-pose positions of their
+ * source vertices where the deformer has them, else the output of a bind-pose deform.
+ */
+export function restOfOutput(deformer: Deformer, rigPositions: ArrayLike<number>): Float32Array {
+  const source = deformer.sourceVertex;
+  const nRig = Math.floor(rigPositions.length / 3);
+  deformer.deform(identitySkin(deformer.jointCount));
+  const out = Float32Array.from(deformer.positions);
+  if (source) {
+    for (let o = 0; o < source.length; o++) {
+      const v = source[o];
+      if (v < nRig) for (let c = 0; c < 3; c++) out[3 * o + c] = rigPositions[3 * v + c];
+    }
+  }
+  return out;
+}
+
+/**
+ * Rest error: the largest distance, over output vertices that come from a rig vertex, between the
+ * bind-pose deform and that vertex's original position. null when no output vertex has a source
+ * (a resampled model: see the classic detail loss instead).
+ */
+export function restError(deformer: Deformer, rigPositions: ArrayLike<number>): number | null {
+  const source = deformer.sourceVertex;
+  if (!source) return null;
+  const nRig = Math.floor(rigPositions.length / 3);
+  deformer.deform(identitySkin(deformer.jointCount));
+  const p = deformer.positions;
+  let err = 0, any = false;
+  for (let o = 0; o < source.length; o++) {
+    const v = source[o];
+    if (v >= nRig) continue;
+    any = true;
+    const dx = p[3 * o] - rigPositions[3 * v], dy = p[3 * o + 1] - rigPositions[3 * v + 1], dz = p[3 * o + 2] - rigPositions[3 * v + 2];
+    const d = Math.sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(d <= err)) err = Number.isNaN(d) ? Infinity : d;
+  }
+  return any ? err : null;
+}
+
+// ------------------------------------------------------------------------------------ methods
+
+/**
+ * The methods the report, metrics and tests compare: GCS with the weights criterion (the default),
+ * smooth, the paper's Y criterion and the axial variant (influence width 1), the classic
+ * cross-section model, LBS and DQS.
+ */
+export type MethodName = 'gcs' | 'gcs-smooth' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
+export const METHODS: MethodName[] = ['gcs', 'gcs-smooth', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
+export const METHOD_LABELS: Record<MethodName, string> = {
+  gcs: 'GCS (weights, default)', 'gcs-smooth': 'GCS smooth (weights)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
+  classic: 'classic', lbs: 'LBS', dqs: 'DQS',
+};
+
+export interface BuildSettings {
+  sections?: number;
+  contours?: number;
+  rays?: number;
+}
+
+/** Builds a deformer by method name. */
+export function buildMethod(rig: Rig, method: MethodName, settings: BuildSettings = {}): Deformer {
+  switch (method) {
+    case 'gcs': return rig.buildGcs({ sections: settings.sections });
+    case 'gcs-smooth': return rig.buildGcs({ sections: settings.sections, smooth: true });
+    case 'gcs-y': return rig.buildGcs({ sections: settings.sections, criterion: 'y' });
+    case 'gcs-axial': return rig.buildGcs({ sections: settings.sections, criterion: 'axial' });
+    case 'classic': return rig.buildClassic({ contours: settings.contours, rays: settings.rays });
+    case 'lbs': return rig.buildLbs();
+    case 'dqs': return rig.buildDqs();
+  }
+}
+
+/** A build failure as data: the GcsError code and message (e.g. a method not in this binary). */
+export function errorInfo(e: unknown): { code: string; message: string } {
+  if (e instanceof GcsError) return { code: e.code, message: e.message };
+  return { code: 'ERROR', message: e instanceof Error ? e.message : String(e) };
+}
+
+// ------------------------------------------------------------------------------------ reference DQS
+
+/**
+ * A skin matrix split as S = [R·K | t] in double precision: R a rotation (Gram–Schmidt on the
+ * columns, in order of length, a right-handed frame; the identity when every column has collapsed),
+ * K = Rᵀ·S₃ₓ₃ the scale, t the translation, and (R, t) as a unit dual quaternion.
+ * Written apart from the core's C++ on purpose: the reference must not share its bugs.
+ */
+export interface SplitMatrix {
+  /** R, column-major 3×3. */
+  r: Float64Array;
+  /** K = Rᵀ·S, column-major 3×3. */
+  k: Float64Array;
+  /** Dual quaternion (x, y, z, w) real then dual. */
+  dq: Float64Array;
+}
+
+export function splitSkinMatrix(s: ArrayLike<number>, offset = 0): SplitMatrix {
+  const col = (c: number) => [s[offset + 4 * c], s[offset + 4 * c + 1], s[offset + 4 * c + 2]];
+  const cols = [col(0), col(1), col(2)];
+  const len = cols.map((v) => Math.hypot(v[0], v[1], v[2]));
+  const big = Math.max(...len);
+  const r = new Float64Array(9);
+  const axes: number[][] = [[], [], []];
+  if (!(big > 1e-30)) {
+    axes[0] = [1, 0, 0]; axes[1] = [0, 1, 0]; axes[2] = [0, 0, 1];
+  } else {
+    const order = [0, 1, 2].sort((a, b) => len[b] - len[a]);
+    const [a, b, c] = order;
+    const ea = cols[a].map((x) => x / len[a]);
+    let vb = cols[b].map((x, i) => x - (cols[b][0] * ea[0] + cols[b][1] * ea[1] + cols[b][2] * ea[2]) * ea[i]);
+    let lb = Math.hypot(vb[0], vb[1], vb[2]);
+    if (!(lb > 1e-6 * big)) {
+      const helper = Math.abs(ea[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+      vb = cross(ea, helper);
+      lb = Math.hypot(vb[0], vb[1], vb[2]);
+    }
+    axes[a] = ea;
+    axes[b] = vb.map((x) => x / lb);
+    axes[c] = cross(axes[(c + 1) % 3], axes[(c + 2) % 3]);
+  }
+  for (let c = 0; c < 3; c++) for (let i = 0; i < 3; i++) r[3 * c + i] = axes[c][i];
+  const k = new Float64Array(9);
+  for (let c = 0; c < 3; c++) for (let i = 0; i < 3; i++) k[3 * c + i] = axes[i][0] * cols[c][0] + axes[i][1] * cols[c][1] + axes[i][2] * cols[c][2];
+  const q = quatFromRotation(r);
+  const t = [s[offset + 12], s[offset + 13], s[offset + 14]];
+  // dual = ½ (t, 0) · q
+  const d = quatMul([t[0], t[1], t[2], 0], q).map((x) => 0.5 * x);
+  return { r, k, dq: Float64Array.from([...q, ...d]) };
+}
+
+function cross(a: number[], b: number[]): number[] {
+  return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+}
+
+function quatMul(a: ArrayLike<number>, b: ArrayLike<number>): number[] {
+  const [ax, ay, az, aw] = [a[0], a[1], a[2], a[3]];
+  const [bx, by, bz, bw] = [b[0], b[1], b[2], b[3]];
+  return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+    aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz];
+}
+
+/** Unit quaternion (x, y, z, w) of a column-major rotation (Shepperd's method). */
+function quatFromRotation(r: Float64Array): number[] {
+  const m00 = r[0], m10 = r[1], m20 = r[2], m01 = r[3], m11 = r[4], m21 = r[5], m02 = r[6], m12 = r[7], m22 = r[8];
+  const tr = m00 + m11 + m22;
+  let x: number, y: number, z: number, w: number;
+  if (tr > 0) {
+    const s = 2 * Math.sqrt(tr + 1);
+    w = 0.25 * s; x = (m21 - m12) / s; y = (m02 - m20) / s; z = (m10 - m01) / s;
+  } else if (m00 > m11 && m00 > m22) {
+    const s = 2 * Math.sqrt(1 + m00 - m11 - m22);
+    w = (m21 - m12) / s; x = 0.25 * s; y = (m01 + m10) / s; z = (m02 + m20) / s;
+  } else if (m11 > m22) {
+    const s = 2 * Math.sqrt(1 + m11 - m00 - m22);
+    w = (m02 - m20) / s; x = (m01 + m10) / s; y = 0.25 * s; z = (m12 + m21) / s;
+  } else {
+    const s = 2 * Math.sqrt(1 + m22 - m00 - m11);
+    w = (m10 - m01) / s; x = (m02 + m20) / s; y = (m12 + m21) / s; z = 0.25 * s;
+  }
+  const n = Math.hypot(x, y, z, w);
+  return [x / n, y / n, z / n, w / n];
+}
+
+/**
+ * Scale-aware dual-quaternion skinning of a rig's bind-pose positions (design.md §5): per vertex,
+ * the normalised blend of its joints' dual quaternions (in the first influence's hemisphere) moves
+ * K·x, K the blend of the joints' scale parts. Writes vertexCount × 3 positions into `out`.
+ */
+export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Float64Array | Float32Array): void {
+  const J = input.parents.length;
+  const split: SplitMatrix[] = [];
+  for (let j = 0; j < J; j++) split.push(splitSkinMatrix(skin, 16 * j));
+  const n = Math.floor(input.positions.length / 3);
+  const P = input.positions, W = input.weights, Jt = input.joints;
+  const real = [0, 0, 0, 0], dual = [0, 0, 0, 0], k = new Float64Array(9);
+  for (let v = 0; v < n; v++) {
+    let sum = 0;
+    for (let i = 0; i < 4; i++) if (W[4 * v + i] > 0) sum += W[4 * v + i];
+    real.fill(0); dual.fill(0); k.fill(0);
+    let pivot: Float64Array | null = null;
+    for (let i = 0; i < 4; i++) {
+      const w = W[4 * v + i] / sum;
+      if (!(w > 0)) continue;
+      const sj = split[Jt[4 * v + i]];
+      if (!pivot) pivot = sj.dq;
+      const dot = sj.dq[0] * pivot[0] + sj.dq[1] * pivot[1] + sj.dq[2] * pivot[2] + sj.dq[3] * pivot[3];
+      const s = dot < 0 ? -w : w;
+      for (let c = 0; c < 4; c++) { real[c] += s * sj.dq[c]; dual[c] += s * sj.dq[4 + c]; }
+      for (let c = 0; c < 9; c++) k[c] += w * sj.k[c];
+    }
+    const len = Math.hypot(real[0], real[1], real[2], real[3]);
+    for (let c = 0; c < 4; c++) { real[c] /= len; dual[c] /= len; }
+    // t = 2 · dual · conj(real)
+    const tq = quatMul(dual, [-real[0], -real[1], -real[2], real[3]]);
+    const x = P[3 * v], y = P[3 * v + 1], z = P[3 * v + 2];
+    const kx = k[0] * x + k[3] * y + k[6] * z, ky = k[1] * x + k[4] * y + k[7] * z, kz = k[2] * x + k[5] * y + k[8] * z;
+    // Rotate (kx, ky, kz) by the unit quaternion: v + 2w(q×v) + 2 q×(q×v).
+    const [qx, qy, qz, qw] = real;
+    const cx = qy * kz - qz * ky, cy = qz * kx - qx * kz, cz = qx * ky - qy * kx;
+    const rx = kx + 2 * (qw * cx + qy * cz - qz * cy);
+    const ry = ky + 2 * (qw * cy + qz * cx - qx * cz);
+    const rz = kz + 2 * (qw * cz + qx * cy - qy * cx);
+    out[3 * v] = rx + 2 * tq[0];
+    out[3 * v + 1] = ry + 2 * tq[1];
+    out[3 * v + 2] = rz + 2 * tq[2];
+  }
+}
+
+// ------------------------------------------------------------------------------------ fidelity
+
+/** Fidelity of one method over a set of frames (design.md §7). Distances in % of `height`. */
+export interface Fidelity {
+  frames: number;
+  /** Largest distance of a vertex bound ≥ 0.999 to one joint from S_j·x; null: no such vertex or no source map. */
+  rigidError: number | null;
+  /** Vertices bound ≥ 0.999 to one joint (the rigid error's population). */
+  rigidVertices: number;
+  /** Distance from the reference DQS over every vertex and frame: 95th percentile and max; null without a source map. */
+  dqsP95: number | null;
+  dqsMax: number | null;
+  /** Triangles whose normal turned against their rest normal carried by their dominant joint, summed over frames. */
+  flipped: number;
+  /** Triangles with an edge longer than twice its rest length, summed over frames. */
+  stretched: number;
+  /** Largest |length − 1| of an output normal. */
+  normalOffUnit: number;
+  /** NaN or infinite output values (positions and normals), summed over frames. */
+  nonFinite: number;
+  /** Largest gap between output vertices that coincide at rest. */
+  seamGap: number;
+}
+
+export interface FidelityOptions {
+  /** The character's height in this mesh's units (default: the rig's own bind-pose height). */
+  height?: number;
+}
+
+/**
+ * Measures deformers against a rig over a fixed set of frames (skin matrices J × 16 each). Build it
+ * once per mesh and clip set: it computes the reference DQS of every frame once, then
+ * `measure(deformer)` for each method.
+ */
+export class FidelityProbe {
+  readonly height: number;
+  readonly vertexCount: number;
+  private readonly reference: Float64Array[] = [];
+  private readonly rigid: Int32Array; // per rig vertex: its joint when bound ≥ 0.999, else -1
+  private readonly rigidCount: number;
+  private readonly dominant: Int32Array; // per rig vertex: the joint of largest weight
+  private readonly rotations: Float64Array[] = []; // per frame: J × 9 rotations
+
+  constructor(readonly input: RigInput, readonly frames: readonly Float32Array[], options: FidelityOptions = {}) {
+    const n = Math.floor(input.positions.length / 3);
+    this.vertexCount = n;
+    this.height = options.height ?? boundsHeight(input.positions);
+    this.rigid = new Int32Array(n).fill(-1);
+    this.dominant = new Int32Array(n);
+    let rigidCount = 0;
+    for (let v = 0; v < n; v++) {
+      let sum = 0, best = 0;
+      for (let i = 0; i < 4; i++) sum += Math.max(0, input.weights[4 * v + i]);
+      for (let i = 1; i < 4; i++) if (input.weights[4 * v + i] > input.weights[4 * v + best]) best = i;
+      this.dominant[v] = input.joints[4 * v + best];
+      let bound = -1;
+      for (let i = 0; i < 4; i++) {
+        const w = input.weights[4 * v + i] / sum;
+        if (w >= 0.999) bound = input.joints[4 * v + i];
+      }
+      // The same joint listed twice would sum to 1 with neither entry ≥ 0.999: merge.
+      if (bound < 0) {
+        const j0 = this.dominant[v];
+        let w = 0;
+        for (let i = 0; i < 4; i++) if (input.joints[4 * v + i] === j0) w += Math.max(0, input.weights[4 * v + i]) / sum;
+        if (w >= 0.999) bound = j0;
+      }
+      this.rigid[v] = bound;
+      if (bound >= 0) rigidCount++;
+    }
+    this.rigidCount = rigidCount;
+    const J = input.parents.length;
+    for (const skin of frames) {
+      const ref = new Float64Array(3 * n);
+      referenceDqs(input, skin, ref);
+      this.reference.push(ref);
+      const rot = new Float64Array(9 * J);
+      for (let j = 0; j < J; j++) rot.set(splitSkinMatrix(skin, 16 * j).r, 9 * j);
+      this.rotations.push(rot);
+    }
+  }
+
+  /** Deforms `deformer` through every frame and measures it. */
+  measure(deformer: Deformer): Fidelity {
+    const source = deformer.sourceVertex;
+    const nOut = deformer.vertexCount;
+    const indices = deformer.indices;
+    const P0 = this.input.positions;
+    // Rest geometry of the output mesh and the joint that carries each output vertex.
+    deformer.deform(identitySkin(deformer.jointCount));
+    const rest = Float64Array.from(deformer.positions);
+    const jointOf = new Int32Array(nOut).fill(-1);
+    if (source) {
+      for (let o = 0; o < nOut; o++) {
+        const v = source[o];
+        jointOf[o] = this.dominant[v];
+        for (let c = 0; c < 3; c++) rest[3 * o + c] = P0[3 * v + c];
+      }
+    } else {
+      const parts = (deformer as unknown as { parts?: { joint: number; firstVertex: number; vertexCount: number }[] }).parts;
+      if (parts) for (const p of parts) jointOf.fill(p.joint, p.firstVertex, p.firstVertex + p.vertexCount);
+    }
+    const pairs = coincidentPairs(rest);
+    const triCount = Math.floor(indices.length / 3);
+    // Per triangle: the joint of largest summed weight over its corners (or of its first corner),
+    // its rest normal, its rest edge lengths.
+    const triJoint = new Int32Array(triCount).fill(-1);
+    const restNormal = new Float64Array(3 * triCount);
+    const restEdge = new Float64Array(3 * triCount);
+    for (let t = 0; t < triCount; t++) {
+      const a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+      triJoint[t] = source ? triangleJoint(this.input, source[a], source[b], source[c]) : jointOf[a];
+      faceNormal(rest, a, b, c, restNormal, 3 * t);
+      restEdge[3 * t] = dist(rest, a, b); restEdge[3 * t + 1] = dist(rest, b, c); restEdge[3 * t + 2] = dist(rest, c, a);
+    }
+    const scale = 100 / this.height;
+    let rigidError = 0, flipped = 0, stretched = 0, normalOff = 0, nonFinite = 0, gap = 0;
+    const dqsDistances = source ? new Float32Array(nOut * this.frames.length) : null;
+    const np = new Float64Array(3);
+    this.frames.forEach((skin, f) => {
+      deformer.deform(skin);
+      const pos = deformer.positions, nrm = deformer.normals;
+      nonFinite += countNonFinite(pos, nrm);
+      gap = Math.max(gap, seamGap(pos, pairs));
+      for (let o = 0; o < nOut; o++) {
+        const l = Math.hypot(nrm[3 * o], nrm[3 * o + 1], nrm[3 * o + 2]);
+        const off = Math.abs(l - 1);
+        if (!(off <= normalOff)) normalOff = Number.isNaN(off) ? Infinity : off;
+      }
+      if (source && dqsDistances) {
+        const ref = this.reference[f];
+        for (let o = 0; o < nOut; o++) {
+          const v = source[o];
+          const d = Math.hypot(pos[3 * o] - ref[3 * v], pos[3 * o + 1] - ref[3 * v + 1], pos[3 * o + 2] - ref[3 * v + 2]);
+          dqsDistances[f * nOut + o] = Number.isNaN(d) ? Infinity : d;
+          const j = this.rigid[v];
+          if (j >= 0) {
+            const m = 16 * j;
+            const x = P0[3 * v], y = P0[3 * v + 1], z = P0[3 * v + 2];
+            const ex = skin[m] * x + skin[m + 4] * y + skin[m + 8] * z + skin[m + 12];
+            const ey = skin[m + 1] * x + skin[m + 5] * y + skin[m + 9] * z + skin[m + 13];
+            const ez = skin[m + 2] * x + skin[m + 6] * y + skin[m + 10] * z + skin[m + 14];
+            const e = Math.hypot(pos[3 * o] - ex, pos[3 * o + 1] - ey, pos[3 * o + 2] - ez);
+            if (!(e <= rigidError)) rigidError = Number.isNaN(e) ? Infinity : e;
+          }
+        }
+      }
+      const rot = this.rotations[f];
+      for (let t = 0; t < triCount; t++) {
+        const a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+        const j = triJoint[t];
+        const rx = restNormal[3 * t], ry = restNormal[3 * t + 1], rz = restNormal[3 * t + 2];
+        if (j >= 0 && (rx !== 0 || ry !== 0 || rz !== 0)) {
+          faceNormal(pos, a, b, c, np, 0);
+          const r = 9 * j;
+          const cx = rot[r] * rx + rot[r + 3] * ry + rot[r + 6] * rz;
+          const cy = rot[r + 1] * rx + rot[r + 4] * ry + rot[r + 7] * rz;
+          const cz = rot[r + 2] * rx + rot[r + 5] * ry + rot[r + 8] * rz;
+          if (cx * np[0] + cy * np[1] + cz * np[2] < 0) flipped++;
+        }
+        // Stretch is relative to the triangle's own scale change: compare with the rest edge carried by S_j's scale.
+        const k = j >= 0 ? jointScale(skin, j) : 1;
+        if (dist(pos, a, b) > 2 * k * restEdge[3 * t] || dist(pos, b, c) > 2 * k * restEdge[3 * t + 1] ||
+            dist(pos, c, a) > 2 * k * restEdge[3 * t + 2]) stretched++;
+      }
+    });
+    return {
+      frames: this.frames.length,
+      rigidError: source && this.rigidCount ? rigidError * scale : null,
+      rigidVertices: this.rigidCount,
+      dqsP95: dqsDistances ? percentile(dqsDistances, 95) * scale : null,
+      dqsMax: dqsDistances ? maxOf(dqsDistances) * scale : null,
+      flipped, stretched, normalOffUnit: normalOff, nonFinite, seamGap: gap * scale,
+    };
+  }
+}
+
+/** Largest extent of the bounding box of xyz positions. */
+export function boundsHeight(positions: ArrayLike<number>): number {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i + 2 < positions.length; i += 3)
+    for (let c = 0; c < 3; c++) { lo[c] = Math.min(lo[c], positions[i + c]); hi[c] = Math.max(hi[c], positions[i + c]); }
+  return Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
+function triangleJoint(input: RigInput, a: number, b: number, c: number): number {
+  const sum = new Map<number, number>();
+  for (const v of [a, b, c])
+    for (let i = 0; i < 4; i++) {
+      const w = input.weights[4 * v + i];
+      if (w > 0) sum.set(input.joints[4 * v + i], (sum.get(input.joints[4 * v + i]) ?? 0) + w);
+    }
+  let best = -1, bw = -Infinity;
+  for (const [j, w] of sum) if (w > bw || (w === bw && j < best)) { bw = w; best = j; }
+  return best;
+}
+
+function faceNormal(p: ArrayLike<number>, a: number, b: number, c: number, out: Float64Array, o: number): void {
+  const ux = p[3 * b] - p[3 * a], uy = p[3 * b + 1] - p[3 * a + 1], uz = p[3 * b + 2] - p[3 * a + 2];
+  const vx = p[3 * c] - p[3 * a], vy = p[3 * c + 1] - p[3 * a + 1], vz = p[3 * c + 2] - p[3 * a + 2];
+  out[o] = uy * vz - uz * vy; out[o + 1] = uz * vx - ux * vz; out[o + 2] = ux * vy - uy * vx;
+}
+
+function dist(p: ArrayLike<number>, a: number, b: number): number {
+  return Math.hypot(p[3 * a] - p[3 * b], p[3 * a + 1] - p[3 * b + 1], p[3 * a + 2] - p[3 * b + 2]);
+}
+
+/** Mean column length of joint j's skin matrix: its scale (1 for a rigid motion). */
+function jointScale(skin: ArrayLike<number>, j: number): number {
+  const m = 16 * j;
+  return (Math.hypot(skin[m], skin[m + 1], skin[m + 2]) + Math.hypot(skin[m + 4], skin[m + 5], skin[m + 6]) +
+    Math.hypot(skin[m + 8], skin[m + 9], skin[m + 10])) / 3;
+}
+
+function maxOf(a: ArrayLike<number>): number {
+  let m = 0;
+  for (let i = 0; i < a.length; i++) if (!(a[i] <= m)) m = Number.isNaN(a[i]) ? Infinity : a[i];
+  return m;
+}
