@@ -85,7 +85,12 @@ describe('model settings', () => {
     const input = makeTube().input;
     (input.inverseBindMatrices as Float32Array).set(new THREE.Matrix4().elements, 16);
     const flat = gcs.createRig(input);
-    expectGcsError(() => flat.buildGcs(), 'ZERO_LENGTH_BONE', /zero-length bone/);
+    // The paper's rule needs bone axes; the weights criterion (the default) does not.
+    expectGcsError(() => flat.buildGcs({ criterion: 'axial' }), 'ZERO_LENGTH_BONE', /zero-length bone/);
+    expectGcsError(() => flat.buildGcs({ criterion: 'y' }), 'ZERO_LENGTH_BONE', /zero-length bone/);
+    const weights = flat.buildGcs();
+    expect(weights.sectionCount).toBeGreaterThan(0);
+    weights.dispose();
     flat.dispose();
   });
 

@@ -250,3 +250,108 @@ describe('reference deformers against hand-computed values', () => {
     rig.dispose();
   });
 });
+
+// The weights criterion (design.md §2a), the default: analytic cases that fail if it were wrong.
+describe('GCS weights criterion (default)', () => {
+  const bend = (tube: ReturnType<typeof makeTube>, deg: number) => rotationAbout(tube.joint, Z, (deg * Math.PI) / 180);
+  /** Largest distance between two deformers' outputs, matched through their source vertices. */
+  const distance = (a: { positions: Float32Array; sourceVertex: Uint32Array | null }, b: { positions: Float32Array; sourceVertex: Uint32Array | null }) => {
+    const sa = a.sourceVertex!, sb = b.sourceVertex!;
+    const inB = new Uint32Array(sb.length);
+    sb.forEach((v, o) => { inB[v] = o; });
+    let d = 0;
+    sa.forEach((v, o) => {
+      const q = inB[v];
+      d = Math.max(d, Math.hypot(a.positions[3 * o] - b.positions[3 * q], a.positions[3 * o + 1] - b.positions[3 * q + 1], a.positions[3 * o + 2] - b.positions[3 * q + 2]));
+    });
+    return d;
+  };
+
+  test('plates bound 100 % to their bone stay exactly rigid (the paper\'s rule bends them)', () => {
+    const tube = makeTube({ rings: 21 });
+    const w = tube.input.weights as Float32Array, j = tube.input.joints as Uint32Array;
+    for (let v = 0; v < tube.along.length; v++) {
+      j[4 * v] = tube.along[v] <= 1 ? 0 : 1;
+      w[4 * v] = 1; w[4 * v + 1] = 0;
+    }
+    const rig = gcs.createRig(tube.input);
+    const m = bend(tube, 70);
+    const skin = tubeSkin(m);
+    const worst = (d: ReturnType<typeof rig.buildGcs>) => {
+      d.deform(skin);
+      let e = 0;
+      d.sourceVertex!.forEach((v, o) => {
+        const x = new THREE.Vector3().fromArray(tube.input.positions as Float32Array, 3 * v);
+        if (j[4 * v] === 1) x.applyMatrix4(m);
+        e = Math.max(e, x.distanceTo(new THREE.Vector3().fromArray(d.positions, 3 * o)));
+      });
+      return e;
+    };
+    const weights = rig.buildGcs();
+    expect(weights.sections().every((s) => s.rigid)).toBe(true);
+    expect(worst(weights)).toBeLessThan(1e-6);
+    expect(worst(rig.buildGcs({ criterion: 'axial' }))).toBeGreaterThan(0.05); // 2.5 % of the tube's height
+    rig.dispose();
+  });
+
+  test('a coarse tube whose every vertex touches the joint bends like DQS (the paper\'s SGS rule swallows it)', () => {
+    const tube = makeTube({ rings: 5, band: 1 });
+    const rig = gcs.createRig(tube.input);
+    const skin = tubeSkin(bend(tube, 100));
+    const dqs = rig.buildDqs();
+    dqs.deform(skin);
+    const weights = rig.buildGcs();
+    weights.deform(skin);
+    // 5 rings, weights 0, 0.16, 0.5, 0.84, 1 on joint 1: one section per ring.
+    expect(weights.sectionCount).toBe(5);
+    expect(distance(weights, dqs)).toBeLessThan(1e-5);
+    const paper = rig.buildGcs({ criterion: 'axial' });
+    paper.deform(skin);
+    expect(distance(paper, dqs)).toBeGreaterThan(0.05);
+    rig.dispose();
+  });
+
+  test('the even-split section is one transform for both parts: half the joint\'s rotation about its centre', () => {
+    const tube = makeTube(); // ring 20 sits on the joint with weights exactly 0.5 / 0.5
+    const rig = gcs.createRig(tube.input);
+    const d = rig.buildGcs({ sections: 6 });
+    d.deform(tubeSkin(bend(tube, 90)));
+    const sections = d.sections();
+    const shared = sections.filter((s) => s.shared);
+    expect(shared.length).toBe(1);
+    expect(shared[0].alpha).toBeCloseTo(0.5, 6);
+    expect(shared[0].beta).toBeCloseTo(0.5, 6);
+    expect(new Set([shared[0].part, shared[0].distal])).toEqual(new Set([0, 1]));
+    const i = sections.indexOf(shared[0]);
+    expectMatrixClose(d.sectionMatrices().subarray(16 * i, 16 * i + 16), rotationAbout(tube.joint, Z, Math.PI / 4));
+    // The rigid cores are exactly S_0 and S_1.
+    const matrices = d.sectionMatrices();
+    for (const [k, s] of sections.entries())
+      if (s.rigid) expectMatrixClose(matrices.subarray(16 * k, 16 * k + 16), s.part === 0 ? new THREE.Matrix4() : bend(tube, 90), 1e-6);
+    rig.dispose();
+  });
+
+  test('the section count is the level of detail: more sections, closer to DQS; smooth mode closer still', () => {
+    const tube = makeTube({ band: 0.4 });
+    const rig = gcs.createRig(tube.input);
+    const skin = tubeSkin(bend(tube, 120));
+    const dqs = rig.buildDqs();
+    dqs.deform(skin);
+    const error = (o: { sections: number; smooth?: boolean }) => {
+      const d = rig.buildGcs(o);
+      d.deform(skin);
+      const e = distance(d, dqs);
+      const n = d.sectionCount;
+      d.dispose();
+      return { e, n };
+    };
+    const coarse = error({ sections: 3 }), mid = error({ sections: 6 }), fine = error({ sections: 20 });
+    const smooth = error({ sections: 6, smooth: true });
+    expect(coarse.n).toBeLessThan(mid.n);
+    expect(mid.n).toBeLessThan(fine.n);
+    expect(mid.e).toBeLessThan(coarse.e);
+    expect(fine.e).toBeLessThan(mid.e);
+    expect(smooth.e).toBeLessThan(mid.e / 2);
+    rig.dispose();
+  });
+});
