@@ -223,10 +223,17 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
   std::vector<WeightKey> keys;
   std::vector<uint32_t> keyOf(G);
+  // Each group's cleaned weights, read once (4 joints, 4 weights, a count).
+  std::vector<glm::uvec4> cleanJoints(G);
+  std::vector<glm::vec4> cleanWeightsOf(G);
+  std::vector<uint8_t> cleanCount(G);
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t joint[4];
-    float weight[4];
+    uint32_t joint[4] = {0, 0, 0, 0};
+    float weight[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    cleanJoints[g] = glm::uvec4(joint[0], joint[1], joint[2], joint[3]);
+    cleanWeightsOf[g] = glm::vec4(weight[0], weight[1], weight[2], weight[3]);
+    cleanCount[g] = uint8_t(n);
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
@@ -254,9 +261,9 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   const uint32_t K = uint32_t(keys.size());
   std::vector<double> sums(size_t(K) * 4, 0.0);
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t joint[4];
-    float weight[4];
-    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    const glm::uvec4& joint = cleanJoints[g];
+    const glm::vec4& weight = cleanWeightsOf[g];
+    const uint32_t n = cleanCount[g];
     const WeightKey& key = keys[keyOf[g]];
     for (uint32_t i = 0; i < n; ++i) {
       uint32_t s = key.slot(joint[i]);
@@ -320,9 +327,9 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   for (uint32_t g = 0; g < G; ++g) {
     const uint32_t own = sectionOfGroup[g];
     otherOfGroup[g] = own;
-    uint32_t joint[4];
-    float weight[4];
-    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    const glm::uvec4& joint = cleanJoints[g];
+    const glm::vec4& weight = cleanWeightsOf[g];
+    const uint32_t n = cleanCount[g];
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
