@@ -1,8 +1,14 @@
-// npm run metrics [-- --json] [--markdown] [--no-models] [--vertices N]
-// Fidelity per method (design.md §7) on the default human and on the characters in
-// ../shared/models (skipped with a reason when absent): rest error, classic detail loss, joint
-// thickness under 90°/135° knee and elbow bends, thickness under 90°/180° forearm twist, volume
-// ratio under bends (closed meshes), seam gap, non-finite values, flipped triangles.
+// npm run metrics [-- --json] [--markdown] [--no-models] [--vertices N] [--sections N] [--frames N]
+// Fidelity per method (design.md §7) on the default human and on every character in
+// ../shared/models (skipped with a reason when absent):
+// - FidelityProbe (web/lib/measure.ts) over every sampled frame of every clip, on every skinned
+//   mesh of the character, in % of the character's height (gltf-node characterHeight): rigid
+//   error, distance from an independent DQS (p95, max), flipped triangles beside LBS's, stretched
+//   triangles, normals off unit length, non-finite values, seam gap;
+// - where the skeleton has human bone names: joint thickness under 90°/135° knee and elbow bends,
+//   forearm width under 90°/180° twist, volume ratio under bends (closed meshes), the rest error
+//   and flipped triangles over those poses, and the classic model's resampling loss.
+// --markdown prints one fidelity table (rows: character × method) for the README, nothing else.
 import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -10,52 +16,108 @@ import * as THREE from 'three';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { loadGltfFile, rootOf, sampleClip, skinMatricesOf } from '../dist/cli/gltf-node.js';
-import { coincidentPairs, countNonFinite, errorInfo, identitySkin, restError, restOfOutput, seamGap } from '../dist/cli/measure.js';
+import { characterHeight, loadGltfFile, rootOf, sampleClip, skinMatricesOf } from '../dist/cli/gltf-node.js';
+import { FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, restOfOutput } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import {
-  bindCentres, dominantJoints, findBone, rayThickness, flippedTriangles, isClosed, minWidth, outputJoints, planeSection, posedCentre,
+  bindCentres, dominantJoints, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
   rotateBoneWorld, signedVolume, worldPos,
 } from './bench/fidelity.mjs';
 
 let args;
 try {
+  const positive = (s, flag) => {
+    const n = Number(s);
+    if (!Number.isInteger(n) || n < 1) throw new Error(`${flag} must be a whole number ≥ 1; got '${s}'`);
+    return n;
+  };
   args = parseArgs(process.argv.slice(2), {
     json: { type: 'flag', default: false },
     markdown: { type: 'flag', default: false },
     noModels: { type: 'flag', default: false },
-    vertices: { parse: Number, default: undefined },
-    sections: { parse: Number, default: 6 },
+    vertices: { parse: positive, default: undefined },
+    sections: { parse: positive, default: 6 },
+    frames: { parse: positive, default: 60 },
   });
 } catch (e) {
   console.error(`metrics: ${e.message}`);
   process.exit(2);
 }
 if (args.help) {
-  console.log('usage: npm run metrics -- [--json] [--markdown] [--no-models] [--vertices N] [--sections N]');
+  console.log('usage: npm run metrics -- [--json] [--markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
   process.exit(0);
 }
-const log = args.json ? (...a) => console.error(...a) : (...a) => console.log(...a);
-const fmtTable = args.markdown ? markdownTable : table;
-const sections = args.sections;
-const METHODS = [
-  { key: 'gcs', label: 'GCS', build: (rig) => rig.buildGcs({ sections }) },
-  { key: 'gcs-smooth', label: 'GCS smooth', build: (rig) => rig.buildGcs({ sections, smooth: true }) },
-  { key: 'gcs-twist', label: 'GCS twist', build: (rig) => rig.buildGcs({ sections, twistSpread: true }) },
-  { key: 'classic', label: 'classic', build: (rig) => rig.buildClassic({}) },
-  { key: 'lbs', label: 'LBS', build: (rig) => rig.buildLbs() },
-  { key: 'dqs', label: 'DQS', build: (rig) => rig.buildDqs() },
-];
+// Progress on stderr whenever stdout carries a document (JSON or the markdown table).
+const log = args.json || args.markdown ? (...a) => console.error(...a) : (...a) => console.log(...a);
+const { sections, frames: framesPerClip } = args;
 const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../shared/models');
 const deg = Math.PI / 180;
 
 const gcs = await initGcsSkin();
 
-/** Fidelity of every method on one skinned mesh. */
-function measure(name, mesh, clips) {
+/** Runs `measure(deformer)` for every method on a rig; { error } where the build or a frame fails. */
+function eachMethod(rig, measure) {
+  const out = {};
+  for (const method of METHODS) {
+    let d;
+    try {
+      d = buildMethod(rig, method, { sections });
+      out[method] = measure(d, method);
+    } catch (e) {
+      out[method] = { error: errorInfo(e) };
+    } finally {
+      d?.dispose();
+    }
+  }
+  return out;
+}
+
+/**
+ * Fidelity of a character (all its skinned meshes) per method: FidelityProbe per mesh over every
+ * clip's frames, then summed (counts) or maxed (distances) over the meshes. With several meshes
+ * the p95 is the largest mesh p95: an upper bound of the p95 over all their vertices.
+ */
+function fidelityOf(meshes, clips, heights) {
+  const perMesh = meshes.map((mesh, i) => {
+    const input = rigInputFromSkinnedMesh(mesh);
+    const rig = gcs.createRig(input);
+    try {
+      const sampled = clips.flatMap((clip) => sampleClip(mesh, clip, framesPerClip));
+      const frames = sampled.length ? sampled : [identitySkin(rig.jointCount)];
+      const probe = new FidelityProbe(input, frames, { height: heights.meshUnits[i] > 0 ? heights.meshUnits[i] : rig.height });
+      return { name: mesh.name, vertices: rig.vertexCount, triangles: input.indices.length / 3, frames: frames.length,
+        methods: eachMethod(rig, (d) => probe.measure(d)) };
+    } finally {
+      rig.dispose();
+    }
+  });
+  const maxOrNull = (xs) => (xs.every((x) => x === null) ? null : Math.max(...xs.filter((x) => x !== null)));
+  const sum = (xs) => xs.reduce((a, b) => a + b, 0);
+  const methods = {};
+  for (const method of METHODS) {
+    const fs = perMesh.map((m) => m.methods[method]);
+    const failed = fs.find((f) => f.error);
+    if (failed) { methods[method] = { error: failed.error }; continue; }
+    methods[method] = {
+      frames: fs[0].frames, rigidError: maxOrNull(fs.map((f) => f.rigidError)), rigidVertices: sum(fs.map((f) => f.rigidVertices)),
+      dqsP95: maxOrNull(fs.map((f) => f.dqsP95)), dqsMax: maxOrNull(fs.map((f) => f.dqsMax)),
+      flipped: sum(fs.map((f) => f.flipped)), stretched: sum(fs.map((f) => f.stretched)),
+      normalOffUnit: Math.max(...fs.map((f) => f.normalOffUnit)), nonFinite: sum(fs.map((f) => f.nonFinite)),
+      seamGap: Math.max(...fs.map((f) => f.seamGap)),
+    };
+  }
+  return { meshes: perMesh, methods };
+}
+
+/**
+ * The human-specific measures on one mesh whose bones have human names: joint thickness under
+ * bends, forearm width under twist, volume ratio, plus the rest error (distance from the rig's
+ * positions at the bind pose) and flipped triangles over those poses (FidelityProbe), and the
+ * classic model's resampling loss. `height` is the character's height in this mesh's units.
+ */
+function shapeOf(mesh, height) {
   const input = rigInputFromSkinnedMesh(mesh);
   const rig = gcs.createRig(input);
-  const height = rig.height;
   const bones = mesh.skeleton.bones;
   const root = rootOf(mesh);
   const J = bones.length;
@@ -120,26 +182,18 @@ function measure(name, mesh, clips) {
     }
   }
   resetPose();
-  const clipFrames = [];
-  for (const clip of clips) clipFrames.push(...sampleClip(mesh, clip, 20));
-  resetPose();
+  const bindProbe = new FidelityProbe(input, [identitySkin(J)], { height });
+  const poseProbe = new FidelityProbe(input, Object.values(poses), { height });
 
-  const results = {};
-  for (const m of METHODS) {
-    let d;
-    try {
-      d = m.build(rig);
-    } catch (e) {
-      results[m.key] = { error: errorInfo(e) };
-      continue;
-    }
+  const methods = eachMethod(rig, (d, method) => {
     const r = {};
     const indices = d.indices;
     const vj = outputJoints(d, dominant);
     const restOut = restOfOutput(d, input.positions);
-    const pairs = coincidentPairs(restOut);
-    r.restError = restError(d, input.positions);
-    if (m.key === 'classic') r.detailLoss = d.detailLoss;
+    // At the bind pose the reference DQS is the rig's own positions: its distance is the rest error.
+    r.restError = bindProbe.measure(d).dqsMax;
+    r.flippedPoses = poseProbe.measure(d).flipped;
+    if (method === 'classic') r.detailLoss = d.detailLoss;
     const deformed = (skin) => { d.deform(skin); return Float32Array.from(d.positions); };
     const ref = deformed(poses.reference);
     const closed = isClosed(restOut, indices);
@@ -186,41 +240,38 @@ function measure(name, mesh, clips) {
     }
     if (closed) for (const a of [90, 135]) if (poses[`bend${a}`]) r[`volume${a}`] = signedVolume(deformed(poses[`bend${a}`]), indices) / refVolume;
     r.closed = closed;
-    // Seam gap, non-finite values, flipped triangles over every pose and clip frame.
-    let gap = 0, bad = 0, flipped = 0, flippedClips = 0;
-    const posed = Object.values(poses);
-    const all = [...posed, ...clipFrames];
-    all.forEach((skin, i) => {
-      d.deform(skin);
-      bad += countNonFinite(d.positions, d.normals);
-      gap = Math.max(gap, seamGap(d.positions, pairs));
-      const f = flippedTriangles(restOut, d.positions, indices, vj, skin);
-      if (i < posed.length) flipped = Math.max(flipped, f);
-      else flippedClips = Math.max(flippedClips, f);
-    });
-    r.seamGap = gap / height;
-    r.nonFinite = bad;
-    r.flipped = flipped;
-    r.flippedClips = flippedClips;
     r.triangles = indices.length / 3;
-    r.poses = all.length;
-    results[m.key] = r;
-    d.dispose();
-  }
+    return r;
+  });
   rig.dispose();
-  return { name, vertices: input.positions.length / 3, triangles: input.indices.length / 3, joints: J, height, notes, poses: Object.keys(poses), clipFrames: clipFrames.length, methods: results };
+  return { mesh: mesh.name, poses: Object.keys(poses), notes, methods };
 }
 
-// ---------------------------------------------------------------- models
+/** Everything measured on one character: its skinned meshes (the human measures on the largest). */
+function measureCharacter(name, meshes, clips) {
+  const heights = characterHeight(meshes);
+  const largest = meshes.reduce((a, b) => (b.geometry.getAttribute('position').count > a.geometry.getAttribute('position').count ? b : a));
+  const shape = shapeOf(largest, heights.meshUnits[meshes.indexOf(largest)]);
+  const fidelity = fidelityOf(meshes, clips, heights);
+  const notes = [...shape.notes];
+  if (meshes.length > 1) notes.push(`${meshes.length} skinned meshes: fidelity summed/maxed over all; the bends, twist and volume on the largest ('${largest.name}')`);
+  if (!clips.length) notes.push('no animation clip: fidelity over the bind pose only');
+  return {
+    name, height: heights.world, meshes: fidelity.meshes.map(({ methods, ...m }) => m), clips: clips.map((c) => c.name),
+    frames: fidelity.meshes[0].frames, notes, fidelity: fidelity.methods, shape,
+  };
+}
+
+// ---------------------------------------------------------------- characters
 const reports = [];
 log('metrics: default human…');
 const human = createHuman(args.vertices ? { vertices: args.vertices } : {});
-reports.push(measure('default human', human.mesh, human.clips));
+reports.push(measureCharacter('default human', [human.mesh], human.clips));
 if (args.noModels) log('metrics: shared models skipped (--no-models)');
 else if (!existsSync(MODELS_DIR)) log(`metrics: shared models skipped: ${MODELS_DIR} is absent`);
 else {
-  const files = readdirSync(MODELS_DIR).filter((f) => /\.(glb|gltf)$/i.test(f)).sort();
-  if (!files.length) log(`metrics: shared models skipped: no .glb/.gltf in ${MODELS_DIR}`);
+  const files = readdirSync(MODELS_DIR).filter((f) => /\.glb$/i.test(f)).sort();
+  if (!files.length) log(`metrics: shared models skipped: no .glb in ${MODELS_DIR}`);
   for (const f of files) {
     log(`metrics: ${f}…`);
     let model;
@@ -231,37 +282,67 @@ else {
       continue;
     }
     if (!model.skinnedMeshes.length) { log(`metrics: ${f} skipped: no skinned mesh`); continue; }
-    // The largest skinned mesh (a character may carry small extra skinned meshes: visor, eyes).
-    const mesh = model.skinnedMeshes.reduce((a, b) => (b.geometry.getAttribute('position').count > a.geometry.getAttribute('position').count ? b : a));
-    const rep = measure(`${f} (${mesh.name || 'mesh'})`, mesh, model.clips);
-    if (model.skinnedMeshes.length > 1) rep.notes.push(`${model.skinnedMeshes.length} skinned meshes: measured the largest`);
-    reports.push(rep);
+    reports.push(measureCharacter(f, model.skinnedMeshes, model.clips));
   }
 }
 
 if (args.json) {
-  console.log(JSON.stringify({ sections, models: reports }, null, 2));
+  console.log(JSON.stringify({ sections, framesPerClip, methods: METHODS, characters: reports }, null, 2));
   process.exit(0);
 }
+
+// ---------------------------------------------------------------- tables
+/** One row per method of a character's fidelity; `first` labels the character on its first row. */
+function fidelityRows(rep, first) {
+  const lbs = rep.fidelity.lbs;
+  return METHODS.map((method, i) => {
+    const f = rep.fidelity[method];
+    const head = [...first(i), METHOD_LABELS[method]];
+    if (f.error) return [...head, 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a'];
+    const flipped = method === 'lbs' || lbs.error ? String(f.flipped) : `${f.flipped} (LBS ${lbs.flipped})`;
+    return [...head, f.rigidError === null ? 'resampled' : num(f.rigidError, 3), f.dqsP95 === null ? 'resampled' : num(f.dqsP95, 3),
+      f.dqsMax === null ? 'resampled' : num(f.dqsMax, 3), flipped, String(f.stretched), num(f.normalOffUnit, 3), String(f.nonFinite), num(f.seamGap, 3)];
+  });
+}
+const FIDELITY_HEADER = ['method', 'rigid error %', 'DQS p95 %', 'DQS max %', 'flipped', 'stretched', 'normal off unit', 'non-finite', 'seam gap %'];
+const describe = (rep) => `${rep.clips.length} clip${rep.clips.length === 1 ? '' : 's'} × ${framesPerClip} frames`;
+const failures = reports.flatMap((rep) => METHODS.filter((m) => rep.fidelity[m].error).map((m) => `${rep.name}, ${METHOD_LABELS[m]}: n/a — ${rep.fidelity[m].error.code}: ${rep.fidelity[m].error.message}`));
+
+if (args.markdown) {
+  const rows = [['character', ...FIDELITY_HEADER]];
+  for (const rep of reports) rows.push(...fidelityRows(rep, (i) => [i === 0 ? `${rep.name} (${describe(rep)})` : '']));
+  console.log(markdownTable(rows));
+  console.log(`\nEvery clip of each character sampled at ${framesPerClip} frames, GCS at ${sections} sections per part. ` +
+    'Distances in % of the character\'s height (bind-pose bounding box of all its skinned meshes, world units); counts summed over frames ' +
+    '(and meshes). Rigid error: vertices bound ≥ 0.999 to one joint against S_j·x. DQS: distance from a scale-aware ' +
+    'dual-quaternion skinning computed independently in JavaScript. Flipped: triangles whose normal turned against their rest ' +
+    'normal carried by their dominant joint, with LBS\'s count over the same frames. Stretched: an edge over twice its rest ' +
+    'length. "resampled": the classic model has no vertex of the original mesh.' +
+    (reports.some((r) => r.meshes.length > 1) ? ' Characters of several skinned meshes: the p95 is the largest over the meshes (an upper bound).' : ''));
+  for (const f of failures) console.log(`\n${f}`);
+  process.exit(0);
+}
+
 const ratio = (x) => (x === undefined ? 'n/a' : Number.isFinite(x) ? x.toFixed(2) : String(x));
 for (const rep of reports) {
-  console.log(`\n${rep.name}: ${rep.vertices} vertices, ${rep.triangles} triangles, ${rep.joints} joints, height ${rep.height.toFixed(3)}; ` +
-    `${rep.poses.length} poses + ${rep.clipFrames} clip frames`);
+  const meshes = rep.meshes.map((m) => `'${m.name}' ${m.vertices} vertices / ${m.triangles} triangles`).join(', ');
+  console.log(`\n${rep.name}: ${meshes}; height ${rep.height.toFixed(3)} world units; ${describe(rep)} = ${rep.frames} frames`);
   for (const n of rep.notes) console.log(`  note: ${n}`);
-  const cols = METHODS.map((m) => m.key);
-  const get = (key, f) => cols.map((c) => (rep.methods[c].error ? 'n/a' : f(rep.methods[c], key)));
-  const rows = [['metric', ...METHODS.map((m) => m.label)]];
-  rows.push(['rest error (% height)', ...get('restError', (r) => (r.restError === null ? 'resampled' : num((100 * r.restError) / rep.height, 4)))]);
-  rows.push(['resampling loss RMS / max (% height)', ...get('', (r) => (r.detailLoss ? `${num(r.detailLoss.rms, 2)} / ${num(r.detailLoss.max, 2)}` : '—'))]);
+  console.log(table([FIDELITY_HEADER, ...fidelityRows(rep, () => [])]));
+  const s = rep.shape;
+  const cols = METHODS;
+  const get = (f) => cols.map((c) => (s.methods[c].error ? 'n/a' : f(s.methods[c])));
+  const rows = [['measure (largest mesh)', ...cols.map((m) => METHOD_LABELS[m])]];
+  rows.push(['rest error (% height)', ...get((r) => (r.restError === null ? 'resampled' : num(r.restError, 3)))]);
+  rows.push(['resampling loss RMS / max (% own height)', ...get((r) => (r.detailLoss ? `${num(r.detailLoss.rms, 2)} / ${num(r.detailLoss.max, 2)}` : '—'))]);
   for (const [key, label] of [['knee90', 'knee 90° thickness (LBS ≈ 0.71)'], ['knee135', 'knee 135° thickness (LBS ≈ 0.38)'],
     ['elbow90', 'elbow 90° thickness'], ['elbow135', 'elbow 135° thickness'],
     ['twist90', 'forearm twist 90°: min width'], ['twist180', 'forearm twist 180°: min width'],
     ['volume90', 'volume, knee+elbow 90°'], ['volume135', 'volume, knee+elbow 135°']])
-    rows.push([label, ...get(key, (r) => (key.startsWith('volume') && !r.closed ? 'open mesh' : ratio(r[key])))]);
-  rows.push(['seam gap, max (% height)', ...get('seamGap', (r) => num(100 * r.seamGap, 4))]);
-  rows.push(['non-finite values', ...get('nonFinite', (r) => String(r.nonFinite))]);
-  rows.push(['flipped triangles, bend/twist poses (max)', ...get('flipped', (r) => `${r.flipped} / ${r.triangles}`)]);
-  rows.push(['flipped triangles, clip frames (max)', ...get('flippedClips', (r) => (rep.clipFrames ? `${r.flippedClips} / ${r.triangles}` : 'no clips'))]);
-  console.log(fmtTable(rows));
-  for (const m of METHODS) if (rep.methods[m.key].error) console.log(`  ${m.label}: n/a — ${rep.methods[m.key].error.code}: ${rep.methods[m.key].error.message}`);
+    rows.push([label, ...get((r) => (key.startsWith('volume') && !r.closed ? 'open mesh' : ratio(r[key])))]);
+  const lbsPoses = s.methods.lbs.error ? undefined : s.methods.lbs.flippedPoses;
+  rows.push([`flipped, ${s.poses.length === 1 ? 'reference pose' : `reference + ${s.poses.length - 1} bend/twist poses`}`, ...cols.map((c) => (s.methods[c].error ? 'n/a'
+    : c === 'lbs' || lbsPoses === undefined ? String(s.methods[c].flippedPoses) : `${s.methods[c].flippedPoses} (LBS ${lbsPoses})`))]);
+  console.log(`\n${table(rows)}`);
 }
+for (const f of failures) console.log(`  ${f}`);

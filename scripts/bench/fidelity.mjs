@@ -1,5 +1,6 @@
-// Geometry measurements for scripts/metrics.mjs: posing named bones, plane cross-sections of a
-// limb, thickness across a bent joint and under twist, closed-mesh volume, flipped triangles.
+// Geometry measurements for scripts/metrics.mjs (the human-specific ones; the fidelity figures are
+// FidelityProbe's, web/lib/measure.ts): posing named bones, plane cross-sections of a limb,
+// thickness across a bent joint and under twist, closed-mesh volume.
 import * as THREE from 'three';
 
 const norm = (name) => name.toLowerCase().replace(/[^a-z0-9]/g, '');
@@ -145,37 +146,6 @@ export function isClosed(positions, indices) {
     }
   for (const n of edges.values()) if (n !== 2) return false;
   return edges.size > 0;
-}
-
-function faceNormal(P, a, b, c, out) {
-  const ux = P[3 * b] - P[3 * a], uy = P[3 * b + 1] - P[3 * a + 1], uz = P[3 * b + 2] - P[3 * a + 2];
-  const vx = P[3 * c] - P[3 * a], vy = P[3 * c + 1] - P[3 * a + 1], vz = P[3 * c + 2] - P[3 * a + 2];
-  out[0] = uy * vz - uz * vy; out[1] = uz * vx - ux * vz; out[2] = ux * vy - uy * vx;
-  return out;
-}
-
-/**
- * Triangles whose deformed normal opposes their rest normal carried by the rotation of their
- * part's skin matrix (the part of the triangle's first vertex). Degenerate triangles are skipped.
- */
-export function flippedTriangles(rest, posed, indices, vertexJoint, skin) {
-  const nr = [0, 0, 0], np = [0, 0, 0];
-  let flipped = 0;
-  for (let t = 0; t < indices.length; t += 3) {
-    const a = indices[t], b = indices[t + 1], c = indices[t + 2];
-    faceNormal(rest, a, b, c, nr);
-    const lr = Math.hypot(nr[0], nr[1], nr[2]);
-    if (!(lr > 1e-12)) continue;
-    faceNormal(posed, a, b, c, np);
-    const j = vertexJoint[a];
-    if (j < 0) continue;
-    const o = 16 * j;
-    const rx = skin[o] * nr[0] + skin[o + 4] * nr[1] + skin[o + 8] * nr[2];
-    const ry = skin[o + 1] * nr[0] + skin[o + 5] * nr[1] + skin[o + 9] * nr[2];
-    const rz = skin[o + 2] * nr[0] + skin[o + 6] * nr[1] + skin[o + 10] * nr[2];
-    if (rx * np[0] + ry * np[1] + rz * np[2] < 0) flipped++;
-  }
-  return flipped;
 }
 
 /** Bind-pose joint centres (mesh space) from the inverse bind matrices. */

@@ -77,3 +77,69 @@ export function sampleClip(mesh: THREE.SkinnedMesh, clip: THREE.AnimationClip, f
   mixer.uncacheRoot(root);
   return out;
 }
+
+/** Uniform scale of an object's world matrix: the mean length of its three axis columns. */
+export function worldScaleOf(o: THREE.Object3D): number {
+  o.updateWorldMatrix(true, false);
+  const e = o.matrixWorld.elements;
+  return (Math.hypot(e[0], e[1], e[2]) + Math.hypot(e[4], e[5], e[6]) + Math.hypot(e[8], e[9], e[10])) / 3;
+}
+
+export interface CharacterHeight {
+  /** Largest extent of the world bounding box of every skinned mesh in its bind pose (world units). */
+  world: number;
+  /** Per mesh (the order given): its world scale, and the height in that mesh's own units (world / scale). */
+  scales: number[];
+  meshUnits: number[];
+}
+
+/**
+ * The character's height (design.md §7): the largest extent of the world bounding box of all
+ * `meshes` in their bind pose, then that length in each mesh's own units through the mesh's world
+ * scale (the deformers work in mesh space and their output is drawn through the mesh's world
+ * matrix, so a distance d in a deformer's output is d × scale in the world).
+ *
+ * The bind pose in world space is `matrixWorld · C · x`, C the one skin matrix (mesh space) that
+ * every joint has in the bind pose. Call it on a freshly loaded scene: when the bones' current pose
+ * gives every weighted joint the same skin matrix, that is C (the file's rest pose is its bind pose
+ * up to C); otherwise the rest pose is not a bind pose and C is taken as the mean scale of those
+ * skin matrices. Not simply `matrixWorld · x`: glTF ignores a skinned mesh node's own transform
+ * (three cancels it through bindMatrixInverse) and some files' inverse bind matrices leave out the
+ * armature's scale (Soldier.glb: positions in cm under a 0.01 armature), which C carries.
+ */
+export function characterHeight(meshes: readonly THREE.SkinnedMesh[]): CharacterHeight {
+  const box = new THREE.Box3();
+  const p = new THREE.Vector3();
+  const toWorld = new THREE.Matrix4();
+  for (const mesh of meshes) rootOf(mesh).updateMatrixWorld(true);
+  for (const mesh of meshes) {
+    toWorld.copy(mesh.matrixWorld).multiply(bindPoseMatrix(mesh));
+    const position = mesh.geometry.getAttribute('position');
+    for (let i = 0; i < position.count; i++) box.expandByPoint(p.fromBufferAttribute(position, i).applyMatrix4(toWorld));
+  }
+  const size = box.isEmpty() ? new THREE.Vector3() : box.getSize(new THREE.Vector3());
+  const world = Math.max(size.x, size.y, size.z);
+  const scales = meshes.map(worldScaleOf);
+  return { world, scales, meshUnits: scales.map((s) => world / s) };
+}
+
+/** C of characterHeight: the common skin matrix of the weighted joints, or their mean scale. */
+function bindPoseMatrix(mesh: THREE.SkinnedMesh): THREE.Matrix4 {
+  const J = mesh.skeleton.bones.length;
+  const skin = skinMatricesOf(mesh, new Float32Array(16 * J));
+  const joints = mesh.geometry.getAttribute('skinIndex'), weights = mesh.geometry.getAttribute('skinWeight');
+  const used = new Set<number>();
+  if (joints && weights)
+    for (let i = 0; i < joints.count; i++) for (let k = 0; k < 4; k++) if (weights.getComponent(i, k) > 0) used.add(joints.getComponent(i, k));
+  const list = [...used].filter((j) => j < J);
+  if (!list.length) return new THREE.Matrix4();
+  const first = 16 * list[0];
+  let size = 0, spread = 0;
+  for (let c = 0; c < 16; c++) size = Math.max(size, Math.abs(skin[first + c]));
+  for (const j of list) for (let c = 0; c < 16; c++) spread = Math.max(spread, Math.abs(skin[16 * j + c] - skin[first + c]));
+  if (spread <= 1e-4 * size) return new THREE.Matrix4().fromArray(skin, first);
+  let scale = 0;
+  for (const j of list) for (let c = 0; c < 3; c++) scale += Math.hypot(skin[16 * j + 4 * c], skin[16 * j + 4 * c + 1], skin[16 * j + 4 * c + 2]);
+  scale /= 3 * list.length;
+  return new THREE.Matrix4().makeScale(scale, scale, scale);
+}

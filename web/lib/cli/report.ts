@@ -1,37 +1,40 @@
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--json]`:
-// builds every deformer on any glTF skinned character and reports counts, build times, and per
-// clip and method the frame time, non-finite values, seam gap (and per method the rest error).
-// The JSON shape is documented in docs/report-json.md.
-import * as THREE from 'three';
+// builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
+// method, build ms, median ms per frame and the fidelity figures of design.md §7 (FidelityProbe
+// over every sampled frame of every clip, distances in % of the character's height), and per clip
+// the frame time. The JSON shape is documented in docs/report-json.md.
+import type * as THREE from 'three';
 import { GcsError } from '../errors.js';
-import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin } from '../index.js';
+import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../index.js';
 import { rigInputFromSkinnedMesh } from '../three.js';
-import { loadGltfFile, sampleClip } from './gltf-node.js';
+import { characterHeight, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
-  METHODS, buildMethod, coincidentPairs, countNonFinite, errorInfo, identitySkin, restError, restOfOutput, seamGap, timeFrames,
-  type MethodName,
-} from './measure.js';
+  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
+} from '../measure.js';
 
 export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--json]
-  Builds every deformer (gcs, gcs-smooth, classic, lbs, dqs) on each skinned mesh of the file and
-  prints counts, build ms, and per clip and method the median ms per frame, non-finite values,
-  seam gap and rest error.
+  Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
+  method, build ms, median ms per frame and its fidelity over every sampled frame of every clip:
+  rigid error, distance from an independent DQS (p95, max), flipped and stretched triangles,
+  normals off unit length, non-finite values, seam gap (distances in % of the character's height);
+  then per clip the frame times.
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
   --frames N      frames sampled per clip (default 60)
-  --json          machine-readable output (docs/report-json.md)`;
+  --json          machine-readable output (docs/report-json.md)
+  exit codes: 0 ok, 1 some method produced non-finite values, 2 bad arguments or unreadable file`;
 
 export interface ReportOptions {
   clip?: string;
   sections?: number;
   frames?: number;
-  /** Timing budget per clip and method (default 300 ms). */
+  /** Timing budget per clip and method, and for all frames per method (default 300 ms). */
   timeMs?: number;
 }
 
 export interface MethodReport {
   available: boolean;
-  /** Why the method could not be built (e.g. not in this binary yet); absent when available. */
+  /** Why the method could not be built or run (e.g. not in this binary yet); absent when it ran. */
   error?: { code: string; message: string };
   buildMs?: number;
   /** Output vertices and triangles (the classic model resamples, so they differ). */
@@ -39,11 +42,12 @@ export interface MethodReport {
   triangles?: number;
   /** Sections (GCS) or contours (classic); absent for LBS and DQS. */
   sections?: number;
-  /** Max distance of the bind-pose deform from the original vertices (model units); null if none maps back. */
-  restError?: number | null;
-  /** Seam gap in the bind pose. */
-  restSeamGap?: number;
-  /** Classic only: resampling detail loss, % of model height. */
+  /** ms per deform() over all the measured frames. */
+  medianMs?: number;
+  p95Ms?: number;
+  /** FidelityProbe over all the measured frames; distances in % of the mesh's `height`. */
+  fidelity?: Fidelity;
+  /** Classic only: resampling detail loss, % of the mesh's own height. */
   detailLoss?: { rms: number; max: number };
 }
 
@@ -51,10 +55,6 @@ export interface ClipMethodReport {
   medianMs: number;
   p95Ms: number;
   samples: number;
-  /** NaN or infinite values over every sampled frame (positions and normals). */
-  nonFinite: number;
-  /** Largest seam gap over the sampled frames (model units). */
-  seamGap: number;
   /** GCS only: mean share of adjusted sections over the frames. */
   adjustedShare?: number;
 }
@@ -62,6 +62,12 @@ export interface ClipMethodReport {
 export interface MeshReport {
   name: string;
   counts: { vertices: number; triangles: number; joints: number; parts: number | null; sections: number | null; height: number };
+  /** Mean column length of the mesh's world matrix. */
+  worldScale: number;
+  /** The character's height in this mesh's units: 100 % of every fidelity distance. */
+  height: number;
+  /** The frames every method was measured over: all sampled clip frames, or the bind pose when there is no clip. */
+  frames: { count: number; source: 'clips' | 'bind pose' };
   methods: Record<MethodName, MethodReport>;
   clips: { name: string; duration: number; frames: number; methods: Partial<Record<MethodName, ClipMethodReport>> }[];
 }
@@ -69,6 +75,8 @@ export interface MeshReport {
 export interface Report {
   file: string;
   options: { sections: number; frames: number; clip: string | null };
+  /** The character: all skinned meshes of the scene; height in world units (bind pose, bounding box: gltf-node characterHeight). */
+  character: { height: number; skinnedMeshes: number };
   meshes: MeshReport[];
 }
 
@@ -76,6 +84,7 @@ export interface Report {
 export class ReportError extends Error {}
 
 const round = (x: number, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)) : x);
+const roundOrNull = (x: number | null) => (x === null ? null : round(x));
 
 /** Builds the report of a file (throws ReportError for an unreadable or unskinned file). */
 export async function report(file: string, options: ReportOptions = {}, gcs?: GcsSkin): Promise<Report> {
@@ -95,13 +104,28 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
       throw new ReportError(`${file} has no clip named '${options.clip}' (clips: ${model.clips.map((c) => c.name).join(', ') || 'none'})`);
   }
   gcs ??= await initGcsSkin();
+  const height = characterHeight(model.skinnedMeshes);
   const meshes: MeshReport[] = [];
-  for (const mesh of model.skinnedMeshes) meshes.push(reportMesh(gcs, mesh, clips, sections, frames, options.timeMs ?? 300));
-  return { file, options: { sections, frames, clip: options.clip ?? null }, meshes };
+  model.skinnedMeshes.forEach((mesh, i) => {
+    meshes.push(reportMesh(gcs!, mesh, clips, { sections, frames, timeMs: options.timeMs ?? 300, height: height.meshUnits[i], worldScale: height.scales[i] }));
+  });
+  return {
+    file, options: { sections, frames, clip: options.clip ?? null },
+    character: { height: round(height.world, 6), skinnedMeshes: model.skinnedMeshes.length }, meshes,
+  };
 }
 
-function reportMesh(gcs: GcsSkin, mesh: THREE.SkinnedMesh, clips: THREE.AnimationClip[], sections: number, frames: number, timeMs: number): MeshReport {
-  let input;
+interface MeshSettings { sections: number; frames: number; timeMs: number; height: number; worldScale: number }
+
+function roundFidelity(f: Fidelity): Fidelity {
+  return {
+    ...f, rigidError: roundOrNull(f.rigidError), dqsP95: roundOrNull(f.dqsP95), dqsMax: roundOrNull(f.dqsMax),
+    normalOffUnit: round(f.normalOffUnit), seamGap: round(f.seamGap),
+  };
+}
+
+function reportMesh(gcs: GcsSkin, mesh: THREE.SkinnedMesh, clips: THREE.AnimationClip[], s: MeshSettings): MeshReport {
+  let input: RigInput;
   try {
     input = rigInputFromSkinnedMesh(mesh);
   } catch (e) {
@@ -113,104 +137,120 @@ function reportMesh(gcs: GcsSkin, mesh: THREE.SkinnedMesh, clips: THREE.Animatio
   } catch (e) {
     throw new ReportError(`mesh '${mesh.name}' is not a usable skin: ${(e as Error).message}`);
   }
-  const deformers = new Map<MethodName, Deformer>();
-  const pairs = new Map<MethodName, Uint32Array>();
+  // The character's height in this mesh's units; the mesh's own extent if the character has none.
+  const height = s.height > 0 && Number.isFinite(s.height) ? s.height : rig.height;
+  const clipFrames = clips.map((clip) => sampleClip(mesh, clip, s.frames));
+  const all = clipFrames.flat();
+  const frames = all.length ? all : [identitySkin(rig.jointCount)];
+  const probe = new FidelityProbe(input, frames, { height });
   const methods = {} as Record<MethodName, MethodReport>;
+  const clipMethods = clips.map(() => ({}) as Partial<Record<MethodName, ClipMethodReport>>);
+  let gcsCounts: { parts: number; sections: number } | null = null;
   try {
     for (const method of METHODS) {
-      let d: Deformer;
-      const t0 = performance.now();
+      let d: Deformer | undefined;
+      let r: MethodReport = { available: false };
       try {
-        d = buildMethod(rig, method, { sections });
+        const t0 = performance.now();
+        d = buildMethod(rig, method, { sections: s.sections });
+        r.buildMs = round(performance.now() - t0);
+        r.vertices = d.vertexCount;
+        r.triangles = d.indices.length / 3;
+        if (method !== 'lbs' && method !== 'dqs') r.sections = d.sectionCount;
+        if (method === 'gcs') gcsCounts = { parts: d.partCount, sections: d.sectionCount };
+        if (method === 'classic') {
+          const loss = (d as unknown as { detailLoss: { rms: number; max: number } }).detailLoss;
+          r.detailLoss = { rms: round(loss.rms), max: round(loss.max) };
+        }
+        const dd = d;
+        const t = timeFrames(frames.length, (f) => dd.deform(frames[f]), { minSamples: 100, minMs: s.timeMs / 2, maxMs: s.timeMs });
+        r.medianMs = round(t.medianMs);
+        r.p95Ms = round(t.p95Ms);
+        r.fidelity = roundFidelity(probe.measure(dd));
+        clipFrames.forEach((skins, c) => {
+          let adjusted = 0;
+          if (method === 'gcs') for (const skin of skins) { dd.deform(skin); adjusted += (dd as GcsDeformer).adjustedShare; }
+          const tc = timeFrames(skins.length, (f) => dd.deform(skins[f]), { minSamples: 100, minMs: s.timeMs / 2, maxMs: s.timeMs });
+          clipMethods[c][method] = { medianMs: round(tc.medianMs), p95Ms: round(tc.p95Ms), samples: tc.samples };
+          if (method === 'gcs') clipMethods[c][method]!.adjustedShare = round(adjusted / skins.length, 3);
+        });
+        r.available = true;
       } catch (e) {
         if (!(e instanceof GcsError)) throw e;
-        methods[method] = { available: false, error: errorInfo(e) };
-        continue;
-      }
-      const buildMs = performance.now() - t0;
-      deformers.set(method, d);
-      const rest = restOfOutput(d, input.positions);
-      const p = coincidentPairs(rest);
-      pairs.set(method, p);
-      d.deform(identitySkin(d.jointCount));
-      const r: MethodReport = {
-        available: true, buildMs: round(buildMs), vertices: d.vertexCount, triangles: d.indices.length / 3,
-        restError: restError(d, input.positions), restSeamGap: seamGap(d.positions, p),
-      };
-      if (method === 'gcs' || method === 'gcs-smooth' || method === 'classic') r.sections = d.sectionCount;
-      if (method === 'classic') {
-        const loss = (d as unknown as { detailLoss: { rms: number; max: number } }).detailLoss;
-        r.detailLoss = { rms: round(loss.rms), max: round(loss.max) };
+        r = { available: false, error: errorInfo(e), ...(r.buildMs !== undefined ? { buildMs: r.buildMs } : {}) };
+      } finally {
+        d?.dispose();
       }
       methods[method] = r;
-    }
-    const gcsD = deformers.get('gcs');
-    const clipReports: MeshReport['clips'] = [];
-    for (const clip of clips) {
-      const skins = sampleClip(mesh, clip, frames);
-      const per: Partial<Record<MethodName, ClipMethodReport>> = {};
-      for (const [method, d] of deformers) {
-        let nonFinite = 0, gap = 0, adjusted = 0;
-        const p = pairs.get(method)!;
-        for (const skin of skins) {
-          d.deform(skin);
-          nonFinite += countNonFinite(d.positions, d.normals);
-          gap = Math.max(gap, seamGap(d.positions, p));
-          if (method === 'gcs') adjusted += (d as GcsDeformer).adjustedShare;
-        }
-        const t = timeFrames(skins.length, (f) => d.deform(skins[f]), { minSamples: 100, minMs: timeMs / 2, maxMs: timeMs });
-        per[method] = { medianMs: round(t.medianMs), p95Ms: round(t.p95Ms), samples: t.samples, nonFinite, seamGap: gap };
-        if (method === 'gcs') per[method]!.adjustedShare = round(adjusted / skins.length, 3);
-      }
-      clipReports.push({ name: clip.name, duration: round(clip.duration), frames: skins.length, methods: per });
     }
     return {
       name: mesh.name,
       counts: {
         vertices: rig.vertexCount, triangles: input.indices.length / 3, joints: rig.jointCount,
-        parts: gcsD ? gcsD.partCount : null, sections: gcsD ? gcsD.sectionCount : null, height: round(rig.height, 6),
+        parts: gcsCounts?.parts ?? null, sections: gcsCounts?.sections ?? null, height: round(rig.height, 6),
       },
+      worldScale: round(s.worldScale, 6),
+      height: round(height, 6),
+      frames: { count: frames.length, source: all.length ? 'clips' : 'bind pose' },
       methods,
-      clips: clipReports,
+      clips: clips.map((clip, c) => ({ name: clip.name, duration: round(clip.duration), frames: clipFrames[c].length, methods: clipMethods[c] })),
     };
   } finally {
-    for (const d of deformers.values()) d.dispose();
     rig.dispose();
   }
 }
 
-const fmt = (x: number | null | undefined, digits = 3) =>
-  x === null || x === undefined ? 'n/a' : Number.isFinite(x) ? (x === 0 ? '0' : Math.abs(x) < 1e-3 ? x.toExponential(1) : x.toFixed(digits)) : String(x);
+/** The methods that produced non-finite values, per mesh (empty: none). */
+export function nonFiniteMethods(r: Report): { mesh: string; method: MethodName; count: number }[] {
+  const out: { mesh: string; method: MethodName; count: number }[] = [];
+  for (const m of r.meshes)
+    for (const name of METHODS) {
+      const f = m.methods[name]?.fidelity;
+      if (f && f.nonFinite > 0) out.push({ mesh: m.name, method: name, count: f.nonFinite });
+    }
+  return out;
+}
 
+const fmt = (x: number | null | undefined, digits = 3) =>
+  x === null || x === undefined ? 'n/a' : Number.isFinite(x) ? (x === 0 ? '0' : Math.abs(x) < 10 ** -digits ? x.toExponential(1) : x.toFixed(digits)) : String(x);
+
+/** A text table: the first row is the header; the first column and a last 'note' column left-aligned. */
 function table(rows: string[][]): string {
   const widths = rows[0].map((_, c) => Math.max(...rows.map((r) => r[c].length)));
-  return rows.map((r) => r.map((cell, c) => (c === 0 ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ')).join('\n');
+  const left = (c: number) => c === 0 || rows[0][c] === 'note';
+  return rows.map((r) => r.map((cell, c) => (left(c) ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ').trimEnd()).join('\n');
 }
 
 /** The human-readable report. */
 export function formatReport(r: Report): string {
-  const out: string[] = [`gcs-skin report: ${r.file}`];
+  const out: string[] = [`gcs-skin report: ${r.file}`,
+    `character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`];
   for (const m of r.meshes) {
     const c = m.counts;
     out.push('', `mesh '${m.name}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
-      `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part), height ${fmt(c.height, 4)}`);
-    const rows = [['method', 'build ms', 'vertices', 'rest error', 'rest seam gap', 'note']];
+      `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
+    out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
+      `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
+    const lbs = m.methods.lbs?.fidelity?.flipped;
+    const rows = [['method', 'build ms', 'median ms', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'stretched', 'normal off', 'non-finite', 'seam gap %', 'note']];
     for (const name of METHODS) {
       const x = m.methods[name];
-      if (!x.available) { rows.push([name, 'n/a', '', '', '', `${x.error!.code}: ${x.error!.message}`]); continue; }
-      const note = x.detailLoss ? `detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of height` : '';
-      rows.push([name, fmt(x.buildMs, 2), String(x.vertices), fmt(x.restError ?? null), fmt(x.restSeamGap), note]);
+      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', `${x.error!.code}: ${x.error!.message}`]); continue; }
+      const f = x.fidelity;
+      const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : `${f.flipped} (LBS ${lbs})`;
+      const note = x.detailLoss ? `resampled: detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of its height` : '';
+      rows.push([name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, String(f.stretched),
+        fmt(f.normalOffUnit, 4), String(f.nonFinite), fmt(f.seamGap, 4), note]);
     }
     out.push(table(rows));
-    if (!m.clips.length) out.push('(no animation clips: per-frame numbers need a clip)');
+    if (!m.clips.length) out.push('(no animation clips: per-clip timing needs a clip)');
     for (const clip of m.clips) {
       out.push('', `clip '${clip.name}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
-      const rows2 = [['method', 'median ms', 'p95 ms', 'non-finite', 'seam gap', 'adjusted']];
+      const rows2 = [['method', 'median ms', 'p95 ms', 'adjusted']];
       for (const name of METHODS) {
         const x = clip.methods[name];
-        if (!x) { rows2.push([name, 'n/a', '', '', '', '']); continue; }
-        rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), String(x.nonFinite), fmt(x.seamGap),
-          x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
+        if (!x) { rows2.push([name, 'n/a', '', '']); continue; }
+        rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
       }
       out.push(table(rows2));
     }
@@ -246,7 +286,10 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
   return { file, json, help, options };
 }
 
-/** The subcommand: returns the exit code (0 ok, 2 bad arguments or an unreadable/unskinned file). */
+/**
+ * The subcommand: returns the exit code (0 ok; 1 some method produced non-finite values, with the
+ * report printed and one line on stderr; 2 bad arguments or an unreadable/unskinned file).
+ */
 export async function run(argv: string[]): Promise<number> {
   let args;
   try {
@@ -274,5 +317,10 @@ export async function run(argv: string[]): Promise<number> {
     throw e;
   }
   console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r));
+  const bad = nonFiniteMethods(r);
+  if (bad.length) {
+    process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${b.mesh}' (${b.count})`).join(', ')}\n`);
+    return 1;
+  }
   return 0;
 }
