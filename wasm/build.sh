@@ -24,7 +24,7 @@ ln -sfn "${GLM_INCLUDE:-/usr/include}/glm" "$build/include/glm"
 
 exports=$(grep -oE '\bgcs_[a-z0-9_]+\(' "$here/include/gcs_skin.h" | tr -d '(' | sort -u | sed 's/^/_/' | paste -sd, -)
 
-emcc -O3 -msimd128 -std=c++17 -Wall -Wextra \
+emcc -O3 -DNDEBUG -msimd128 -std=c++17 -Wall -Wextra \
   -isystem "$build/include" \
   "$here"/src/*.cpp \
   -sSTANDALONE_WASM --no-entry \

@@ -144,6 +144,35 @@ describe('default GCS on the default human and on scaled rigs', () => {
     expectTargets(measureRig('tube ×100', tube.input, scaled, 200));
   });
 
+  test('every criterion and method measures the same, in % of height, with skin matrices ×100', () => {
+    const { tube, frames } = tubePoses();
+    const scaleBy = (k: number) => frames.map((skin) => {
+      const out = new Float32Array(skin.length);
+      const s = new THREE.Matrix4().makeScale(k, k, k);
+      for (let j = 0; j < skin.length / 16; j++) out.set(new THREE.Matrix4().fromArray(skin, 16 * j).premultiply(s).elements, 16 * j);
+      return out;
+    });
+    const rig = gcs.createRig(tube.input);
+    const figures = (k: number) => {
+      const probe = new FidelityProbe(tube.input, scaleBy(k), { height: 2 * k });
+      return [rig.buildGcs(), rig.buildGcs({ smooth: true }), rig.buildGcs({ criterion: 'y' }), rig.buildGcs({ criterion: 'axial', twistSpread: true }),
+        rig.buildGcs({ criterion: 'axial', smooth: true }), rig.buildLbs(), rig.buildDqs()].map((d) => {
+        const f = probe.measure(d);
+        d.dispose();
+        return f;
+      });
+    };
+    const one = figures(1), hundred = figures(100);
+    one.forEach((a, i) => {
+      const b = hundred[i];
+      expect(Math.abs(b.dqsMax! - a.dqsMax!)).toBeLessThan(1e-3);
+      expect(Math.abs(b.dqsP95! - a.dqsP95!)).toBeLessThan(1e-3);
+      expect(b.normalOffUnit).toBeLessThan(NORMAL_TOLERANCE);
+      expect(b.nonFinite).toBe(0);
+    });
+    rig.dispose();
+  });
+
   test('an armature scaled ×100 with its mesh ×0.01 (three.js scene graph)', () => {
     const tube = makeTube({ band: 0.3 });
     const scene = new THREE.Group();

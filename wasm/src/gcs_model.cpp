@@ -740,7 +740,8 @@ void GcsDeformerImpl::sectionTransformsPaper(const glm::mat4* skin, const ScaleS
   for (uint32_t j = 0; j < J; ++j) {
     if (!parts[j].isPart || parts[j].parent < 0) continue;
     glm::mat4 d = rigidInverse(rigidOf(poses[parts[j].parent])) * rigidOf(poses[j]);
-    motions[j] = motionAbout(d, jointCentres[j]);
+    // The rigid parts act on scaled points (S = [R | t]·K): their joint centre is K·c_j.
+    motions[j] = motionAbout(d, poses[j].scale * jointCentres[j]);
     if (settings.twistSpread) swingTwist(motions[j].rotation, parts[j].twistAxis, swings[j], twists[j]);
   }
   const uint32_t S = uint32_t(sections.size());

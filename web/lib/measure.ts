@@ -353,7 +353,11 @@ export interface Fidelity {
 }
 
 export interface FidelityOptions {
-  /** The character's height in this mesh's units (default: the rig's own bind-pose height). */
+  /**
+   * The character's height in the units of the deformers' OUTPUT (posed mesh space). Default: the
+   * rig's own bind-pose height, which is right only when the skin matrices carry no scale (a rig
+   * whose S_j are ×100 outputs ×100 positions: pass 100 × that height).
+   */
   height?: number;
 }
 
@@ -365,7 +369,7 @@ export interface FidelityOptions {
 export class FidelityProbe {
   readonly height: number;
   readonly vertexCount: number;
-  private readonly reference: Float64Array[] = [];
+  private readonly reference: Float32Array[] = [];
   private readonly rigid: Int32Array; // per rig vertex: its joint when bound ≥ 0.999, else -1
   private readonly rigidCount: number;
   private readonly dominant: Int32Array; // per rig vertex: the joint of largest weight
@@ -401,7 +405,7 @@ export class FidelityProbe {
     this.rigidCount = rigidCount;
     const J = input.parents.length;
     for (const skin of frames) {
-      const ref = new Float64Array(3 * n);
+      const ref = new Float32Array(3 * n); // computed in double, stored in float (memory)
       referenceDqs(input, skin, ref);
       this.reference.push(ref);
       const rot = new Float64Array(9 * J);
@@ -423,6 +427,7 @@ export class FidelityProbe {
     if (source) {
       for (let o = 0; o < nOut; o++) {
         const v = source[o];
+        if (!(v < this.vertexCount)) throw new GcsError('LENGTH_MISMATCH', `output vertex ${o} comes from rig vertex ${v}, but the probe's rig has ${this.vertexCount}: measure a deformer built from the same rig`);
         jointOf[o] = this.dominant[v];
         for (let c = 0; c < 3; c++) rest[3 * o + c] = P0[3 * v + c];
       }
