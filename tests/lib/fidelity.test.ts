@@ -8,7 +8,7 @@ import { basename } from 'node:path';
 import { initGcsSkin, type Deformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { characterHeight, sampleClip } from '../../web/lib/cli/gltf-node.js';
 import { FidelityProbe, type Fidelity } from '../../web/lib/measure.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
@@ -82,29 +82,16 @@ function expectTargets(f: Figures, plainFlips = 1.7) {
   expect(f.smooth.flipped).toBeLessThanOrEqual(Math.max(10, 1.3 * f.dqs.flipped));
 }
 
-/** Height of a whole character in world units: the bind-pose box of all its skinned meshes. */
-function worldHeight(meshes: THREE.SkinnedMesh[]): number {
-  const box = new THREE.Box3();
-  for (const m of meshes) {
-    m.geometry.computeBoundingBox();
-    box.union(m.geometry.boundingBox!.clone().applyMatrix4(m.matrixWorld));
-  }
-  const s = box.getSize(new THREE.Vector3());
-  return Math.max(s.x, s.y, s.z);
-}
-
 describe.skipIf(files.length === 0)('default GCS on the shared characters', () => {
   for (const file of files) {
     test(`${basename(file)}: every clip sampled`, async () => {
       const model = await loadGlb(file);
-      const height = worldHeight(model.skinnedMeshes);
-      for (const mesh of model.skinnedMeshes) {
+      const height = characterHeight(model.skinnedMeshes); // before any clip poses the bones
+      model.skinnedMeshes.forEach((mesh, i) => {
         const frames: Float32Array[] = [];
         for (const clip of model.clips) frames.push(...sampleClip(mesh, clip, 24));
-        const scale = new THREE.Vector3();
-        mesh.matrixWorld.decompose(new THREE.Vector3(), new THREE.Quaternion(), scale);
-        expectTargets(measureRig(`${basename(file)} '${mesh.name}'`, rigInputFromSkinnedMesh(mesh), frames, height / scale.x));
-      }
+        expectTargets(measureRig(`${basename(file)} '${mesh.name}'`, rigInputFromSkinnedMesh(mesh), frames, height.meshUnits[i]));
+      });
     });
   }
 });
