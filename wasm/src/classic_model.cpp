@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstring>
 #include <new>
-#include <unordered_map>
 #include "error.h"
 #include "transform.h"
 

@@ -1,8 +1,8 @@
 #include "rig.h"
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <new>
-#include <unordered_map>
 #include "error.h"
 
 namespace gcs {
@@ -14,27 +14,45 @@ bool allFinite(const float* values, size_t count) {
 }
 
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
-  struct Key {
-    uint32_t x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    size_t operator()(const Key& k) const {
-      return size_t(k.x * 73856093u) ^ size_t(k.y * 19349663u) ^ size_t(k.z * 83492791u);
+  // A sort of the exact position bits, not a hash: O(n log n) for any input (a hash of raw float
+  // bits put integer grids of power-of-two sizes into a few buckets: quadratic).
+  struct Entry {
+    uint32_t x, y, z, v;
+    bool operator<(const Entry& o) const {
+      if (x != o.x) return x < o.x;
+      if (y != o.y) return y < o.y;
+      if (z != o.z) return z < o.z;
+      return v < o.v;
     }
+    bool samePoint(const Entry& o) const { return x == o.x && y == o.y && z == o.z; }
   };
-  std::unordered_map<Key, uint32_t, Hash> seen;
-  seen.reserve(rig.vertexCount * 2);
-  std::vector<uint32_t> group(rig.vertexCount);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    Key k;
+  const uint32_t n = rig.vertexCount;
+  std::vector<Entry> entries(n);
+  for (uint32_t v = 0; v < n; ++v) {
     glm::vec3 p = rig.positions[v] + glm::vec3(0.0f);  // +0 folds -0 into 0
-    std::memcpy(&k.x, &p.x, 4);
-    std::memcpy(&k.y, &p.y, 4);
-    std::memcpy(&k.z, &p.z, 4);
-    auto it = seen.emplace(k, uint32_t(representative.size()));
-    if (it.second) representative.push_back(v);
-    group[v] = it.first->second;
+    Entry& e = entries[v];
+    std::memcpy(&e.x, &p.x, 4);
+    std::memcpy(&e.y, &p.y, 4);
+    std::memcpy(&e.z, &p.z, 4);
+    e.v = v;
+  }
+  std::sort(entries.begin(), entries.end());
+  std::vector<uint32_t> runOf(n);
+  uint32_t runs = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (i > 0 && !entries[i].samePoint(entries[i - 1])) ++runs;
+    runOf[entries[i].v] = runs;
+  }
+  // Group ids in order of first appearance, the representative the group's first vertex.
+  std::vector<uint32_t> idOfRun(n ? runs + 1 : 0, ~0u);
+  std::vector<uint32_t> group(n);
+  for (uint32_t v = 0; v < n; ++v) {
+    uint32_t& id = idOfRun[runOf[v]];
+    if (id == ~0u) {
+      id = uint32_t(representative.size());
+      representative.push_back(v);
+    }
+    group[v] = id;
   }
   return group;
 }
