@@ -2,8 +2,11 @@
 // Screenshots of the demo page for the README: builds the demo, serves it with `vite preview`
 // and photographs it in headless Chromium (SwiftShader).
 //
-//   node scripts/screenshot-demo.mjs            → docs/demo.png, docs/demo-sections.png
+//   node scripts/screenshot-demo.mjs            → docs/demo.png (the default: weights criterion),
+//                                                 docs/demo-sections.png (colour by section, 8 sections)
 //   node scripts/screenshot-demo.mjs --out DIR  → the same files in DIR
+//   EXTRA='?criterion=y&colour=1' node scripts/screenshot-demo.mjs → also extra.png
+// A page that shows a message (e.g. the wasm failed to load) or throws is an error: no picture.
 import { existsSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
@@ -42,14 +45,18 @@ try {
   ];
   for (const shot of shots) {
     const page = await context.newPage();
-    page.on('pageerror', (e) => console.error('page error:', e.message));
+    const errors = [];
+    page.on('pageerror', (e) => errors.push(e.message));
     await page.goto(url + shot.query);
     await page.waitForFunction(() => window.__demo !== undefined);
     await page.evaluate(() => window.__demo.ready);
+    const message = await page.evaluate(() => window.__demo.error());
+    if (message) throw new Error(`${shot.file}: the page says: ${message}`);
     // A stride of the walk with legs apart, then hold it so every view shows the same pose.
     await page.waitForFunction(() => window.__demo.time() > 0.9, null, { timeout: 60000 });
     await page.evaluate(() => window.__demo.pause(0.32));
     await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
+    if (errors.length) throw new Error(`${shot.file}: page errors: ${errors.join('; ')}`);
     await page.screenshot({ path: join(outDir, shot.file) });
     console.log('wrote', join(outDir, shot.file));
     await page.close();

@@ -1,5 +1,6 @@
 // The demo page in headless Chromium: both views render, animate, follow the GUI's section
-// slider, load a dropped character, and keep the old one when a file is broken.
+// slider in each GCS criterion (weights, the default; the paper's Y and axial), load a dropped
+// character, and keep the old one when a file is broken.
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
@@ -30,6 +31,27 @@ async function setNumber(page: Page, name: string, value: number): Promise<void>
   const input = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('input');
   await input.fill(String(value));
   await input.press('Enter');
+}
+
+/** Picks a criterion in the GUI's menu (by its label) and waits until the GCS model is rebuilt with it. */
+async function setCriterion(page: Page, label: string, value: string): Promise<void> {
+  const builds = await page.evaluate(() => window.__demo.gcsBuilds());
+  await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^criterion$/ }) }).locator('select').selectOption(label);
+  await page.waitForFunction(([n, c]) => window.__demo.gcsBuilds() > (n as number) && window.__demo.criterion() === c, [builds, value] as const);
+}
+
+/** The section count as the GCS view's readout shows it ("320 sections"). */
+async function sectionReadout(page: Page): Promise<number> {
+  const text = await page.locator('.readout[data-view=gcs]').innerText();
+  const m = /([\d,]+) sections/.exec(text);
+  if (!m) throw new Error(`no section count in the GCS readout: ${text}`);
+  return Number(m[1].replace(/,/g, ''));
+}
+
+/** Whether a lil-gui controller (by its label) is disabled. */
+async function disabled(page: Page, name: string): Promise<boolean> {
+  return page.locator('.lil-gui .controller').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) })
+    .evaluate((el) => el.classList.contains('disabled'));
 }
 
 /** Drops files on the page as a user would (a synthetic drop event carrying a DataTransfer). */
@@ -71,7 +93,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
 
   test('the page starts walking the default human, with both views labelled', async () => {
     const state = await page.evaluate(() => ({
-      error: window.__demo.error(), character: window.__demo.character(), sections: window.__demo.sectionCount(),
+      error: window.__demo.error(), character: window.__demo.character(), sections: window.__demo.sectionCount(), criterion: window.__demo.criterion(),
       views: window.__demo.views().map((v) => v.kind), classicError: window.__demo.classicError(), rigid: window.__demo.rigidParts(),
     }));
     expect(state.error).toBe('');
@@ -87,7 +109,22 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
       expect(state.rigid.length).toBeGreaterThan(0);
       expect(classicLabel).toMatch(/Carried rigidly/);
     }
-    await expect(page.locator('.lil-gui .controller .name', { hasText: 'sections per part' }).isVisible()).resolves.toBe(true);
+    await expect(page.locator('.lil-gui .controller .name', { hasText: /^sections$/ }).isVisible()).resolves.toBe(true);
+  });
+
+  test('the page opens with the weights criterion; the paper-only controls are disabled; the readout says why', async () => {
+    expect(await page.evaluate(() => window.__demo.criterion())).toBe('weights');
+    const menu = page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^criterion$/ }) }).locator('select');
+    await expect(menu.evaluate((el: HTMLSelectElement) => Array.from(el.options).map((o) => o.text)))
+      .resolves.toEqual(['weights (default)', 'Y (paper)', "axial (paper's rule, bone axis)"]);
+    await expect(menu.evaluate((el: HTMLSelectElement) => el.options[el.selectedIndex].text)).resolves.toBe('weights (default)');
+    expect(await disabled(page, 'influence width')).toBe(true);
+    expect(await disabled(page, 'twist spread')).toBe(true);
+    expect(await disabled(page, 'smooth mode')).toBe(false);
+    await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/weights criterion · 6 sections: weight step 1\/8/);
+    const readout = await page.locator('.readout[data-view=gcs]').innerText();
+    expect(readout).toMatch(/criterion weights: vertices bound 100 % to a bone move exactly with it; the paper's Y rule bends them/);
+    expect(readout).toMatch(/\d+ % of vertices in rigid cores/);
   });
 
   test('both views render a lit character (not blank, many colours in each)', async () => {
@@ -129,7 +166,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     expect(await page.evaluate(() => window.__demo.sectionsPerPart())).toBe(6);
 
     // Type into the slider's number input, as a user would.
-    const sections = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: 'sections per part' }) });
+    const sections = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: /^sections$/ }) });
     await sections.locator('input').fill('12');
     await sections.locator('input').press('Enter');
     await page.waitForFunction((n) => window.__demo.sectionCount() !== n, before.count);
@@ -141,7 +178,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     const diff = await analyse(page, shot12, regions, before.shot);
     expect(diff[0].changed, 'GCS view changed').toBeGreaterThan(0.005);
     expect(diff[1].changed, 'classic view unchanged (paused, not rebuilt)').toBeLessThan(0.002);
-    await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/12 sections per part/);
+    await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/12 sections: weight step 1\/20/);
 
     // Drag on the slider track itself: near its left end is few sections.
     const box = (await sections.locator('.slider').boundingBox())!;
@@ -155,6 +192,62 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
       await page.evaluate(() => window.__demo.setSections(6));
       await frames(page, 2);
     }
+  });
+
+  test('each criterion (weights, Y, axial) renders; its section slider changes the section count readout and the picture', async () => {
+    const regions = await viewRegions(page);
+    await toggle(page, 'pause');
+    await toggle(page, 'colour by section');
+    const errorsBefore = pageErrors.length;
+    try {
+      const criteria = [
+        { label: 'Y (paper)', value: 'y', text: /Y \(paper\) criterion · 6 sections per part/ },
+        { label: "axial (paper's rule, bone axis)", value: 'axial', text: /axial \(paper's rule\) criterion · 6 sections per part/ },
+        { label: 'weights (default)', value: 'weights', text: /weights criterion · 6 sections: weight step 1\/8/ },
+      ];
+      for (const c of criteria) {
+        await setCriterion(page, c.label, c.value);
+        await frames(page, 3);
+        expect(await page.evaluate(() => window.__demo.error()), `${c.value}: no message`).toBe('');
+        await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(c.text);
+        await expect(page.locator('.readout[data-view=gcs]').innerText()).resolves.toMatch(new RegExp(`criterion ${c.value === 'y' ? 'Y' : c.value}`));
+        const paperOnly = c.value !== 'weights';
+        expect(await disabled(page, 'influence width'), `${c.value}: influence width enabled`).toBe(!paperOnly);
+        expect(await disabled(page, 'twist spread'), `${c.value}: twist spread enabled`).toBe(!paperOnly);
+
+        const before = { readout: await sectionReadout(page), shot: await page.screenshot() };
+        expect(before.readout).toBe(await page.evaluate(() => window.__demo.sectionCount()));
+        const builds = await page.evaluate(() => window.__demo.gcsBuilds());
+        await setNumber(page, 'sections', 10);
+        await page.waitForFunction((n) => window.__demo.gcsBuilds() > n, builds);
+        await frames(page, 3);
+        const after = await sectionReadout(page);
+        expect(after, `${c.value}: the section count readout follows the slider`).toBeGreaterThan(before.readout);
+        const diff = await analyse(page, await page.screenshot(), regions, before.shot);
+        expect(diff[0].colours, `${c.value}: the GCS view renders`).toBeGreaterThan(150);
+        expect(diff[0].changed, `${c.value}: the GCS view changed`).toBeGreaterThan(0.005);
+        expect(diff[1].changed, `${c.value}: the classic view unchanged`).toBeLessThan(0.002);
+        await setNumber(page, 'sections', 6);
+        await page.waitForFunction((n) => window.__demo.sectionCount() === n, before.readout);
+      }
+      expect(pageErrors.slice(errorsBefore)).toEqual([]);
+    } finally {
+      await toggle(page, 'colour by section');
+      await toggle(page, 'pause');
+      await frames(page, 2);
+    }
+  }, 360000); // three rebuilds and six screenshots: minutes on a loaded 2-core machine (SwiftShader)
+
+  test('?criterion=y opens with the paper\'s Y criterion', async () => {
+    const other = await context.newPage();
+    other.on('pageerror', (e) => pageErrors.push(e.message));
+    await other.goto(`${server.url}?criterion=y&sections=8`);
+    await other.waitForFunction(() => window.__demo !== undefined);
+    await other.evaluate(() => window.__demo.ready);
+    expect(await other.evaluate(() => ({ criterion: window.__demo.criterion(), perPart: window.__demo.sectionsPerPart(), error: window.__demo.error() })))
+      .toEqual({ criterion: 'y', perPart: 8, error: '' });
+    await expect(other.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/Y \(paper\) criterion · 8 sections per part/);
+    await other.close();
   });
 
   test('the other controls: clip, third (three.js LBS) view, classic contours and bulge', async () => {

@@ -129,6 +129,9 @@ export interface DemoHook {
   sectionCount(): number;
   sectionsPerPart(): number;
   setSections(n: number): void;
+  criterion(): string;
+  gcsBuilds(): number;
+  lookAt(eye: [number, number, number], target: [number, number, number]): void;
   classicError(): string | null;
   rigidParts(): string[];
   readouts(): unknown;

@@ -49,10 +49,29 @@ const qNumber = (key: string, fallback: number) => {
 };
 const qBool = (key: string, fallback: boolean) => (query.has(key) ? query.get(key) !== '0' && query.get(key) !== 'false' : fallback);
 
+/** ?criterion=weights|y|axial (default weights, the library's default). */
+function parseCriterion(value: string | null): Criterion {
+  const v = (value ?? '').toLowerCase();
+  return v === 'y' || v === 'axial' ? v : 'weights';
+}
+
+/** The criterion menu: label → value. */
+const CRITERION_MENU: Record<string, Criterion> = {
+  'weights (default)': 'weights',
+  'Y (paper)': 'y',
+  "axial (paper's rule, bone axis)": 'axial',
+};
+/** What the GCS view says about each criterion: a short name and one line on why the default differs from the paper. */
+const CRITERION_TEXT: Record<Criterion, { name: string; why: string }> = {
+  weights: { name: 'weights', why: 'vertices bound 100 % to a bone move exactly with it; the paper\'s Y rule bends them' },
+  y: { name: 'Y (paper)', why: 'bins of bind-pose height; skin bound 100 % to one bone bends too (weights keeps it rigid)' },
+  axial: { name: 'axial (paper\'s rule)', why: 'bins along each bone; skin bound 100 % to one bone bends too (weights keeps it rigid)' },
+};
+
 const params = {
   // GCS model (left)
   sections: Math.round(Math.min(48, Math.max(3, qNumber('sections', 6)))),
-  criterion: (query.get('criterion') === 'y' ? 'y' : 'axial') as Criterion,
+  criterion: parseCriterion(query.get('criterion')),
   influenceWidth: 1,
   smooth: qBool('smooth', false),
   twistSpread: qBool('twist', false),
@@ -85,6 +104,8 @@ let gui: GUI;
 interface OptionsCtl { options(values: string[]): OptionsCtl; name(n: string): OptionsCtl; onChange(f: () => void): OptionsCtl }
 let clipController: OptionsCtl;
 let sectionsController: { setValue(v: number): unknown };
+/** The controls that only apply to the paper's criteria (y, axial). */
+let paperOnlyControllers: { disable(d?: boolean): unknown; domElement: HTMLElement }[] = [];
 let pausedController: { setValue(v: boolean): unknown };
 let current: Character | null = null;
 const gcsGroup = new THREE.Group();
@@ -102,6 +123,10 @@ const timing = { gcs: NaN, classic: NaN };
 let busy = 0;
 /** Builds of the classic model so far (a bulge change must not add one). */
 let classicBuilds = 0;
+/** Builds and rebuilds of the GCS model so far. */
+let gcsBuilds = 0;
+/** The criterion the current GCS model was built with. */
+let builtCriterion: Criterion = params.criterion;
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 const fileInput = $<HTMLInputElement>('file');
@@ -252,11 +277,15 @@ function initGui(): void {
   gui = new GUI({ title: 'gcs-skin', width: 270 });
 
   const g = gui.addFolder('GCS model (left)');
-  sectionsController = g.add(params, 'sections', 3, 48, 1).name('sections per part').onChange(() => { pendingGcs = true; });
-  g.add(params, 'criterion', { 'axial (bone axis)': 'axial', 'Y (paper)': 'y' }).onChange(() => { pendingGcs = true; });
-  g.add(params, 'influenceWidth', 0.05, 1, 0.05).name('influence width').onChange(() => { pendingGcs = true; });
+  const criterionCtl = g.add(params, 'criterion', CRITERION_MENU).onChange(() => { pendingGcs = true; updatePaperOnlyControls(); });
+  criterionCtl.domElement.style.setProperty('--name-width', '22%'); // room for "axial (paper's rule, bone axis)"
+  sectionsController = g.add(params, 'sections', 3, 48, 1).name('sections').onChange(() => { pendingGcs = true; });
   g.add(params, 'smooth').name('smooth mode').onChange(() => { pendingGcs = true; });
-  g.add(params, 'twistSpread').name('twist spread').onChange(() => { pendingGcs = true; });
+  paperOnlyControllers = [
+    g.add(params, 'influenceWidth', 0.05, 1, 0.05).name('influence width').onChange(() => { pendingGcs = true; }),
+    g.add(params, 'twistSpread').name('twist spread').onChange(() => { pendingGcs = true; }),
+  ];
+  updatePaperOnlyControls();
 
   const c = gui.addFolder('Classic model (right)');
   c.add(params, 'contours', CLASSIC_LIMITS.minContours, 64, 1).onChange(() => { pendingClassic = true; });
@@ -278,6 +307,15 @@ function initGui(): void {
   v.add(params, 'loadHuman').name('load the default human');
 }
 
+/** Influence width and twist spread apply to the paper's criteria only: disabled (greyed) under weights. */
+function updatePaperOnlyControls(): void {
+  const off = params.criterion === 'weights';
+  for (const c of paperOnlyControllers) {
+    c.disable(off);
+    c.domElement.title = off ? 'only for the Y and axial criteria' : '';
+  }
+}
+
 function setClipOptions(names: string[]): void {
   // lil-gui's options() re-adds the controller at the end of its folder: put it back first.
   clipController = clipController.options(names.length ? names : ['(none)']).name('clip').onChange(playClip);
@@ -286,7 +324,9 @@ function setClipOptions(names: string[]): void {
 }
 
 function gcsOptions(): GcsOptions {
-  return { sections: params.sections, criterion: params.criterion, influenceWidth: params.influenceWidth, smooth: params.smooth, twistSpread: params.twistSpread };
+  const options: GcsOptions = { sections: params.sections, criterion: params.criterion, smooth: params.smooth };
+  if (params.criterion !== 'weights') Object.assign(options, { influenceWidth: params.influenceWidth, twistSpread: params.twistSpread });
+  return options;
 }
 function classicOptions(): ClassicOptions {
   return { contours: params.contours, rays: params.rays, bulge: params.bulge };
@@ -318,23 +358,36 @@ function stepFrame(): void {
 // Colours and materials
 
 const tmpColour = new THREE.Color();
+/** Vertices in rigid cores (weights criterion) of each GCS deformer, counted when it is coloured. */
+const rigidVertices = new WeakMap<SkinDeformer, number>();
 
-/** One colour per generalized section: a hue per part, alternating light/dark bands; SGS yellow. */
+/**
+ * One colour per generalized section: a hue per part, alternating light/dark bands along it; shared
+ * sections (SGS) yellow. Weights criterion: bands run from one joint to the next (sections of one
+ * joint pair sorted by the second joint's weight), rigid cores are a pale grey tinted by the part.
+ */
 function gcsColours(skin: SkinDeformer): void {
   const d = skin.deformer as GcsDeformer;
   const sections = d.sections();
   const ofVertex = d.sectionOfVertex();
   const rank = new Array<number>(sections.length).fill(0);
-  const byPart = new Map<number, number[]>();
-  sections.forEach((s, i) => { if (!byPart.has(s.part)) byPart.set(s.part, []); byPart.get(s.part)!.push(i); });
-  for (const list of byPart.values()) {
+  const groups = new Map<string, number[]>();
+  const byWeights = builtCriterion === 'weights';
+  sections.forEach((s, i) => {
+    const key = byWeights ? `${s.part}:${s.distal}` : `${s.part}`;
+    if (!groups.has(key)) groups.set(key, []);
+    groups.get(key)!.push(i);
+  });
+  for (const list of groups.values()) {
     list.sort((a, b) => sections[a].t - sections[b].t);
     list.forEach((i, r) => { rank[i] = r; });
   }
+  rigidVertices.set(skin, sections.reduce((n, s) => n + (s.rigid ? s.count : 0), 0));
   const palette = sections.map((s, i) => {
+    const hue = (0.22 + ((s.part * 0.618034) % 1) * 0.8) % 1;
     if (s.shared) return tmpColour.setHSL(0.15, 1, 0.55).clone();
-    const hue = 0.22 + ((s.part * 0.618034) % 1) * 0.8;
-    return tmpColour.setHSL(hue % 1, 0.6, rank[i] % 2 ? 0.36 : 0.6).clone();
+    if (s.rigid) return tmpColour.setHSL(hue, 0.2, 0.72).clone();
+    return tmpColour.setHSL(hue, 0.6, rank[i] % 2 ? 0.36 : 0.56).clone();
   });
   const colours = new Float32Array(d.vertexCount * 3);
   for (let v = 0; v < d.vertexCount; v++) {
@@ -519,10 +572,12 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
       await yieldToPage();
       const skin = new SkinDeformer(gcs, src, { method: 'gcs', gcs: gcsOptions(), material: gcsMaterial });
       built.push(skin);
+      builtCriterion = params.criterion;
       vertices += src.geometry.getAttribute('position').count;
       triangles += src.geometry.index ? src.geometry.index.count / 3 : src.geometry.getAttribute('position').count / 3;
     }
     const gcsSkins = built.slice();
+    gcsBuilds++;
 
     showStatus('building… classic cross-section model');
     await yieldToPage();
@@ -603,9 +658,11 @@ function disposeCharacter(ch: Character): void {
 
 function rebuildGcs(ch: Character): void {
   pendingGcs = false;
+  gcsBuilds++;
   try {
     for (const s of ch.gcs) {
       s.rebuild('gcs', { gcs: gcsOptions() });
+      builtCriterion = params.criterion;
       gcsColours(s);
     }
   } catch (e) {
@@ -678,10 +735,17 @@ function updateLabels(): void {
     const maxWidth = Math.max(160, Math.min(440, r.width - (overlaid ? 300 : 20)));
     let body = '';
     if (r.kind === 'gcs') {
+      const byWeights = builtCriterion === 'weights';
+      const detail = byWeights
+        ? `${params.sections} sections: weight step 1/${2 * (params.sections - 2)}`
+        : `${params.sections} sections per part`;
       body = '<h2>GCS — generalized cross-sections</h2><div class="sub">Li, Wang, Mao · ' +
-        `${params.sections} sections per part, ${params.criterion === 'y' ? 'Y' : 'axial'} criterion` +
-        `${params.smooth ? ', smooth' : ''}${params.twistSpread ? ', twist spread' : ''}</div>` +
-        (params.colourBySection ? '<div class="sub">colour = section · <span style="color:#ffd83d">yellow = shared section (SGS)</span></div>' : '');
+        `${esc(CRITERION_TEXT[builtCriterion].name)} criterion · ${detail}` +
+        `${params.smooth ? ', smooth' : ''}${!byWeights && params.twistSpread ? ', twist spread' : ''}</div>`;
+      if (params.colourBySection) {
+        body += '<div class="sub">colour = section · <span style="color:#ffd83d">yellow = shared section (SGS)</span>' +
+          (byWeights ? ' · <span style="color:#c4c8cc">pale grey = rigid core (moves exactly with its bone)</span>' : '') + '</div>';
+      }
     } else if (r.kind === 'classic') {
       body = '<h2>Classic cross-sections</h2><div class="sub">Shen, Magnenat-Thalmann, Thalmann 1994 · ' +
         `${params.contours} contours × ${params.rays} rays per limb</div>`;
@@ -710,7 +774,7 @@ function summariseBones(names: string[]): string {
 
 interface Readouts {
   character: string;
-  gcs: { ms: number; vertices: number; triangles: number; sections: number; adjustedShare: number } | null;
+  gcs: { ms: number; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
   classic: { ms: number; vertices: number; triangles: number; contours: number; detailLoss: { rms: number; max: number } } | null;
   lbs: { vertices: number; triangles: number } | null;
 }
@@ -723,14 +787,16 @@ function collectReadouts(): Readouts {
   let gcsInfo: Readouts['gcs'] = null;
   let classicInfo: Readouts['classic'] = null;
   try {
-    let sections = 0, adjusted = 0;
+    let sections = 0, adjusted = 0, rigid = 0, vertices = 0;
     for (const s of ch.gcs) {
       const d = s.deformer as GcsDeformer;
+      rigid += rigidVertices.get(s) ?? 0;
+      vertices += d.vertexCount;
       sections += d.sectionCount;
       adjusted += d.adjustedShare * d.sectionCount;
     }
     gcsInfo = {
-      ms: timing.gcs, sections, adjustedShare: sections ? adjusted / sections : 0,
+      ms: timing.gcs, sections, adjustedShare: sections ? adjusted / sections : 0, criterion: builtCriterion, rigidShare: vertices ? rigid / vertices : 0,
       vertices: ch.gcs.reduce((n, s) => n + s.deformer.vertexCount, 0), triangles: ch.gcs.reduce((n, s) => n + tri(s), 0),
     };
     if (ch.classic.length) {
@@ -760,7 +826,11 @@ function updateReadouts(): void {
   const rows: Record<ViewKind, string[]> = { gcs: [], classic: [], lbs: [] };
   if (r.gcs) {
     rows.gcs.push(`deform <b>${ms(r.gcs.ms)} ms</b> / frame · ${n(r.gcs.vertices)} vertices · ${n(r.gcs.triangles)} triangles`);
-    rows.gcs.push(`<b>${n(r.gcs.sections)}</b> sections · <b>${(r.gcs.adjustedShare * 100).toFixed(0)} %</b> adjusted this frame · rest pose exact`);
+    rows.gcs.push(`<b>${n(r.gcs.sections)}</b> sections` +
+      (r.gcs.criterion === 'weights' ? ` · <b>${(r.gcs.rigidShare * 100).toFixed(0)} %</b> of vertices in rigid cores` : '') +
+      ` · <b>${(r.gcs.adjustedShare * 100).toFixed(0)} %</b> adjusted this frame · rest pose exact`);
+    const c = CRITERION_TEXT[r.gcs.criterion];
+    rows.gcs.push(`<span class="criterion">criterion <b>${esc(c.name)}</b>: ${esc(c.why)}</span>`);
   }
   if (r.classic) {
     rows.classic.push(`deform <b>${ms(r.classic.ms)} ms</b> / frame · ${n(r.classic.vertices)} vertices · ${n(r.classic.triangles)} triangles`);
@@ -878,6 +948,9 @@ Object.assign(window, {
     sectionCount: () => current?.gcs.reduce((n, s) => n + s.deformer.sectionCount, 0) ?? 0,
     sectionsPerPart: () => params.sections,
     setSections: (n: number) => { sectionsController.setValue(n); },
+    /** The criterion of the GCS model on screen. */
+    criterion: () => builtCriterion,
+    gcsBuilds: () => gcsBuilds,
     classicError: () => current?.classicError ?? null,
     rigidParts: () => current?.rigidParts ?? [],
     readouts: () => collectReadouts(),
@@ -889,6 +962,12 @@ Object.assign(window, {
     pause: (t?: number) => {
       pausedController.setValue(true);
       if (t !== undefined) current?.mixer.setTime(t);
+    },
+    /** Moves the shared camera (for close-ups): eye position and target, world units. */
+    lookAt: (eye: [number, number, number], target: [number, number, number]) => {
+      camera.position.set(...eye);
+      controls.target.set(...target);
+      controls.update();
     },
     /** Settles when every queued load has finished. */
     idle: () => queue.then(() => undefined),
