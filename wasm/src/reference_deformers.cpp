@@ -59,7 +59,10 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
       glm::vec3 rest(q[0], q[1], q[2]);
       // As three.js does: the normal by the blended matrix, then unit length. Where the blend has
       // collapsed (bones scaled to 0), the rest normal turned by the first influence's rotation.
-      glm::vec3 rn = unitOr(glm::vec3(m * glm::vec4(rest, 0.0f)), poses[j[0]].rotation * rest);
+      glm::vec3 rn(m * glm::vec4(rest, 0.0f));
+      float len2 = glm::dot(rn, rn);
+      if (len2 > 1e-24f && len2 < 1e24f) rn *= 1.0f / std::sqrt(len2);
+      else rn = unitOr(rn, poses[j[0]].rotation * rest);
       for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
     }
     return;
@@ -70,19 +73,44 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
   float w4[4];
   glm::mat4 pm, nm;
   for (uint32_t v = 0; v < n; ++v) {
-    uint32_t k = 0;
-    for (int i = 0; i < 4; ++i) {
-      if (!(weights[v][i] > 0.0f)) continue;
-      blend[k] = &poses[joints[v][i]];
-      w4[k++] = weights[v][i];
-    }
-    bool renorm = false;
-    blendPoses(blend, w4, k, scale, pm, nm, renorm);
     const float* p = &restPositions[3 * size_t(v)];
     const float* q = &restNormals[3 * size_t(v)];
-    glm::vec3 rp(pm * glm::vec4(p[0], p[1], p[2], 1.0f));
-    glm::vec3 rn(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
-    if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one
+    glm::vec3 rp, rn;
+    if (scale.uniform) {
+      // Every K = s·I: rotate s·x by the blended unit quaternion and translate (no matrices).
+      const glm::uvec4 j = joints[v];
+      const glm::vec4 wv = weights[v];
+      const glm::vec4 pivot = poses[j[0]].real;
+      glm::vec4 br(0.0f), bd(0.0f);
+      for (int i = 0; i < 4; ++i) {
+        if (!(wv[i] > 0.0f)) continue;
+        const JointPose& jp = poses[j[i]];
+        float sw = glm::dot(jp.real, pivot) < 0.0f ? -wv[i] : wv[i];
+        br += sw * jp.real;
+        bd += sw * jp.dual;
+      }
+      const float inv = 1.0f / glm::length(br);
+      br *= inv;
+      bd *= inv;
+      const glm::vec3 u(br), du(bd);
+      const glm::vec3 t = 2.0f * (br.w * du - bd.w * u - glm::cross(du, u));
+      const glm::vec3 x = scale.s * glm::vec3(p[0], p[1], p[2]), nn(q[0], q[1], q[2]);
+      // r·x = x + 2u×(u×x + w·x)
+      rp = x + 2.0f * glm::cross(u, glm::cross(u, x) + br.w * x) + t;
+      rn = nn + 2.0f * glm::cross(u, glm::cross(u, nn) + br.w * nn);
+    } else {
+      uint32_t k = 0;
+      for (int i = 0; i < 4; ++i) {
+        if (!(weights[v][i] > 0.0f)) continue;
+        blend[k] = &poses[joints[v][i]];
+        w4[k++] = weights[v][i];
+      }
+      bool renorm = false;
+      blendPoses(blend, w4, k, scale, pm, nm, renorm);
+      rp = glm::vec3(pm * glm::vec4(p[0], p[1], p[2], 1.0f));
+      rn = glm::vec3(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
+      if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one
+    }
     for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
   }
 }
