@@ -141,19 +141,32 @@ inline void decompose(const glm::mat4& s, JointPose& out) {
   out.normal[3][3] = 0.0f;
 }
 
-// Decomposes every skin matrix of a frame and tells what their scales have in common.
+// Decomposes every skin matrix of a frame and tells what their scales have in common. `uniform`
+// holds when every K_j is s·I up to a relative 1e-5 (float rounding of Rᵀ·S makes exact equality
+// rare on animated rigs), all with the same s; s is then exact when K_0 is exactly uniform (the
+// bind pose: 1).
 inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose* poses) {
   ScaleState st;
   for (uint32_t j = 0; j < count; ++j) {
     decompose(skin[j], poses[j]);
     if (st.same && j > 0 && poses[j].scale != poses[0].scale) st.same = false;
   }
-  st.uniform = st.same && count > 0 && isUniformScale(poses[0].scale);
-  st.s = st.uniform ? (poses[0].scale[0][0] + poses[0].scale[1][1] + poses[0].scale[2][2]) / 3.0f : 1.0f;
-  if (st.uniform) {  // exact when the scale is the same on every axis (always in the rest pose: 1)
-    const glm::mat3& k = poses[0].scale;
-    if (k[0][0] == k[1][1] && k[1][1] == k[2][2]) st.s = k[0][0];
+  if (count == 0) return st;
+  const glm::mat3& k0 = poses[0].scale;
+  const float s0 = (k0[0][0] + k0[1][1] + k0[2][2]) / 3.0f;
+  st.uniform = s0 > 0.0f;
+  const float tol = 1e-5f * s0;
+  for (uint32_t j = 0; j < count && st.uniform; ++j) {
+    const glm::mat3& k = poses[j].scale;
+    for (int c = 0; c < 3 && st.uniform; ++c)
+      for (int i = 0; i < 3; ++i)
+        if (std::fabs(k[c][i] - (c == i ? s0 : 0.0f)) > tol) {
+          st.uniform = false;
+          break;
+        }
   }
+  st.s = st.uniform ? s0 : 1.0f;
+  if (st.uniform && k0[0][0] == k0[1][1] && k0[1][1] == k0[2][2]) st.s = k0[0][0];
   return st;
 }
 
