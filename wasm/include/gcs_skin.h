@@ -17,6 +17,12 @@
  * A successful call sets the code to GCS_OK. A rejected call never changes the object it was
  * given: the object stays usable.
  *
+ * Memory: wasm memory grows up to 4 GiB; pointers are unsigned 32-bit offsets (read them as
+ * unsigned in JavaScript: `>>> 0`). The core is built without C++ exceptions, so a failed
+ * allocation inside a build would abort the module: every gcs_rig_create / gcs_build_* first
+ * reserves an upper bound of its peak memory (one malloc, freed at once) and fails with
+ * GCS_ERR_OUT_OF_MEMORY when it cannot be had. gcs_deformer_deform never allocates.
+ *
  * Conventions: matrices are column-major float[16] (glTF, three.js, GLM). Positions and normals
  * are float[3] per vertex, interleaved (x, y, z). Indices are uint32 triangle lists.
  * Pointers handed out (positions, normals, indices, …) point into wasm memory: they stay valid
@@ -80,7 +86,8 @@ typedef struct GcsRig GcsRig;
  *   weights          vertexCount × 4 floats, ≥ 0, finite, sum > 0 (normalised on copy).
  *   parents          jointCount int32: the parent joint id, or -1 for a root; no cycles.
  *   inverseBind      jointCount × 16 floats (column-major): glTF inverse bind matrices,
- *                    mapping mesh space to joint space in the bind pose; invertible, finite.
+ *                    mapping mesh space to joint space in the bind pose; finite (else
+ *                    GCS_ERR_NON_FINITE) and invertible (else GCS_ERR_DEGENERATE).
  *   jointCount       1 .. GCS_MAX_JOINTS.
  * Returns a rig handle, or null with the error recorded.
  */

@@ -6,6 +6,7 @@
 #include "../include/gcs_skin.h"
 #include "error.h"
 #include "gcs_model.h"
+#include "memory.h"
 #include "reference_deformers.h"
 #include "rig.h"
 
@@ -33,6 +34,9 @@ GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t ve
                        const float* weights, const int32_t* parents, const float* inverseBind,
                        uint32_t jointCount) {
   gcs::clearError();
+  if (vertexCount <= GCS_MAX_VERTICES && jointCount <= GCS_MAX_JOINTS &&
+      !gcs::reserveMemory(gcs::rigPeakBytes(vertexCount, indexCount, jointCount), "the rig"))
+    return nullptr;
   GcsRig* handle = new (std::nothrow) GcsRig();
   if (!handle) {
     fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while creating a rig");
@@ -74,6 +78,9 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
     fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)", criterion);
     return nullptr;
   }
+  const gcs::Rig& r = rig->rig;
+  if (!gcs::reserveMemory(gcs::gcsPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the GCS model"))
+    return nullptr;
   gcs::GcsSettings settings;
   settings.sections = sections;
   settings.criterion = GcsCriterion(criterion);
@@ -86,12 +93,18 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
 GcsDeformer* gcs_build_lbs(const GcsRig* rig) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
+  const gcs::Rig& r = rig->rig;
+  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the LBS deformer"))
+    return nullptr;
   return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_LBS));
 }
 
 GcsDeformer* gcs_build_dqs(const GcsRig* rig) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
+  const gcs::Rig& r = rig->rig;
+  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the DQS deformer"))
+    return nullptr;
   return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_DQS));
 }
 

@@ -1,8 +1,10 @@
 // The C API of the classic cross-section model (gcs_skin.h, "classic cross-sections").
 #include <cmath>
+#include <vector>
 #include "../include/gcs_skin.h"
 #include "classic_model.h"
 #include "error.h"
+#include "memory.h"
 
 namespace {
 gcs::ClassicModel* asClassic(const GcsDeformer* d) {
@@ -17,6 +19,22 @@ GcsDeformer* gcs_build_classic(const GcsRig* rig, uint32_t contours, uint32_t ra
   if (!rig) {
     gcs::fail(GCS_ERR_INVALID_ARGUMENT, "the rig is null (destroyed or never created)");
     return nullptr;
+  }
+  {
+    // Parts (joints owning a vertex by dominant weight): what the contour count multiplies.
+    const gcs::Rig& r = rig->rig;
+    std::vector<uint8_t> owns;
+    uint64_t parts = 0;
+    if (r.jointCount <= GCS_MAX_JOINTS) {
+      owns.assign(r.jointCount, 0);
+      for (uint32_t v = 0; v < r.vertexCount; ++v) {
+        uint32_t j = r.dominantJoint(v);
+        if (j < r.jointCount && !owns[j]) owns[j] = 1, ++parts;
+      }
+    }
+    const uint64_t c = contours <= GCS_CLASSIC_MAX_CONTOURS ? contours : 0, k = rays <= GCS_CLASSIC_MAX_RAYS ? rays : 0;
+    if (!gcs::reserveMemory(gcs::classicPeakBytes(r.vertexCount, r.indices.size(), parts, c, k), "the classic model"))
+      return nullptr;
   }
   gcs::ClassicModel* model = gcs::buildClassic(rig->rig, contours, rays, bulge);
   if (!model) return nullptr;

@@ -183,7 +183,7 @@ bool buildRig(const float* positions, const float* normals, uint32_t vertexCount
         for (int r = 0; r < 4; ++r) m[c][r] = inverseBind[16 * j + 4 * c + r];
       float det = glm::determinant(m);
       if (!(std::fabs(det) > 1e-12f))
-        return fail(GCS_ERR_NON_FINITE, "the inverse bind matrix of joint %u is not invertible", j);
+        return fail(GCS_ERR_DEGENERATE, "the inverse bind matrix of joint %u is singular (not invertible): the joint has no bind pose", j);
       rig.inverseBind[j] = m;
       rig.bind[j] = glm::inverse(m);
       rig.jointCentres[j] = glm::vec3(rig.bind[j][3]);

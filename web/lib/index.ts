@@ -173,10 +173,10 @@ export class GcsSkin {
       // Negative or fractional ids must not wrap silently into valid ones: map them out of range.
       for (let i = 0; i < values.length; i++) {
         const v = values[i];
-        view[(ptr >> 2) + i] = Number.isInteger(v) && v >= 0 && v <= 0xffffffff ? v : 0xffffffff;
+        view[(ptr >>> 2) + i] = Number.isInteger(v) && v >= 0 && v <= 0xffffffff ? v : 0xffffffff;
       }
     } else {
-      view.set(values as ArrayLike<number>, ptr >> 2);
+      view.set(values as ArrayLike<number>, ptr >>> 2);
     }
     return ptr;
   }
@@ -218,7 +218,12 @@ export class GcsSkin {
       const ib = this.copyIn(inverseBindMatrices, 'f32'); ptrs.push(ib);
       const handle = this.core.gcs_rig_create(p, n, vertexCount, ix, indices.length, jt, wt, pa, ib, jointCount);
       if (!handle) this.raise('the rig was rejected');
-      return new Rig(this, handle);
+      try {
+        return new Rig(this, handle);
+      } catch (e) {
+        this.core.gcs_rig_destroy(handle); // nothing made here outlives a failure
+        throw e;
+      }
     } finally {
       for (const ptr of ptrs) this.core.gcs_free(ptr);
     }

@@ -77,7 +77,29 @@ export async function instantiateCore(source?: WasmSource): Promise<CoreExports>
     },
   };
   const instance = await WebAssembly.instantiate(module, imports);
-  exports = instance.exports as unknown as CoreExports;
+  exports = unsignedResults(instance.exports as unknown as CoreExports);
   exports._initialize();
   return exports;
+}
+
+// Functions whose result is a pointer or a uint32 count. wasm returns i32, which JavaScript reads
+// as signed: above 2 GiB of memory a pointer would come back negative (and typed-array views on it
+// throw RangeError). `>>> 0` reads it as the unsigned value the C API means.
+const UNSIGNED_RESULTS = [
+  'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
+  'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
+  'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
+  'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
+  'gcs_gcs_section_matrices', 'gcs_classic_part_count', 'gcs_classic_parts',
+] as const;
+
+function unsignedResults(raw: CoreExports): CoreExports {
+  const core = { ...raw } as CoreExports;
+  const table = core as unknown as Record<string, (...args: number[]) => number>;
+  const source = raw as unknown as Record<string, (...args: number[]) => number>;
+  for (const name of UNSIGNED_RESULTS) {
+    const f = source[name];
+    table[name] = (...args: number[]) => f(...args) >>> 0;
+  }
+  return core;
 }

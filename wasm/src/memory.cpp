@@ -1,0 +1,40 @@
+#include "memory.h"
+#include <cstdlib>
+#include "error.h"
+
+namespace gcs {
+
+// The reserved block escapes through this volatile slot: without it the compiler may remove a
+// malloc whose result is only tested and freed, and assume it succeeded.
+static void* volatile reserved = nullptr;
+
+bool reserveMemory(uint64_t bytes, const char* what) {
+  // Leave room below 4 GiB for what the caller holds besides (and for size_t being 32 bits).
+  const uint64_t limit = 0xF0000000ull;
+  reserved = bytes < limit ? std::malloc(size_t(bytes)) : nullptr;
+  void* p = reserved;
+  if (!p)
+    return fail(GCS_ERR_OUT_OF_MEMORY, "out of memory: %s needs about %llu MB and wasm memory cannot grow that far (4 GB at most)",
+                what, (unsigned long long)(bytes >> 20));
+  std::free(p);
+  reserved = nullptr;
+  return true;
+}
+
+// The estimates count every array a build holds at its peak (see rig.cpp, gcs_model.cpp,
+// reference_deformers.cpp, classic_model.cpp), with a 1.5× margin for vector growth and the heap.
+uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
+  return (v * (12 + 12 + 16 + 16 + 12) + i * 4 + j * (64 * 2 + 12 + 4)) * 3 / 2 + 65536;
+}
+uint64_t gcsPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
+  return (v * 260 + i * 8 + j * 4096) * 3 / 2 + 65536;
+}
+uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
+  return (v * (24 + 24 + 24 + 16 + 16 + 4) + i * 4 + j * 128) * 3 / 2 + 65536;
+}
+uint64_t classicPeakBytes(uint64_t v, uint64_t i, uint64_t parts, uint64_t contours, uint64_t rays) {
+  const uint64_t points = parts * (contours + 2) * (rays + 1);
+  return (v * 300 + i * 24 + points * 96) * 3 / 2 + 65536;
+}
+
+}  // namespace gcs
