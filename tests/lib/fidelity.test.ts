@@ -238,3 +238,34 @@ describe('default GCS on the default human and on scaled rigs', () => {
     rig.dispose();
   });
 });
+
+describe('finite output for finite input (every method)', () => {
+  test('bones scaled by 0, 1e-30, 1e-8, 1e8 and 1e20, and mirrored: no NaN or infinity, unit normals', () => {
+    const tube = makeTube({ band: 0.3 });
+    const rig = gcs.createRig(tube.input);
+    const deformers: [string, Deformer][] = [
+      ['gcs', rig.buildGcs()], ['gcs smooth', rig.buildGcs({ smooth: true })], ['gcs y', rig.buildGcs({ criterion: 'y' })],
+      ['gcs axial smooth twist', rig.buildGcs({ criterion: 'axial', smooth: true, twistSpread: true })],
+      ['classic', rig.buildClassic()], ['lbs', rig.buildLbs()], ['dqs', rig.buildDqs()],
+    ];
+    const bend = rotationAbout(tube.joint, new THREE.Vector3(0, 0, 1), 1.1);
+    for (const s of [0, 1e-30, 1e-8, 1e8, 1e20, -1]) {
+      // Joint 1 scaled by s about its own centre (s = -1: a mirror).
+      const j = tube.joint;
+      const scaled = bend.clone().multiply(new THREE.Matrix4().makeTranslation(j.x, j.y, j.z))
+        .multiply(new THREE.Matrix4().makeScale(s, s, s)).multiply(new THREE.Matrix4().makeTranslation(-j.x, -j.y, -j.z));
+      const skin = tubeSkin(scaled);
+      for (const [name, d] of deformers) {
+        d.deform(skin);
+        const p = d.positions, n = d.normals;
+        let bad = 0, worstNormal = 0;
+        for (let i = 0; i < p.length; i++) if (!Number.isFinite(p[i]) || !Number.isFinite(n[i])) bad++;
+        for (let o = 0; o < d.vertexCount; o++) worstNormal = Math.max(worstNormal, Math.abs(Math.hypot(n[3 * o], n[3 * o + 1], n[3 * o + 2]) - 1));
+        expect(bad, `${name}, scale ${s}`).toBe(0);
+        expect(worstNormal, `${name}, scale ${s}`).toBeLessThan(NORMAL_TOLERANCE);
+      }
+    }
+    for (const [, d] of deformers) d.dispose();
+    rig.dispose();
+  });
+});
