@@ -21,7 +21,8 @@
  * unsigned in JavaScript: `>>> 0`). The core is built without C++ exceptions, so a failed
  * allocation inside a build would abort the module: every gcs_rig_create / gcs_build_* first
  * reserves an upper bound of its peak memory (one malloc, freed at once) and fails with
- * GCS_ERR_OUT_OF_MEMORY when it cannot be had. gcs_deformer_deform never allocates.
+ * GCS_ERR_OUT_OF_MEMORY when it cannot be had (as does gcs_deformer_set_morph_targets).
+ * gcs_deformer_deform never allocates.
  *
  * Conventions: matrices are column-major float[16] (glTF, three.js, GLM). Positions and normals
  * are float[3] per vertex, interleaved (x, y, z). Indices are uint32 triangle lists.
@@ -172,6 +173,25 @@ uint32_t gcs_deformer_kind(const GcsDeformer* deformer);
  * (then the output arrays keep the previous frame).
  */
 int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount);
+
+/*
+ * Morph targets (blend shapes), applied to the rest mesh before skinning, as three.js does
+ * (morph, then skin). GCS, LBS and DQS only (the classic model resamples: GCS_ERR_INVALID_ARGUMENT).
+ *   deltas        targetCount × vertexCount × 3 floats: position deltas in the RIG's vertex order
+ *                 (glTF morph targets, mesh space); finite.
+ *   normalDeltas  the same for normals, or null (normals then stay the rest normals).
+ *   targetCount   0 .. GCS_MAX_MORPH_TARGETS; 0 removes every target (the rest mesh is restored).
+ *   vertexCount   must equal the deformer's vertex count (the rig's).
+ * Replaces any previous targets; every influence starts at 0. Returns 1, or 0 with the error
+ * recorded (nothing changed).
+ */
+#define GCS_MAX_MORPH_TARGETS 256
+int gcs_deformer_set_morph_targets(GcsDeformer* deformer, const float* deltas, const float* normalDeltas,
+                                   uint32_t targetCount, uint32_t vertexCount);
+/* The influence of each target (three.js's morphTargetInfluences), finite, targetCount of them;
+   taken at the next gcs_deformer_deform, which re-morphs the rest mesh only when they changed
+   (O(vertices × non-zero targets) then). Returns 1, or 0 with the error recorded. */
+int gcs_deformer_set_morph_influences(GcsDeformer* deformer, const float* influences, uint32_t targetCount);
 
 /* The output mesh. Arrays are owned by the deformer and stay at the same address for its life. */
 uint32_t gcs_deformer_vertex_count(const GcsDeformer* deformer);

@@ -1,8 +1,10 @@
 // The C API (gcs_skin.h): argument checks, error recording, and nothing else.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <vector>
 #include "../include/gcs_skin.h"
 #include "error.h"
 #include "gcs_model.h"
@@ -130,7 +132,71 @@ int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32
       return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u contains NaN or infinity", i / 16);
   // glm::mat4 is 16 floats, column-major, no padding: the array can be read in place.
   static_assert(sizeof(glm::mat4) == 16 * sizeof(float), "glm::mat4 must be 16 packed floats");
+  d.applyMorphs();
   d.deform(reinterpret_cast<const glm::mat4*>(skinMatrices));
+  return 1;
+}
+
+int gcs_deformer_set_morph_targets(GcsDeformer* deformer, const float* deltas, const float* normalDeltas,
+                                   uint32_t targetCount, uint32_t vertexCount) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  gcs::Deformer& d = *deformer->impl;
+  std::vector<float>* rest = d.morphableRestPositions();
+  std::vector<float>* restN = d.morphableRestNormals();
+  if (!rest || !restN || d.sourceVertex.size() != d.vertexCount)
+    return fail(GCS_ERR_INVALID_ARGUMENT, "morph targets apply to the GCS, LBS and DQS deformers; the classic model resamples the mesh");
+  if (targetCount > GCS_MAX_MORPH_TARGETS)
+    return fail(GCS_ERR_OUT_OF_RANGE, "at most %d morph targets; got %u", GCS_MAX_MORPH_TARGETS, targetCount);
+  if (targetCount > 0 && !deltas) return fail(GCS_ERR_INVALID_ARGUMENT, "the morph target deltas are null");
+  if (targetCount > 0 && vertexCount != d.vertexCount)
+    return fail(GCS_ERR_LENGTH_MISMATCH, "morph targets have %u vertices each, but the mesh has %u", vertexCount, d.vertexCount);
+  const size_t n = size_t(d.vertexCount) * 3;
+  if (targetCount > 0) {
+    if (!gcs::allFinite(deltas, n * targetCount))
+      return fail(GCS_ERR_NON_FINITE, "a morph target position delta is NaN or infinite");
+    if (normalDeltas && !gcs::allFinite(normalDeltas, n * targetCount))
+      return fail(GCS_ERR_NON_FINITE, "a morph target normal delta is NaN or infinite");
+    if (!gcs::reserveMemory(uint64_t(n) * 4 * (uint64_t(targetCount) * (normalDeltas ? 2 : 1) + 2) * 3 / 2 + 4096, "the morph targets"))
+      return 0;
+  }
+  // Back to the unmorphed rest first (so that replacing or removing targets starts from it).
+  if (d.morphTargetCount > 0) {
+    std::copy(d.morphBasePositions.begin(), d.morphBasePositions.end(), rest->begin());
+    std::copy(d.morphBaseNormals.begin(), d.morphBaseNormals.end(), restN->begin());
+  }
+  d.morphTargetCount = targetCount;
+  d.morphInfluences.assign(targetCount, 0.0f);
+  d.morphApplied.assign(targetCount, 0.0f);
+  if (targetCount == 0) {
+    d.morphBasePositions.clear(), d.morphBaseNormals.clear(), d.morphDeltas.clear(), d.morphNormalDeltas.clear();
+    return 1;
+  }
+  d.morphBasePositions = *rest;
+  d.morphBaseNormals = *restN;
+  // Deltas come in rig vertex order; the deformer stores its vertices in its own order.
+  d.morphDeltas.assign(n * targetCount, 0.0f);
+  d.morphNormalDeltas.assign(normalDeltas ? n * targetCount : 0, 0.0f);
+  for (uint32_t t = 0; t < targetCount; ++t)
+    for (uint32_t o = 0; o < d.vertexCount; ++o) {
+      const uint32_t v = d.sourceVertex[o];
+      for (int c = 0; c < 3; ++c) {
+        d.morphDeltas[t * n + 3 * size_t(o) + c] = deltas[t * n + 3 * size_t(v) + c];
+        if (normalDeltas) d.morphNormalDeltas[t * n + 3 * size_t(o) + c] = normalDeltas[t * n + 3 * size_t(v) + c];
+      }
+    }
+  return 1;
+}
+
+int gcs_deformer_set_morph_influences(GcsDeformer* deformer, const float* influences, uint32_t targetCount) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  gcs::Deformer& d = *deformer->impl;
+  if (targetCount != d.morphTargetCount)
+    return fail(GCS_ERR_LENGTH_MISMATCH, "got %u morph influences, but the deformer has %u morph targets", targetCount, d.morphTargetCount);
+  if (targetCount > 0 && !influences) return fail(GCS_ERR_INVALID_ARGUMENT, "the morph influences are null");
+  if (!gcs::allFinite(influences, targetCount)) return fail(GCS_ERR_NON_FINITE, "a morph influence is NaN or infinite");
+  std::copy(influences, influences + targetCount, d.morphInfluences.begin());
   return 1;
 }
 

@@ -23,6 +23,18 @@ class Deformer {
   std::vector<uint32_t> indices;
   std::vector<uint32_t> sourceVertex;  // empty when output vertices have no single source
 
+  // Morph targets (blend shapes), applied to the rest mesh before skinning (three.js's order).
+  // A deformer whose output vertices are rig vertices exposes its rest arrays (output order) here;
+  // the classic model, which resamples, returns null and takes no morph targets.
+  virtual std::vector<float>* morphableRestPositions() { return nullptr; }
+  virtual std::vector<float>* morphableRestNormals() { return nullptr; }
+  uint32_t morphTargetCount = 0;
+  std::vector<float> morphBasePositions, morphBaseNormals;  // the unmorphed rest (output order)
+  std::vector<float> morphDeltas, morphNormalDeltas;        // target × output vertex × 3
+  std::vector<float> morphInfluences, morphApplied;         // requested and last applied
+  // Brings the rest arrays to base + Σ influence · delta when the influences changed.
+  void applyMorphs();
+
   void allocateOutput(uint32_t count) {
     vertexCount = count;
     positions.assign(size_t(count) * 3 + 1, 0.0f);

@@ -51,6 +51,8 @@ class GcsDeformerImpl final : public Deformer {
  public:
   GcsDeformerKind kind() const override { return GCS_KIND_GCS; }
   void deform(const glm::mat4* skin) override;
+  std::vector<float>* morphableRestPositions() override { return &restPositions; }
+  std::vector<float>* morphableRestNormals() override { return &restNormals; }
   float stat(GcsStat which) const override;
 
   GcsSettings settings;

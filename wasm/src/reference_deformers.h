@@ -11,6 +11,8 @@ class SkinningDeformer final : public Deformer {
   explicit SkinningDeformer(GcsDeformerKind k) : kind_(k) {}
   GcsDeformerKind kind() const override { return kind_; }
   void deform(const glm::mat4* skin) override;
+  std::vector<float>* morphableRestPositions() override { return &restPositions; }
+  std::vector<float>* morphableRestNormals() override { return &restNormals; }
   float stat(GcsStat which) const override;
 
   std::vector<float> restPositions, restNormals;

@@ -340,6 +340,9 @@ export class Deformer {
   private positionsView: Float32Array;
   private normalsView: Float32Array;
   private skinView: Float32Array;
+  private morphPtr = 0;
+  private morphCount = 0;
+  private morphView: Float32Array = new Float32Array(0);
 
   /** @internal */
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
@@ -408,6 +411,63 @@ export class Deformer {
     if (!this.gcs.core.gcs_deformer_deform(h, this.skinPtr, this.jointCount)) this.gcs.raise('deform failed');
   }
 
+  /**
+   * Morph targets (blend shapes) applied to the rest mesh before skinning, as three.js does.
+   * `deltas[t]`: target t's position deltas, vertexCount × 3 in the RIG's vertex order (glTF /
+   * three.js `geometry.morphAttributes.position` with `morphTargetsRelative`); `normalDeltas`
+   * likewise or omitted. Replaces previous targets; an empty list removes them. GCS, LBS and DQS
+   * (the classic model resamples the mesh: INVALID_ARGUMENT). Build time only: it copies.
+   */
+  setMorphTargets(deltas: readonly ArrayLike<number>[], normalDeltas?: readonly ArrayLike<number>[] | null): void {
+    const h = this.live();
+    const T = deltas.length, V = this.vertexCount;
+    if (normalDeltas && normalDeltas.length !== T)
+      throw new GcsError('LENGTH_MISMATCH', `${normalDeltas.length} normal delta arrays for ${T} morph targets`);
+    for (const [t, d] of deltas.entries())
+      if (!d || d.length !== V * 3) throw new GcsError('LENGTH_MISMATCH', `morph target ${t} has ${d?.length ?? 0} numbers; ${V * 3} (3 per vertex) are expected`);
+    normalDeltas?.forEach((d, t) => {
+      if (!d || d.length !== V * 3) throw new GcsError('LENGTH_MISMATCH', `morph target ${t}'s normal deltas have ${d?.length ?? 0} numbers; ${V * 3} are expected`);
+    });
+    const flat = (arrays: readonly ArrayLike<number>[]) => {
+      const out = new Float32Array(T * V * 3);
+      arrays.forEach((a, t) => out.set(a, t * V * 3));
+      return out;
+    };
+    const ptrs: number[] = [];
+    try {
+      const p = T ? this.gcs.copyIn(flat(deltas), 'f32') : 0; if (p) ptrs.push(p);
+      const n = T && normalDeltas ? this.gcs.copyIn(flat(normalDeltas), 'f32') : 0; if (n) ptrs.push(n);
+      const influences = this.gcs.core.gcs_alloc(Math.max(4, T * 4));
+      if (!influences) this.gcs.raise('out of memory for the morph influences');
+      if (!this.gcs.core.gcs_deformer_set_morph_targets(h, p, n, T, V)) {
+        this.gcs.core.gcs_free(influences);
+        this.gcs.raise('the morph targets were rejected');
+      }
+      if (this.morphPtr) this.gcs.core.gcs_free(this.morphPtr);
+      this.morphPtr = influences;
+      this.morphCount = T;
+      this.morphView = this.gcs.viewF32(influences, T);
+    } finally {
+      for (const ptr of ptrs) this.gcs.core.gcs_free(ptr);
+    }
+  }
+
+  /** Morph influences for the next `deform` (three.js's `morphTargetInfluences`); no allocation. */
+  setMorphInfluences(influences: ArrayLike<number>): void {
+    const h = this.live();
+    if (!influences || influences.length !== this.morphCount)
+      throw new GcsError('LENGTH_MISMATCH', `got ${influences?.length ?? 0} morph influences, but the deformer has ${this.morphCount} morph targets`);
+    if (this.morphCount === 0) return;
+    if (this.morphView.buffer !== this.gcs.memory.buffer) this.morphView = this.gcs.viewF32(this.morphPtr, this.morphCount);
+    this.morphView.set(influences);
+    if (!this.gcs.core.gcs_deformer_set_morph_influences(h, this.morphPtr, this.morphCount)) this.gcs.raise('the morph influences were rejected');
+  }
+
+  /** Number of morph targets set with setMorphTargets. */
+  get morphTargetCount(): number {
+    return this.morphCount;
+  }
+
   /** Sections (GCS) or contours (classic) in the model; 0 for LBS/DQS. */
   get sectionCount(): number {
     return this.gcs.core.gcs_deformer_stat(this.live(), 0);
@@ -422,6 +482,8 @@ export class Deformer {
     if (!this.handle) return;
     this.gcs.core.gcs_deformer_destroy(this.handle);
     this.gcs.core.gcs_free(this.skinPtr);
+    if (this.morphPtr) this.gcs.core.gcs_free(this.morphPtr);
+    this.morphPtr = 0;
     this.handle = 0;
   }
 

@@ -25,6 +25,8 @@ export interface CoreExports {
   gcs_deformer_destroy(d: number): void;
   gcs_deformer_kind(d: number): number;
   gcs_deformer_deform(d: number, skin: number, jointCount: number): number;
+  gcs_deformer_set_morph_targets(d: number, deltas: number, normalDeltas: number, targets: number, vertices: number): number;
+  gcs_deformer_set_morph_influences(d: number, influences: number, targets: number): number;
   gcs_deformer_vertex_count(d: number): number;
   gcs_deformer_positions(d: number): number;
   gcs_deformer_normals(d: number): number;
