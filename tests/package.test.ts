@@ -1,7 +1,7 @@
 // Packaging: the `npm pack` tarball, installed into an empty folder, imports and deforms in node
 // through the package's `exports` map (no access to this repository's sources).
-import { execFileSync } from 'node:child_process';
-import { cpSync, mkdtempSync, readdirSync, symlinkSync, writeFileSync } from 'node:fs';
+import { execFileSync, spawnSync } from 'node:child_process';
+import { cpSync, mkdtempSync, readFileSync, readdirSync, symlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { expect, test } from 'vitest';
@@ -11,7 +11,7 @@ const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
 
 test('the npm tarball installs into an empty folder, imports and deforms', () => {
   const dir = mkdtempSync(join(tmpdir(), 'gcs-skin-pack-'));
-  // Pack from a copy of the package sources: `prepare` rebuilds dist/ there, never under the
+  // Pack from a copy of the package sources: `prepack` rebuilds dist/ there, never under the
   // feet of other test files that use this checkout's dist/.
   const src = join(dir, 'src');
   for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'bin', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
@@ -23,7 +23,14 @@ test('the npm tarball installs into an empty folder, imports and deforms', () =>
   const app = join(dir, 'app');
   execFileSync('mkdir', ['-p', app]);
   writeFileSync(join(app, 'package.json'), JSON.stringify({ name: 'app', private: true, type: 'module' }));
-  execFileSync(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', join(dir, tarball!)], { cwd: app, stdio: ['ignore', 'pipe', 'pipe'] });
+  // No install script runs in a consumer's install (dist/ ships built): npm warns about none.
+  const install = spawnSync(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', '--foreground-scripts', join(dir, tarball!)], { cwd: app, encoding: 'utf8' });
+  expect(install.status).toBe(0);
+  expect(`${install.stdout}\n${install.stderr}`).not.toMatch(/gcs-skin@[^\n]*(prepare|install|postinstall)|install script/i);
+  const installed = JSON.parse(readFileSync(join(app, 'node_modules/gcs-skin/package.json'), 'utf8'));
+  expect(Object.keys(installed.scripts ?? {}).filter((k) => /^(pre|post)?install$|^prepare$/.test(k))).toEqual([]);
+  // The types carry no @internal members.
+  expect(readFileSync(join(app, 'node_modules/gcs-skin/dist/index.d.ts'), 'utf8')).not.toMatch(/@internal|refreshViews|copyIn/);
   writeFileSync(join(app, 'main.mjs'), `
     import { initGcsSkin, GcsError } from 'gcs-skin';
     const gcs = await initGcsSkin();
