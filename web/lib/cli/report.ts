@@ -7,7 +7,7 @@ import type * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../index.js';
 import { rigInputFromSkinnedMesh } from '../three.js';
-import { characterHeight, loadGltfFile, sampleClip } from './gltf-node.js';
+import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
 } from '../measure.js';
@@ -78,10 +78,26 @@ export interface Report {
   /** The character: all skinned meshes of the scene; height in world units (bind pose, bounding box: gltf-node characterHeight). */
   character: { height: number; skinnedMeshes: number };
   meshes: MeshReport[];
+  /** What the glTF loaders (gltf-transform, three's GLTFLoader) warned about; [] if nothing. */
+  warnings: string[];
 }
 
-/** A failure the command reports as one line on stderr with exit code 2. */
-export class ReportError extends Error {}
+/**
+ * A failure the command reports as one line on stderr (`gcs-skin report: <message> [<code>]`) with
+ * exit code 2. `code`: a GltfError code for a bad file (docs/report-json.md, "Errors"), the core's
+ * GcsError code for a mesh createRig rejects, or NO_SKINNED_MESH, NO_CLIP, USAGE. `cause`: the
+ * GltfError or GcsError, when there is one.
+ */
+export class ReportError extends Error {
+  readonly code: string;
+  constructor(message: string, code = 'USAGE', options?: { cause?: unknown }) {
+    super(message, options);
+    this.name = 'ReportError';
+    this.code = code;
+  }
+}
+
+const oneLine = (s: string) => s.replace(/\s*\n\s*/g, ' ').trim();
 
 const round = (x: number, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)) : x);
 const roundOrNull = (x: number | null) => (x === null ? null : round(x));
@@ -94,24 +110,27 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
   try {
     model = await loadGltfFile(file);
   } catch (e) {
-    throw new ReportError(`cannot read ${file}: ${(e as Error).message.replace(/\s*\n\s*/g, ' ').trim()}`);
+    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
+    throw new ReportError(`cannot read ${file}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
   }
-  if (!model.skinnedMeshes.length) throw new ReportError(`${file} has no skinned mesh (no skin, joints and weights): nothing to deform`);
+  if (!model.skinnedMeshes.length)
+    throw new ReportError(`${file} has no skinned mesh (no skin, joints and weights): nothing to deform`, 'NO_SKINNED_MESH');
   let clips = model.clips;
   if (options.clip !== undefined) {
     clips = clips.filter((c) => c.name === options.clip);
     if (!clips.length)
-      throw new ReportError(`${file} has no clip named '${options.clip}' (clips: ${model.clips.map((c) => c.name).join(', ') || 'none'})`);
+      throw new ReportError(`${file} has no clip named '${options.clip}' (clips: ${model.clips.map((c) => c.name).join(', ') || 'none'})`, 'NO_CLIP');
   }
   gcs ??= await initGcsSkin();
   const height = characterHeight(model.skinnedMeshes);
   const meshes: MeshReport[] = [];
   model.skinnedMeshes.forEach((mesh, i) => {
-    meshes.push(reportMesh(gcs!, mesh, clips, { sections, frames, timeMs: options.timeMs ?? 300, height: height.meshUnits[i], worldScale: height.scales[i] }));
+    meshes.push(reportMesh(gcs!, file, mesh, clips, { sections, frames, timeMs: options.timeMs ?? 300, height: height.meshUnits[i], worldScale: height.scales[i] }));
   });
   return {
     file, options: { sections, frames, clip: options.clip ?? null },
     character: { height: round(height.world, 6), skinnedMeshes: model.skinnedMeshes.length }, meshes,
+    warnings: model.warnings.map(oneLine),
   };
 }
 
@@ -124,18 +143,23 @@ function roundFidelity(f: Fidelity): Fidelity {
   };
 }
 
-function reportMesh(gcs: GcsSkin, mesh: THREE.SkinnedMesh, clips: THREE.AnimationClip[], s: MeshSettings): MeshReport {
+function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: THREE.AnimationClip[], s: MeshSettings): MeshReport {
+  // The core's own code and sentence (GcsError), after the file and the mesh.
+  const unusable = (e: unknown, what: string) => {
+    if (!(e instanceof GcsError)) throw e;
+    return new ReportError(`${file}: mesh '${mesh.name}' ${what}: ${oneLine(e.message)}`, e.code, { cause: e });
+  };
   let input: RigInput;
   try {
     input = rigInputFromSkinnedMesh(mesh);
   } catch (e) {
-    throw new ReportError(`mesh '${mesh.name}': ${(e as Error).message}`);
+    throw unusable(e, 'cannot be read as a skin');
   }
   let rig;
   try {
     rig = gcs.createRig(input);
   } catch (e) {
-    throw new ReportError(`mesh '${mesh.name}' is not a usable skin: ${(e as Error).message}`);
+    throw unusable(e, 'is not a usable skin');
   }
   // The character's height in this mesh's units; the mesh's own extent if the character has none.
   const height = s.height > 0 && Number.isFinite(s.height) ? s.height : rig.height;
@@ -225,6 +249,7 @@ function table(rows: string[][]): string {
 export function formatReport(r: Report): string {
   const out: string[] = [`gcs-skin report: ${r.file}`,
     `character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`];
+  for (const w of r.warnings) out.push(`loader warning: ${w}`);
   for (const m of r.meshes) {
     const c = m.counts;
     out.push('', `mesh '${m.name}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
@@ -311,7 +336,7 @@ export async function run(argv: string[]): Promise<number> {
     r = await report(args.file, args.options);
   } catch (e) {
     if (e instanceof ReportError) {
-      process.stderr.write(`gcs-skin report: ${e.message.replace(/\s*\n\s*/g, ' ')}\n`);
+      process.stderr.write(`gcs-skin report: ${oneLine(e.message)} [${e.code}]\n`);
       return 2;
     }
     throw e;

@@ -1,0 +1,520 @@
+// A small validator of glTF 2.0 files, run on the bytes before @gltf-transform/core and three's
+// GLTFLoader see them (web/lib/cli/gltf-node.ts). It is not the Khronos validator: it checks what
+// would otherwise crash those loaders with a message about their internals ("Invalid typed array
+// length", "Offset is outside the bounds of the DataView", "Maximum call stack size exceeded"),
+// be read as something else (a wrong magic read as JSON), or be silently repaired (a node with two
+// parents re-parented). Every failure is a GltfError: a `code`, the file, `where` (a JSON path such
+// as "/accessors/3", or a byte offset) and one sentence naming the file, what is wrong and where.
+// The codes are listed in docs/report-json.md ("Errors").
+//
+// Checked:
+// - the GLB container: the 12-byte header (magic 'glTF', version 2, total length = file size), the
+//   chunks (8-byte headers, lengths inside the file, JSON first, at most one BIN);
+// - the JSON: syntax, asset.version 2.x, no required extension (the loader registers none);
+// - buffers: the declared byteLength against the data (BIN chunk, data: URI or external file);
+// - buffer views inside their buffers, accessors (count, type, componentType, byte stride, sparse
+//   parts) inside their buffer views;
+// - references between objects (accessor → buffer view, node → mesh/skin/children, …) exist;
+// - mesh primitives: attributes of one count;
+// - the node graph: no node its own child, no cycle, one parent at most, scene roots are roots;
+// - skins: joints non-empty, unique, existing nodes (their hierarchy is the node graph's, acyclic
+//   by the above); inverse bind matrices MAT4 FLOAT, one per joint; a skinned node has a mesh whose
+//   every primitive has JOINTS_0 and WEIGHTS_0.
+
+/** What is wrong with a glTF file (docs/report-json.md, "Errors"). */
+export type GltfErrorCode =
+  | 'UNREADABLE'      // the file, or a buffer's external file, cannot be read
+  | 'NOT_GLTF'        // neither binary glTF (magic 'glTF') nor a glTF 2.0 JSON document
+  | 'TRUNCATED'       // shorter than its GLB header, or a buffer's data shorter than its byteLength
+  | 'BAD_CONTAINER'   // GLB version or chunk layout wrong
+  | 'BAD_JSON'        // the JSON (chunk) does not parse
+  | 'BAD_STRUCTURE'   // a property of the wrong type or value (count, type, stride, matrix, …)
+  | 'BAD_REFERENCE'   // an index to an object the file does not have
+  | 'OUT_OF_BOUNDS'   // an accessor past its buffer view, a buffer view past its buffer
+  | 'NODE_CYCLE'      // a node its own child or ancestor (joint hierarchies included)
+  | 'NODE_HIERARCHY'  // a node with two parents, a scene root that is someone's child
+  | 'BAD_SKIN'        // a skin or skinned node that cannot be skinned
+  | 'UNSUPPORTED'     // a required extension the loader does not read
+  | 'LOAD_FAILED';    // passed these checks but the loaders still failed (their message follows)
+
+/** A glTF file that cannot be loaded, with a stable `code` and a one-line sentence. */
+export class GltfError extends Error {
+  readonly code: GltfErrorCode;
+  /** The file as given. */
+  readonly file: string;
+  /** Where: a JSON path ("/nodes/3/children"), "byte N" in the file, or "" for the whole file. */
+  readonly where: string;
+  constructor(code: GltfErrorCode, file: string, where: string, message: string) {
+    super(message);
+    this.name = 'GltfError';
+    this.code = code;
+    this.file = file;
+    this.where = where;
+  }
+}
+
+/** glTF JSON, as parsed (nothing trusted). */
+// eslint-disable-next-line @typescript-eslint/no-explicit-any
+export type GltfJson = Record<string, any>;
+
+/** A split glTF file: the JSON, and the GLB's BIN chunk if any. */
+export interface GltfContainer {
+  json: GltfJson;
+  /** The BIN chunk of a .glb (undefined for a JSON .gltf or a GLB without one). */
+  bin?: Uint8Array;
+  glb: boolean;
+}
+
+const GLB_MAGIC = 0x46546c67; // 'glTF'
+const CHUNK_JSON = 0x4e4f534a;
+const CHUNK_BIN = 0x004e4942;
+
+/** 1,234,567 */
+export const n = (x: number) => x.toLocaleString('en-US');
+const plural = (x: number, one: string, many = one.endsWith('sh') ? `${one}es` : `${one}s`) => `${n(x)} ${x === 1 ? one : many}`;
+
+function looksLikeJson(bytes: Uint8Array): boolean {
+  let i = 0;
+  if (bytes[0] === 0xef && bytes[1] === 0xbb && bytes[2] === 0xbf) i = 3; // UTF-8 BOM
+  while (i < bytes.length && (bytes[i] === 0x20 || bytes[i] === 0x09 || bytes[i] === 0x0a || bytes[i] === 0x0d)) i++;
+  return bytes[i] === 0x7b; // '{'
+}
+
+function showBytes(bytes: Uint8Array, count = 4): string {
+  const head = [...bytes.subarray(0, count)];
+  const hex = head.map((b) => b.toString(16).padStart(2, '0')).join(' ');
+  const text = head.map((b) => (b >= 0x20 && b < 0x7f ? String.fromCharCode(b) : '.')).join('');
+  return `${hex} ('${text}')`;
+}
+
+function parseJsonText(bytes: Uint8Array, file: string, where: string, what: string): GltfJson {
+  let text: string;
+  try {
+    text = new TextDecoder('utf-8', { fatal: true }).decode(bytes);
+  } catch {
+    throw new GltfError('BAD_JSON', file, where, `${what} is not UTF-8 text`);
+  }
+  let json: unknown;
+  try {
+    json = JSON.parse(text.replace(/^\uFEFF/, ''));
+  } catch (e) {
+    throw new GltfError('BAD_JSON', file, where, `${what} is not valid JSON (${(e as Error).message.replace(/\s*\n\s*/g, ' ')})`);
+  }
+  if (!json || typeof json !== 'object' || Array.isArray(json))
+    throw new GltfError('NOT_GLTF', file, where, `${what} is not a JSON object, so not glTF`);
+  return json as GltfJson;
+}
+
+/**
+ * Splits the bytes of a .glb or .gltf into its JSON and BIN chunk, checking the GLB container.
+ * Binary or JSON is decided by the content (magic 'glTF', or a JSON object), not the file name.
+ */
+export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContainer {
+  const size = bytes.byteLength;
+  const magic = size >= 4 ? new DataView(bytes.buffer, bytes.byteOffset, 4).getUint32(0, true) : -1;
+  if (magic !== GLB_MAGIC) {
+    if (looksLikeJson(bytes)) return { json: parseJsonText(bytes, file, '', file), glb: false };
+    if (size === 0) throw new GltfError('NOT_GLTF', file, '', `${file} is empty: not a glTF file`);
+    throw new GltfError('NOT_GLTF', file, 'byte 0',
+      `${file} is not a glTF file: it starts with ${showBytes(bytes)}, neither the binary glTF magic 'glTF' nor a JSON object`);
+  }
+  if (size < 12) throw new GltfError('TRUNCATED', file, 'byte 0', `${file} is truncated: it has ${plural(size, 'byte')}, fewer than the 12-byte binary glTF header`);
+  const view = new DataView(bytes.buffer, bytes.byteOffset, size);
+  const version = view.getUint32(4, true);
+  if (version !== 2)
+    throw new GltfError('BAD_CONTAINER', file, 'byte 4', `${file} is binary glTF version ${version}, not 2: only glTF 2.0 is read`);
+  const total = view.getUint32(8, true);
+  if (total > size) throw new GltfError('TRUNCATED', file, 'byte 8', `${file} is truncated: its header says ${n(total)} bytes but the file has ${n(size)}`);
+  if (total < size)
+    throw new GltfError('BAD_CONTAINER', file, 'byte 8',
+      `${file} has ${plural(size - total, 'byte')} more than its header says: the header says ${n(total)} bytes but the file has ${n(size)}`);
+  let json: GltfJson | undefined;
+  let bin: Uint8Array | undefined;
+  let offset = 12;
+  for (let chunk = 0; offset < total; chunk++) {
+    if (offset + 8 > total)
+      throw new GltfError('BAD_CONTAINER', file, `byte ${offset}`,
+        `${file} is not a valid binary glTF: chunk ${chunk} at byte ${n(offset)} has no room for its 8-byte header (the file ends at ${n(total)})`);
+    const length = view.getUint32(offset, true);
+    const type = view.getUint32(offset + 4, true);
+    const name = type === CHUNK_JSON ? 'JSON' : type === CHUNK_BIN ? 'BIN' : `0x${type.toString(16).padStart(8, '0')}`;
+    const start = offset + 8;
+    if (start + length > total)
+      throw new GltfError('BAD_CONTAINER', file, `byte ${offset}`,
+        `${file} is not a valid binary glTF: its ${name} chunk (chunk ${chunk}, at byte ${n(offset)}) says ${n(length)} bytes but only ${n(total - start)} remain in the file`);
+    const data = bytes.subarray(start, start + length);
+    if (chunk === 0) {
+      if (type !== CHUNK_JSON)
+        throw new GltfError('BAD_CONTAINER', file, `byte ${offset}`, `${file} is not a valid binary glTF: its first chunk is of type ${name}, not JSON`);
+      json = parseJsonText(data, file, `byte ${start}`, `the JSON chunk of ${file}`);
+    } else if (type === CHUNK_JSON) {
+      throw new GltfError('BAD_CONTAINER', file, `byte ${offset}`, `${file} is not a valid binary glTF: it has a second JSON chunk (chunk ${chunk}, at byte ${n(offset)})`);
+    } else if (type === CHUNK_BIN) {
+      if (chunk !== 1 || bin)
+        throw new GltfError('BAD_CONTAINER', file, `byte ${offset}`, `${file} is not a valid binary glTF: its BIN chunk is chunk ${chunk}, not the second one`);
+      bin = data;
+    } // other chunk types: ignored, as the specification asks
+    offset = start + length;
+  }
+  if (!json) throw new GltfError('BAD_CONTAINER', file, 'byte 12', `${file} is not a valid binary glTF: it has no JSON chunk`);
+  return { json, bin, glb: true };
+}
+
+/** How a buffer's data is had: its length, and where it came from for messages. */
+export interface BufferData {
+  byteLength: number;
+  /** e.g. "the GLB's BIN chunk", "its file 'model.bin'", "its data: URI". */
+  source: string;
+}
+
+const COMPONENT: Record<number, { name: string; size: number }> = {
+  5120: { name: 'BYTE', size: 1 }, 5121: { name: 'UNSIGNED_BYTE', size: 1 }, 5122: { name: 'SHORT', size: 2 },
+  5123: { name: 'UNSIGNED_SHORT', size: 2 }, 5125: { name: 'UNSIGNED_INT', size: 4 }, 5126: { name: 'FLOAT', size: 4 },
+};
+const TYPE_COMPONENTS: Record<string, number> = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4, MAT2: 4, MAT3: 9, MAT4: 16 };
+
+/** Bytes of one element; matrix columns start on 4-byte boundaries (glTF 2.0 §3.6.2.4). */
+function elementBytes(type: string, size: number): number {
+  if (type === 'MAT2' && size === 1) return 8;
+  if (type === 'MAT3' && size === 1) return 12;
+  if (type === 'MAT3' && size === 2) return 24;
+  return TYPE_COMPONENTS[type] * size;
+}
+
+const isIndex = (x: unknown): x is number => Number.isInteger(x) && (x as number) >= 0;
+const isObject = (x: unknown): x is GltfJson => !!x && typeof x === 'object' && !Array.isArray(x);
+
+/**
+ * Checks the structure of glTF JSON against the data it has (`buffers[i]`: the data of buffer i,
+ * or undefined when the buffer has no data to check, e.g. an extension's fallback buffer).
+ * Throws the first GltfError found.
+ */
+export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferData | undefined)[]): void {
+  function fail(code: GltfErrorCode, where: string, what: string): never {
+    throw new GltfError(code, file, where, `${file}: ${what}`);
+  }
+  const list = (name: string): GltfJson[] => {
+    const a = json[name];
+    if (a === undefined) return [];
+    if (!Array.isArray(a)) fail('BAD_STRUCTURE', `/${name}`, `'${name}' is not an array`);
+    a.forEach((x: unknown, i: number) => { if (!isObject(x)) fail('BAD_STRUCTURE', `/${name}/${i}`, `${name}[${i}] is not an object`); });
+    return a;
+  };
+  const named = (kind: string, i: number, def: GltfJson | undefined) =>
+    typeof def?.name === 'string' && def.name ? `${kind} ${i} '${def.name}'` : `${kind} ${i}`;
+
+  // asset and extensions
+  const version = isObject(json.asset) ? json.asset.version : undefined;
+  if (typeof version !== 'string')
+    throw new GltfError('NOT_GLTF', file, '/asset/version', `${file} is not glTF: its JSON has no asset.version`);
+  if (!/^2\./.test(version))
+    throw new GltfError('NOT_GLTF', file, '/asset/version', `${file} is glTF ${version}, not 2.0: only glTF 2.0 is read`);
+  const required = json.extensionsRequired;
+  if (required !== undefined) {
+    if (!Array.isArray(required)) fail('BAD_STRUCTURE', '/extensionsRequired', `'extensionsRequired' is not an array`);
+    if (required.length)
+      throw new GltfError('UNSUPPORTED', file, '/extensionsRequired',
+        `${file} requires the glTF extension${required.length > 1 ? 's' : ''} ${required.join(', ')}, which this loader does not read`);
+  }
+
+  const accessors = list('accessors'), bufferViews = list('bufferViews'), bufferDefs = list('buffers');
+  const meshes = list('meshes'), nodes = list('nodes'), skins = list('skins'), scenes = list('scenes');
+  const animations = list('animations'), materials = list('materials'), textures = list('textures');
+  const images = list('images'), samplers = list('samplers'), cameras = list('cameras');
+
+  /** Checks that `value` at `where` is an index into `array` (named `kind`), if present or required. */
+  function ref(value: unknown, array: unknown[], kind: string, where: string, owner: string, required = false): void {
+    if (value === undefined && !required) return;
+    if (!isIndex(value)) fail('BAD_STRUCTURE', where, `${owner} refers to ${kind} ${JSON.stringify(value) ?? 'undefined'}, not an index`);
+    if (value >= array.length)
+      fail('BAD_REFERENCE', where, `${owner} refers to ${kind} ${value}, but the file has ${array.length ? `only ${plural(array.length, kind)}` : `no ${kind}`}`);
+  }
+
+  // Where each accessor is used, for messages.
+  const use: string[] = [];
+  const noteUse = (a: unknown, what: string) => { if (isIndex(a) && use[a] === undefined) use[a] = what; };
+  meshes.forEach((m, mi) => {
+    if (!Array.isArray(m.primitives)) return;
+    m.primitives.forEach((p: GltfJson, pi: number) => {
+      if (!isObject(p)) return;
+      const where = `${named('mesh', mi, m)} primitive ${pi}`;
+      if (isObject(p.attributes)) for (const [k, a] of Object.entries(p.attributes)) noteUse(a, `${k} of ${where}`);
+      noteUse(p.indices, `indices of ${where}`);
+    });
+  });
+  skins.forEach((s, si) => noteUse(s.inverseBindMatrices, `inverse bind matrices of ${named('skin', si, s)}`));
+  animations.forEach((a, ai) => {
+    if (Array.isArray(a.samplers)) a.samplers.forEach((s: GltfJson, i: number) => {
+      if (!isObject(s)) return;
+      noteUse(s.input, `times of ${named('animation', ai, a)} sampler ${i}`);
+      noteUse(s.output, `values of ${named('animation', ai, a)} sampler ${i}`);
+    });
+  });
+  const accessorName = (i: number) => `accessor ${i}${use[i] ? ` (${use[i]})` : ''}`;
+
+  // buffers
+  bufferDefs.forEach((b, i) => {
+    const where = `/buffers/${i}`;
+    if (!isIndex(b.byteLength)) fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer ${i}'s byteLength is ${JSON.stringify(b.byteLength)}, not a whole number`);
+    const data = buffers[i];
+    if (data && b.byteLength > data.byteLength)
+      throw new GltfError('TRUNCATED', file, where,
+        `${file} is truncated: buffer ${i} says ${n(b.byteLength)} bytes but ${data.source} has ${n(data.byteLength)}`);
+  });
+
+  // buffer views
+  bufferViews.forEach((v, i) => {
+    const where = `/bufferViews/${i}`;
+    ref(v.buffer, bufferDefs, 'buffer', `${where}/buffer`, `buffer view ${i}`, true);
+    const offset = v.byteOffset ?? 0;
+    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `buffer view ${i}'s byteOffset is ${JSON.stringify(offset)}, not a whole number`);
+    if (!isIndex(v.byteLength) || v.byteLength < 1)
+      fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer view ${i}'s byteLength is ${JSON.stringify(v.byteLength)}, not a whole number ≥ 1`);
+    if (v.byteStride !== undefined && (!Number.isInteger(v.byteStride) || v.byteStride < 4 || v.byteStride > 252))
+      fail('BAD_STRUCTURE', `${where}/byteStride`, `buffer view ${i}'s byteStride is ${JSON.stringify(v.byteStride)}, not a whole number from 4 to 252`);
+    const size = bufferDefs[v.buffer].byteLength;
+    if (offset + v.byteLength > size)
+      fail('OUT_OF_BOUNDS', where,
+        `buffer view ${i} (bytes ${n(offset)} to ${n(offset + v.byteLength)} of buffer ${v.buffer}) goes past the end of its buffer, which has ${n(size)} bytes`);
+  });
+
+  // accessors
+  /** Checks that `count` elements of `bytes` each, `stride` apart from `offset`, fit in buffer view `bv`. */
+  const fits = (where: string, what: string, bv: number, offset: number, count: number, bytes: number, stride: number) => {
+    const need = offset + stride * (count - 1) + bytes;
+    const have = bufferViews[bv].byteLength;
+    if (need > have)
+      fail('OUT_OF_BOUNDS', where,
+        `${what} has count ${n(count)}, too many for buffer view ${bv}: ${plural(count, 'element')} of ${n(bytes)} bytes` +
+        `${stride !== bytes ? `, ${n(stride)} apart,` : ''} from byte ${n(offset)} need ${n(need)} bytes but the view has ${n(have)}`);
+  };
+  accessors.forEach((a, i) => {
+    const where = `/accessors/${i}`;
+    const name = accessorName(i);
+    const component = COMPONENT[a.componentType];
+    if (!component) fail('BAD_STRUCTURE', `${where}/componentType`, `${name} has componentType ${JSON.stringify(a.componentType)}, not a glTF component type`);
+    if (!(a.type in TYPE_COMPONENTS)) fail('BAD_STRUCTURE', `${where}/type`, `${name} has type ${JSON.stringify(a.type)}, not SCALAR, VEC2-4 or MAT2-4`);
+    if (!isIndex(a.count) || a.count < 1) fail('BAD_STRUCTURE', `${where}/count`, `${name} has count ${JSON.stringify(a.count)}, not a whole number ≥ 1`);
+    const offset = a.byteOffset ?? 0;
+    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `${name} has byteOffset ${JSON.stringify(offset)}, not a whole number`);
+    const bytes = elementBytes(a.type, component.size);
+    if (a.bufferView !== undefined) {
+      ref(a.bufferView, bufferViews, 'buffer view', `${where}/bufferView`, name);
+      const stride = bufferViews[a.bufferView].byteStride ?? bytes;
+      if (stride < bytes)
+        fail('BAD_STRUCTURE', where, `${name} has ${n(bytes)}-byte elements but buffer view ${a.bufferView}'s byteStride is ${stride}`);
+      fits(where, name, a.bufferView, offset, a.count, bytes, stride);
+    } else if (offset !== 0) {
+      fail('BAD_STRUCTURE', `${where}/byteOffset`, `${name} has a byteOffset but no buffer view`);
+    }
+    if (a.sparse !== undefined) {
+      const s = a.sparse;
+      const sw = `${where}/sparse`;
+      if (!isObject(s) || !isObject(s.indices) || !isObject(s.values)) fail('BAD_STRUCTURE', sw, `the sparse part of ${name} lacks indices or values`);
+      if (!isIndex(s.count) || s.count < 1 || s.count > a.count)
+        fail('BAD_STRUCTURE', `${sw}/count`, `the sparse count of ${name} is ${JSON.stringify(s.count)}, not from 1 to its count ${n(a.count)}`);
+      const ic = COMPONENT[s.indices.componentType];
+      if (![5121, 5123, 5125].includes(s.indices.componentType))
+        fail('BAD_STRUCTURE', `${sw}/indices/componentType`, `the sparse indices of ${name} have componentType ${JSON.stringify(s.indices.componentType)}, not an unsigned integer type`);
+      for (const [part, size] of [['indices', ic.size], ['values', bytes]] as const) {
+        const p = s[part];
+        ref(p.bufferView, bufferViews, 'buffer view', `${sw}/${part}/bufferView`, `the sparse ${part} of ${name}`, true);
+        const po = p.byteOffset ?? 0;
+        if (!isIndex(po)) fail('BAD_STRUCTURE', `${sw}/${part}/byteOffset`, `the sparse ${part} of ${name} have byteOffset ${JSON.stringify(po)}, not a whole number`);
+        fits(`${sw}/${part}`, `the sparse ${part} of ${name}`, p.bufferView, po, s.count, size, size);
+      }
+    }
+  });
+
+  // meshes
+  meshes.forEach((m, mi) => {
+    const mesh = named('mesh', mi, m);
+    if (!Array.isArray(m.primitives) || !m.primitives.length) fail('BAD_STRUCTURE', `/meshes/${mi}/primitives`, `${mesh} has no primitives`);
+    m.primitives.forEach((p: GltfJson, pi: number) => {
+      const where = `/meshes/${mi}/primitives/${pi}`;
+      const prim = `${mesh} primitive ${pi}`;
+      if (!isObject(p) || !isObject(p.attributes)) fail('BAD_STRUCTURE', where, `${prim} has no attributes`);
+      let first: [string, number] | undefined;
+      for (const [k, a] of Object.entries(p.attributes)) {
+        ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${k}`, true);
+        const count = accessors[a as number].count;
+        if (!first) first = [k, count];
+        else if (count !== first[1])
+          fail('BAD_STRUCTURE', `${where}/attributes/${k}`,
+            `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
+      }
+      ref(p.indices, accessors, 'accessor', `${where}/indices`, `${prim}'s indices`);
+      ref(p.material, materials, 'material', `${where}/material`, prim);
+      if (p.targets !== undefined) {
+        if (!Array.isArray(p.targets)) fail('BAD_STRUCTURE', `${where}/targets`, `${prim}'s morph targets are not an array`);
+        p.targets.forEach((t: GltfJson, ti: number) => {
+          if (!isObject(t)) fail('BAD_STRUCTURE', `${where}/targets/${ti}`, `${prim}'s morph target ${ti} is not an object`);
+          for (const [k, a] of Object.entries(t)) ref(a, accessors, 'accessor', `${where}/targets/${ti}/${k}`, `${prim}'s morph target ${ti} ${k}`, true);
+        });
+      }
+    });
+  });
+
+  // nodes: references and transforms
+  const numbers = (x: unknown, length: number) => Array.isArray(x) && x.length === length && x.every((v) => typeof v === 'number' && Number.isFinite(v));
+  nodes.forEach((d, i) => {
+    const where = `/nodes/${i}`;
+    const node = named('node', i, d);
+    ref(d.mesh, meshes, 'mesh', `${where}/mesh`, node);
+    ref(d.skin, skins, 'skin', `${where}/skin`, node);
+    ref(d.camera, cameras, 'camera', `${where}/camera`, node);
+    if (d.children !== undefined) {
+      if (!Array.isArray(d.children)) fail('BAD_STRUCTURE', `${where}/children`, `the children of ${node} are not an array`);
+      d.children.forEach((c: unknown, k: number) => ref(c, nodes, 'node', `${where}/children/${k}`, `child ${k} of ${node}`, true));
+    }
+    for (const [key, length] of [['matrix', 16], ['translation', 3], ['rotation', 4], ['scale', 3]] as const)
+      if (d[key] !== undefined && !numbers(d[key], length))
+        fail('BAD_STRUCTURE', `${where}/${key}`, `the ${key} of ${node} is not ${length} finite numbers`);
+  });
+
+  // the node graph
+  const nodeName = (i: number) => named('node', i, nodes[i]);
+  const children = nodes.map((d) => (d.children ?? []) as number[]);
+  children.forEach((cs, i) => {
+    const seen = new Set<number>();
+    cs.forEach((c, k) => {
+      if (c === i) fail('NODE_CYCLE', `/nodes/${i}/children/${k}`, `${nodeName(i)} is its own child (a cycle in the node hierarchy)`);
+      if (seen.has(c)) fail('NODE_HIERARCHY', `/nodes/${i}/children`, `${nodeName(i)} lists ${nodeName(c)} twice among its children`);
+      seen.add(c);
+    });
+  });
+  const jointOf = new Map<number, number[]>();
+  skins.forEach((s, si) => {
+    if (Array.isArray(s.joints)) for (const j of s.joints) if (isIndex(j)) jointOf.set(j, [...(jointOf.get(j) ?? []), si]);
+  });
+  const cycle = findCycle(children);
+  if (cycle) {
+    const shown = cycle.length > 9 ? [...cycle.slice(0, 4), -1, ...cycle.slice(-4)] : cycle;
+    const path = [...shown, cycle[0]].map((i) => (i < 0 ? '…' : nodeName(i))).join(' → ');
+    const skinsIn = [...new Set(cycle.flatMap((i) => jointOf.get(i) ?? []))];
+    const joints = skinsIn.length ? ` (joints of ${skinsIn.map((si) => named('skin', si, skins[si])).join(', ')})` : '';
+    fail('NODE_CYCLE', `/nodes/${cycle[0]}/children`, `the node hierarchy has a cycle: ${path}${joints}`);
+  }
+  const parent = new Array<number>(nodes.length).fill(-1);
+  children.forEach((cs, i) => cs.forEach((c) => {
+    if (parent[c] >= 0)
+      fail('NODE_HIERARCHY', `/nodes/${i}/children`,
+        `${nodeName(c)} has two parents, ${nodeName(parent[c])} and ${nodeName(i)}: a glTF node has at most one`);
+    parent[c] = i;
+  }));
+
+  // scenes
+  ref(json.scene, scenes, 'scene', '/scene', 'the file');
+  scenes.forEach((s, si) => {
+    const where = `/scenes/${si}/nodes`;
+    if (s.nodes === undefined) return;
+    if (!Array.isArray(s.nodes)) fail('BAD_STRUCTURE', where, `the nodes of ${named('scene', si, s)} are not an array`);
+    s.nodes.forEach((r: unknown, k: number) => {
+      ref(r, nodes, 'node', `${where}/${k}`, named('scene', si, s), true);
+      if (parent[r as number] >= 0)
+        fail('NODE_HIERARCHY', `${where}/${k}`,
+          `${named('scene', si, s)} lists ${nodeName(r as number)} as a root, but it is a child of ${nodeName(parent[r as number])}`);
+    });
+  });
+
+  // skins and skinned nodes
+  skins.forEach((s, si) => {
+    const where = `/skins/${si}`;
+    const skin = named('skin', si, s);
+    if (!Array.isArray(s.joints) || !s.joints.length) fail('BAD_SKIN', `${where}/joints`, `${skin} has no joints`);
+    const seen = new Set<number>();
+    s.joints.forEach((j: unknown, k: number) => {
+      ref(j, nodes, 'node', `${where}/joints/${k}`, `joint ${k} of ${skin}`, true);
+      if (seen.has(j as number)) fail('BAD_SKIN', `${where}/joints/${k}`, `${skin} lists ${nodeName(j as number)} twice among its joints (joints ${s.joints.indexOf(j)} and ${k})`);
+      seen.add(j as number);
+    });
+    ref(s.skeleton, nodes, 'node', `${where}/skeleton`, `the skeleton of ${skin}`);
+    if (s.inverseBindMatrices !== undefined) {
+      ref(s.inverseBindMatrices, accessors, 'accessor', `${where}/inverseBindMatrices`, `the inverse bind matrices of ${skin}`);
+      const a = accessors[s.inverseBindMatrices];
+      if (a.type !== 'MAT4' || a.componentType !== 5126)
+        fail('BAD_SKIN', `${where}/inverseBindMatrices`,
+          `the inverse bind matrices of ${skin} (accessor ${s.inverseBindMatrices}) are ${a.type} of ${COMPONENT[a.componentType].name}, not MAT4 of FLOAT`);
+      if (a.count < s.joints.length)
+        fail('BAD_SKIN', `${where}/inverseBindMatrices`,
+          `${skin} has ${plural(s.joints.length, 'joint')} but ${plural(a.count, 'inverse bind matrix', 'inverse bind matrices')} (accessor ${s.inverseBindMatrices})`);
+    }
+  });
+  nodes.forEach((d, i) => {
+    if (d.skin === undefined) return;
+    const skin = named('skin', d.skin, skins[d.skin]);
+    if (d.mesh === undefined) fail('BAD_SKIN', `/nodes/${i}/skin`, `${nodeName(i)} has ${skin} but no mesh to skin`);
+    const m = meshes[d.mesh];
+    m.primitives.forEach((p: GltfJson, pi: number) => {
+      const missing = ['JOINTS_0', 'WEIGHTS_0'].filter((k) => p.attributes[k] === undefined);
+      if (missing.length)
+        fail('BAD_SKIN', `/meshes/${d.mesh}/primitives/${pi}/attributes`,
+          `${nodeName(i)} has ${skin} but its ${named('mesh', d.mesh, m)} primitive ${pi} has no ${missing.join(' or ')} attribute: no vertex says which joints move it`);
+    });
+  });
+
+  // animations
+  animations.forEach((a, ai) => {
+    const where = `/animations/${ai}`;
+    const anim = named('animation', ai, a);
+    const ss = Array.isArray(a.samplers) ? a.samplers : fail('BAD_STRUCTURE', `${where}/samplers`, `${anim} has no samplers array`);
+    ss.forEach((s: GltfJson, i: number) => {
+      if (!isObject(s)) fail('BAD_STRUCTURE', `${where}/samplers/${i}`, `sampler ${i} of ${anim} is not an object`);
+      ref(s.input, accessors, 'accessor', `${where}/samplers/${i}/input`, `the input of sampler ${i} of ${anim}`, true);
+      ref(s.output, accessors, 'accessor', `${where}/samplers/${i}/output`, `the output of sampler ${i} of ${anim}`, true);
+    });
+    if (!Array.isArray(a.channels)) fail('BAD_STRUCTURE', `${where}/channels`, `${anim} has no channels array`);
+    a.channels.forEach((c: GltfJson, i: number) => {
+      if (!isObject(c) || !isObject(c.target)) fail('BAD_STRUCTURE', `${where}/channels/${i}`, `channel ${i} of ${anim} has no target`);
+      ref(c.sampler, ss, 'sampler', `${where}/channels/${i}/sampler`, `channel ${i} of ${anim}`, true);
+      ref(c.target.node, nodes, 'node', `${where}/channels/${i}/target/node`, `channel ${i} of ${anim}`);
+    });
+  });
+
+  // textures, images, materials (loaded then dropped, but a bad index would crash the loader)
+  images.forEach((im, i) => ref(im.bufferView, bufferViews, 'buffer view', `/images/${i}/bufferView`, `image ${i}`));
+  textures.forEach((t, i) => {
+    ref(t.source, images, 'image', `/textures/${i}/source`, `texture ${i}`);
+    ref(t.sampler, samplers, 'sampler', `/textures/${i}/sampler`, `texture ${i}`);
+  });
+  materials.forEach((m, i) => {
+    const infos: [string, unknown][] = [
+      ['normalTexture', m.normalTexture], ['occlusionTexture', m.occlusionTexture], ['emissiveTexture', m.emissiveTexture],
+      ['pbrMetallicRoughness/baseColorTexture', m.pbrMetallicRoughness?.baseColorTexture],
+      ['pbrMetallicRoughness/metallicRoughnessTexture', m.pbrMetallicRoughness?.metallicRoughnessTexture],
+    ];
+    for (const [key, info] of infos)
+      if (info !== undefined) {
+        if (!isObject(info)) fail('BAD_STRUCTURE', `/materials/${i}/${key}`, `the ${key} of ${named('material', i, m)} is not an object`);
+        ref(info.index, textures, 'texture', `/materials/${i}/${key}/index`, `the ${key} of ${named('material', i, m)}`, true);
+      }
+  });
+}
+
+/** A cycle of the directed graph `children` (as a list of nodes, each the parent of the next), or null. Iterative. */
+export function findCycle(children: readonly (readonly number[])[]): number[] | null {
+  const state = new Uint8Array(children.length); // 0 unseen, 1 on the current path, 2 done
+  for (let root = 0; root < children.length; root++) {
+    if (state[root]) continue;
+    const path = [root], next = [0];
+    state[root] = 1;
+    while (path.length) {
+      const v = path[path.length - 1];
+      const k = next[next.length - 1]++;
+      if (k >= children[v].length) {
+        state[v] = 2;
+        path.pop();
+        next.pop();
+        continue;
+      }
+      const c = children[v][k];
+      if (state[c] === 1) return path.slice(path.indexOf(c));
+      if (state[c] === 0) {
+        state[c] = 1;
+        path.push(c);
+        next.push(0);
+      }
+    }
+  }
+  return null;
+}
