@@ -94,6 +94,97 @@ describe('three.js adapter', () => {
     skin.dispose();
   });
 
+  test('defaults: the source\'s material and flags, culling on with bounds that follow the bones; the source stays put', () => {
+    const { mesh, bones, group } = tubeSkinnedMesh();
+    mesh.name = 'arm';
+    mesh.castShadow = true;
+    mesh.receiveShadow = true;
+    mesh.renderOrder = 2;
+    mesh.layers.set(3);
+    const skin = new SkinDeformer(gcs, mesh);
+    expect(skin.mesh.material).toBe(mesh.material); // the same object, not a copy and not a stand-in
+    expect([skin.mesh.name, skin.mesh.castShadow, skin.mesh.receiveShadow, skin.mesh.renderOrder, skin.mesh.layers.mask])
+      .toEqual(['arm', true, true, 2, mesh.layers.mask]);
+    expect(skin.mesh.frustumCulled).toBe(true);
+    // Free placement (the default): not inserted anywhere, carries the source's world transform.
+    expect(skin.mesh.parent).toBeNull();
+    expect(skin.mesh.matrix.elements).toEqual(mesh.matrixWorld.elements);
+    expect(mesh.layers.mask).toBe(1 << 3);
+    expect(group.children).toContain(mesh);
+    const inside = () => {
+      const g = skin.mesh.geometry, p = g.getAttribute('position'), v = new THREE.Vector3();
+      let worst = -Infinity;
+      for (let i = 0; i < p.count; i++) {
+        v.fromBufferAttribute(p, i);
+        worst = Math.max(worst, v.distanceTo(g.boundingSphere!.center) - g.boundingSphere!.radius, g.boundingBox!.distanceToPoint(v));
+      }
+      return worst;
+    };
+    const before = skin.mesh.geometry.boundingSphere!.center.clone();
+    bones[1].rotation.z = 2.5;
+    bones[0].position.x = 4;
+    skin.update();
+    expect(inside()).toBeLessThanOrEqual(0);
+    expect(skin.mesh.geometry.boundingSphere!.center.distanceTo(before)).toBeGreaterThan(3); // moved with the bones
+    const material = new THREE.MeshNormalMaterial();
+    const other = new SkinDeformer(gcs, mesh, { method: 'dqs', material });
+    expect(other.mesh.material).toBe(material);
+    skin.dispose();
+    other.dispose();
+    expect(skin.disposed).toBe(true);
+    expect(() => skin.update()).toThrow(GcsError);
+    expect(material.version).toBe(0); // never disposed nor touched
+  });
+
+  test('morph targets: three\'s order (morph, then skin), influences read every update', () => {
+    const { mesh, bones } = tubeSkinnedMesh();
+    const P = mesh.geometry.getAttribute('position');
+    const delta = new Float32Array(P.count * 3);
+    for (let i = 0; i < P.count; i++) if (P.getY(i) > 1.4) { delta[3 * i] = 0.3 * P.getX(i); delta[3 * i + 1] = 0.05; }
+    mesh.geometry.morphAttributes.position = [new THREE.BufferAttribute(delta, 3)];
+    mesh.geometry.morphTargetsRelative = true;
+    mesh.updateMorphTargets();
+    for (const method of ['lbs', 'gcs'] as const) {
+      const skin = new SkinDeformer(gcs, mesh, { method });
+      expect(skin.deformer.morphTargetCount).toBe(1);
+      bones[1].rotation.z = 0.8;
+      for (const w of [0.7, 0]) {
+        mesh.morphTargetInfluences![0] = w;
+        skin.update();
+        const src = skin.deformer.sourceVertex!;
+        const position = skin.mesh.geometry.getAttribute('position');
+        const v = new THREE.Vector3(), u = new THREE.Vector3();
+        let worst = 0;
+        for (let o = 0; o < src.length; o++) {
+          const i = src[o];
+          if (method === 'gcs' && Math.abs(P.getY(i) - 1) < 0.3) continue; // GCS: where bound to one joint
+          v.fromBufferAttribute(P, i).addScaledVector(u.fromArray(delta, 3 * i), w);
+          mesh.applyBoneTransform(i, v);
+          worst = Math.max(worst, v.distanceTo(u.fromBufferAttribute(position, o)));
+        }
+        expect(worst, `${method} ${w}`).toBeLessThan(1e-5);
+      }
+      bones[1].rotation.z = 0;
+      skin.dispose();
+    }
+  });
+
+  test('multi-material groups carry over (the deformers keep the triangle order); the classic model falls back to one group', () => {
+    const { mesh } = tubeSkinnedMesh();
+    const half = Math.floor(mesh.geometry.index!.count / 6) * 3;
+    mesh.geometry.addGroup(0, half, 0);
+    mesh.geometry.addGroup(half, mesh.geometry.index!.count - half, 1);
+    mesh.material = [new THREE.MeshBasicMaterial(), new THREE.MeshBasicMaterial()];
+    for (const method of ['gcs', 'lbs', 'dqs', 'classic'] as const) {
+      const skin = new SkinDeformer(gcs, mesh, { method });
+      expect(skin.mesh.material).toBe(mesh.material);
+      const groups = skin.mesh.geometry.groups.map((g) => [g.start, g.count, g.materialIndex]);
+      if (method === 'classic') expect(groups).toEqual([[0, Infinity, 0]]);
+      else expect(groups, method).toEqual(mesh.geometry.groups.map((g) => [g.start, g.count, g.materialIndex]));
+      skin.dispose();
+    }
+  });
+
   test('a rebuild that fails leaves the current model in place', () => {
     const { mesh } = tubeSkinnedMesh();
     const skin = new SkinDeformer(gcs, mesh, { method: 'gcs', gcs: { sections: 5 } });

@@ -1,6 +1,16 @@
 /**
- * three.js adapter: a THREE.Mesh whose position and normal attributes ARE the deformer's
- * wasm-memory views, driven by a SkinnedMesh's skeleton (and so by its AnimationMixer).
+ * three.js adapter: THREE.Meshes whose position and normal attributes ARE the deformers'
+ * wasm-memory views, driven by SkinnedMeshes' skeletons (and so by an AnimationMixer).
+ *
+ * A whole character (a glTF scene or any Object3D), in place:
+ *
+ *   const character = new GcsCharacter(gcs, gltf.scene);      // every SkinnedMesh under it
+ *   scene.add(gltf.scene);
+ *   const mixer = new THREE.AnimationMixer(gltf.scene);
+ *   // each frame: mixer.update(dt); character.update(); renderer.render(scene, camera);
+ *   // at the end: character.dispose();                        // the SkinnedMeshes come back
+ *
+ * One SkinnedMesh, its deformed mesh placed by hand (carries the source's world transform):
  *
  *   const skin = new SkinDeformer(gcs, skinnedMesh, { method: 'gcs', gcs: { sections: 8 } });
  *   scene.add(skin.mesh);
@@ -8,15 +18,33 @@
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
-import type { ClassicOptions, Deformer, DeformerKind, GcsOptions, GcsSkin, Rig, RigInput } from './index.js';
+import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
 
 export interface SkinDeformerOptions {
   /** Which deformer drives the mesh. Default 'gcs'. */
   method?: DeformerKind;
   gcs?: GcsOptions;
   classic?: ClassicOptions;
-  /** Material of the output mesh (default: a MeshStandardMaterial like the source's colour). */
+  /** Material of the output mesh. Default: the source's own material (the same object, shared, not cloned). */
   material?: THREE.Material | THREE.Material[];
+  /**
+   * Put the deformed mesh in the source's place: it is inserted under the source's parent, right
+   * after it, with the source's local transform (kept in step by update()), and it mirrors
+   * `source.visible`; the source leaves the render, the shadow passes and raycasts (its `layers`
+   * are cleared, so its children still render and its bones still move). `dispose()` undoes it.
+   * A source without a parent gets the deformed mesh as its child, at identity. Default false:
+   * `mesh` is free and carries the source's world transform (add it at the top level).
+   */
+  inPlace?: boolean;
+  /**
+   * When the source geometry has a `tangent` attribute: 'deform' (default) turns the tangents
+   * with the skin (a second deformer of the same kind, fed the tangents as its normals: one more
+   * deform and a copy per frame); 'drop' leaves them out, and three.js derives the tangent frame
+   * of normal maps from the deformed positions and uvs (screen-space derivatives). Carrying the
+   * bind-pose tangents unchanged would tilt normal maps wherever the skin bends, so that is not
+   * offered. Ignored by the classic model.
+   */
+  tangents?: 'deform' | 'drop';
 }
 
 /** Reads the rig (bind-pose mesh, skin, skeleton) out of a SkinnedMesh as GLTFLoader gives it. */
@@ -80,9 +108,160 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
   return { positions, normals, indices, joints, weights, parents, inverseBindMatrices };
 }
 
+type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
+type TypedArray = Float32Array | Float64Array | Int8Array | Uint8Array | Uint8ClampedArray | Int16Array | Uint16Array | Int32Array | Uint32Array;
+
+/** The attributes a deformer replaces or consumes: everything else is carried to the output. */
+const SKINNING_ATTRIBUTES = new Set(['position', 'normal', 'tangent', 'skinIndex', 'skinWeight']);
+
+/** Raw (un-normalised) element i·itemSize+k of an attribute, interleaved or not. */
+function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offset: number } {
+  const inter = attr as THREE.InterleavedBufferAttribute;
+  return inter.isInterleavedBufferAttribute
+    ? { array: inter.data.array as TypedArray, stride: inter.data.stride, offset: inter.offset }
+    : { array: (attr as THREE.BufferAttribute).array as TypedArray, stride: attr.itemSize, offset: 0 };
+}
+
+/** A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
+function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
+  const { array, stride, offset } = rawArray(attr);
+  const size = attr.itemSize;
+  const Ctor = array.constructor as new (length: number) => TypedArray;
+  const out = new Ctor(map.length * size);
+  for (let o = 0; o < map.length; o++) {
+    const s = map[o] * stride + offset;
+    for (let k = 0; k < size; k++) out[o * size + k] = array[s + k];
+  }
+  const result = (attr as { isFloat16BufferAttribute?: boolean }).isFloat16BufferAttribute
+    ? new THREE.Float16BufferAttribute(out as Uint16Array, size, attr.normalized)
+    : new THREE.BufferAttribute(out, size, attr.normalized);
+  result.name = attr.name;
+  const gpuType = (attr as THREE.BufferAttribute).gpuType;
+  if (gpuType !== undefined) result.gpuType = gpuType;
+  return result;
+}
+
+/** Morph targets as relative deltas in the source's vertex order (glTF / three: morphTargetsRelative). */
+interface MorphData {
+  positions: ArrayLike<number>[];
+  normals: ArrayLike<number>[] | null;
+  /** Per target, the largest delta length: bounds grow by Σ |influence| · maxDelta. */
+  maxDelta: Float32Array;
+}
+
+function morphData(geometry: THREE.BufferGeometry): MorphData | null {
+  const targets = geometry.morphAttributes.position;
+  if (!targets || targets.length === 0) return null;
+  const base = geometry.getAttribute('position');
+  const n = base.count;
+  const relative = geometry.morphTargetsRelative;
+  const deltas = (list: AnyAttribute[], baseAttr: AnyAttribute | undefined): ArrayLike<number>[] =>
+    list.map((attr) => {
+      const plain = attr as THREE.BufferAttribute;
+      // The common glTF case, zero copy: setMorphTargets copies into wasm anyway.
+      if (relative && !(attr as THREE.InterleavedBufferAttribute).isInterleavedBufferAttribute && !attr.normalized
+        && attr.itemSize === 3 && plain.array instanceof Float32Array && plain.array.length === n * 3) return plain.array;
+      const out = new Float32Array(n * 3);
+      for (let i = 0; i < Math.min(n, attr.count); i++) {
+        out[3 * i] = attr.getX(i) - (relative || !baseAttr ? 0 : baseAttr.getX(i));
+        out[3 * i + 1] = attr.getY(i) - (relative || !baseAttr ? 0 : baseAttr.getY(i));
+        out[3 * i + 2] = attr.getZ(i) - (relative || !baseAttr ? 0 : baseAttr.getZ(i));
+      }
+      return out;
+    });
+  const positions = deltas(targets, base);
+  const normalTargets = geometry.morphAttributes.normal;
+  const normalBase = geometry.getAttribute('normal');
+  const normals = normalTargets && normalTargets.length === targets.length && normalBase ? deltas(normalTargets, normalBase) : null;
+  const maxDelta = new Float32Array(positions.length);
+  positions.forEach((d, t) => {
+    let m = 0;
+    for (let i = 0; i < d.length; i += 3) m = Math.max(m, d[i] * d[i] + d[i + 1] * d[i + 1] + d[i + 2] * d[i + 2]);
+    maxDelta[t] = Math.sqrt(m);
+  });
+  return { positions, normals, maxDelta };
+}
+
+/** The lowest object that holds the source and all its bones: what update() refreshes. */
+function commonAncestor(objects: THREE.Object3D[]): THREE.Object3D {
+  const chain = (o: THREE.Object3D) => {
+    const c: THREE.Object3D[] = [];
+    for (let p: THREE.Object3D | null = o; p; p = p.parent) c.push(p);
+    return c.reverse();
+  };
+  let common = chain(objects[0]);
+  for (const o of objects.slice(1)) {
+    const c = chain(o);
+    let k = 0;
+    while (k < common.length && k < c.length && common[k] === c[k]) k++;
+    common = common.slice(0, k);
+  }
+  if (common.length) return common[common.length - 1];
+  // Disjoint graphs: fall back to the source's topmost ancestor (the old behaviour).
+  let root = objects[0];
+  while (root.parent) root = root.parent;
+  return root;
+}
+
+/** Brings `object`'s world matrix and its subtree's up to date, its ancestors first. */
+function updateWorld(object: THREE.Object3D): void {
+  // updateMatrixWorld, not updateWorldMatrix: SkinnedMesh overrides only the former (attached
+  // bind mode refreshes bindMatrixInverse there).
+  object.parent?.updateWorldMatrix(true, false);
+  object.updateMatrixWorld(true);
+}
+
 /**
- * A mesh deformed in wasm, driven by `source`'s skeleton. `mesh` carries the source's world
- * transform: add it to the scene at the top level (or under an untransformed group).
+ * The output mesh: its geometry is the deformer's output, so raycasts hit the deformed skin.
+ * Before a raycast its bounds are made exact (one pass over the positions; the raycast itself
+ * walks every triangle), whereas frustum culling uses the per-frame bounds from the bones. An
+ * in-place mesh hidden with its source is not deformed, so it is not raycast either.
+ */
+class DeformedMesh extends THREE.Mesh<THREE.BufferGeometry, THREE.Material | THREE.Material[]> {
+  /** @internal Set by the SkinDeformer that owns the mesh. */
+  exactBounds: (() => boolean) | null = null;
+  override raycast(raycaster: THREE.Raycaster, intersects: THREE.Intersection[]): void {
+    // false: an in-place mesh hidden with its source, not deformed since (stale): no hits.
+    if (this.exactBounds && !this.exactBounds()) return;
+    super.raycast(raycaster, intersects);
+  }
+}
+
+/** Joints carrying skin and, per joint, the radius of its ball (see SkinDeformer.update()). */
+interface BoneBalls {
+  joints: Uint32Array;
+  radii: Float32Array;
+}
+
+/** A deformer and the geometry around it, built but not yet shown (rebuilds are all-or-nothing). */
+interface PendingBuild {
+  method: DeformerKind;
+  gcs: GcsOptions;
+  classic: ClassicOptions;
+  deformer: Deformer;
+  /** Deforms the tangents (as its normals), or null. */
+  tangentDeformer: Deformer | null;
+  geometry: THREE.BufferGeometry;
+  /** Per morph target, the largest delta length; null without morphs. */
+  maxDelta: Float32Array | null;
+}
+
+/**
+ * A mesh deformed in wasm, driven by `source`'s skeleton.
+ *
+ * - Material: the source's own (the same object) unless `options.material`; castShadow,
+ *   receiveShadow, name, layers, renderOrder, customDepthMaterial/customDistanceMaterial are
+ *   copied at build. Every non-skinning attribute of the source (uv, uv1…, color, custom ones) is
+ *   carried, reordered through `deformer.sourceVertex`; tangents per `options.tangents`.
+ * - Placement: by default `mesh` carries the source's world transform (add it at the top level or
+ *   under an untransformed group); with `inPlace: true` it replaces the source in its own graph.
+ * - Frustum culling stays on: the bounds follow the animation (see update()).
+ * - Morph targets (`geometry.morphAttributes.position`) are applied before skinning, as three.js
+ *   does, with the source's `morphTargetInfluences` each frame. The classic model resamples the
+ *   mesh, so it has no morphs, no carried attributes and no tangents.
+ *
+ * `dispose()` frees the wasm memory and the output geometry, removes `mesh` from its parent and,
+ * in place, gives the source back its layers. Materials are never disposed (they are shared).
  */
 export class SkinDeformer {
   readonly source: THREE.SkinnedMesh;
@@ -93,70 +272,283 @@ export class SkinDeformer {
   private options: SkinDeformerOptions;
   private readonly skin: Float32Array;
   private readonly tmp = new THREE.Matrix4();
-  private readonly root: THREE.Object3D;
-  private readonly sourceUv: THREE.BufferAttribute | THREE.InterleavedBufferAttribute | undefined;
+  private readonly point = new THREE.Vector3();
+  /** What update() refreshes: the lowest common ancestor of the source and its bones. */
+  private readonly scope: THREE.Object3D;
+  private readonly inPlace: boolean;
+  /** In place: the source's layers mask, given back by dispose(). */
+  private readonly sourceLayers: number;
+  /** In place, parentless source: the mesh is its child at identity. */
+  private readonly childOfSource: boolean;
+  private tangentRig: Rig | null = null;
+  private tangentDeformer: Deformer | null = null;
+  /** tangent w per source vertex (handedness), copied beside the deformed xyz. */
+  private tangentW: Float32Array | null = null;
+  private tangentOut: Float32Array | null = null;
+  /** Per morph target, the largest delta length (null: no morphs this build). */
+  private maxDelta: Float32Array | null = null;
+  // Bounds from the bones: per joint j that carries skin, its bind position b_j (mesh space) and
+  // the largest distance r_j from b_j to a vertex weighted to it.
+  private readonly pivots: Float32Array;
+  private readonly ownBalls: BoneBalls;
+  private readonly nearBalls: BoneBalls;
+  /** The balls and radius factor of the current build. */
+  private balls: BoneBalls;
+  private ballFactor = 1;
+  private readonly box = new THREE.Box3();
+  private readonly sphere = new THREE.Sphere();
+  private exactFresh = false;
+  private isDisposed = false;
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
-    this.rig = gcs.createRig(rigInputFromSkinnedMesh(source));
+    const input = rigInputFromSkinnedMesh(source);
     this.source = source;
     this.options = { ...options };
     this.method = options.method ?? 'gcs';
-    this.skin = new Float32Array(this.rig.jointCount * 16);
-    this.sourceUv = source.geometry.getAttribute('uv');
-    let root: THREE.Object3D = source;
-    while (root.parent) root = root.parent;
-    this.root = root;
-    const material = options.material ?? new THREE.MeshStandardMaterial({ color: 0xc8a07d, roughness: 0.7 });
-    this.mesh = new THREE.Mesh(new THREE.BufferGeometry(), material);
-    this.mesh.matrixAutoUpdate = false;
-    this.mesh.frustumCulled = false; // the bind-pose bounds do not follow the animation
+    this.inPlace = options.inPlace === true;
+    this.rig = gcs.createRig(input);
     try {
-      this.rebuild(this.method, options);
+      const tangent = source.geometry.getAttribute('tangent');
+      if (tangent && tangent.itemSize >= 3 && options.tangents !== 'drop') {
+        const n = tangent.count;
+        const xyz = new Float32Array(3 * n);
+        const w = new Float32Array(n);
+        for (let i = 0; i < n; i++) {
+          xyz[3 * i] = tangent.getX(i);
+          xyz[3 * i + 1] = tangent.getY(i);
+          xyz[3 * i + 2] = tangent.getZ(i);
+          w[i] = tangent.itemSize > 3 ? (tangent.getW(i) < 0 ? -1 : 1) : 1;
+        }
+        this.tangentRig = gcs.createRig({ ...input, normals: xyz });
+        this.tangentW = w;
+      }
     } catch (e) {
       this.rig.dispose();
       throw e;
     }
+    this.skin = new Float32Array(this.rig.jointCount * 16);
+    ({ pivots: this.pivots, own: this.ownBalls, near: this.nearBalls } = this.boneBounds(input));
+    this.balls = this.ownBalls;
+    this.scope = commonAncestor([source, ...source.skeleton.bones]);
+
+    const mesh = new DeformedMesh(new THREE.BufferGeometry(), options.material ?? source.material);
+    mesh.exactBounds = () => this.exactBounds();
+    mesh.name = source.name;
+    mesh.castShadow = source.castShadow;
+    mesh.receiveShadow = source.receiveShadow;
+    mesh.layers.mask = source.layers.mask;
+    mesh.renderOrder = source.renderOrder;
+    mesh.customDepthMaterial = source.customDepthMaterial;
+    mesh.customDistanceMaterial = source.customDistanceMaterial;
+    mesh.frustumCulled = true; // with bounds that follow the animation (update())
+    mesh.matrixAutoUpdate = false; // update() copies the source's matrix
+    this.mesh = mesh;
+    this.sourceLayers = source.layers.mask;
+    this.childOfSource = this.inPlace && !source.parent;
+    try {
+      this.commit(this.prepare(this.method, options));
+    } catch (e) {
+      this.tangentRig?.dispose();
+      this.rig.dispose();
+      throw e;
+    }
+    if (this.inPlace) {
+      if (this.childOfSource) {
+        source.add(mesh);
+      } else {
+        const parent = source.parent!;
+        parent.add(mesh);
+        // Right after the source: PropertyBinding finds nodes by name depth first, so animation
+        // tracks (bones, morph influences) keep binding to the source, which has the same name.
+        const c = parent.children;
+        c.splice(c.indexOf(mesh), 1);
+        c.splice(c.indexOf(source) + 1, 0, mesh);
+      }
+      source.layers.disableAll(); // out of render, shadows and raycasts; children unaffected
+      this.update();
+    }
   }
 
-  /** Rebuilds the deformer (e.g. a new section count); the geometry is replaced. */
+  /**
+   * Per joint carrying skin: b_j (the joint's bind position, mesh space) and r_j = max |v − b_j|
+   * over the vertices weighted to j ('own'); 'near' also counts, for each joint, the vertices of
+   * its parent and child joints (the paper's criteria and the classic model move a part's skin
+   * with its neighbours' transforms). Why this bounds the deformed mesh: see update().
+   */
+  private boneBounds(input: RigInput): { pivots: Float32Array; own: BoneBalls; near: BoneBalls } {
+    const J = this.rig.jointCount;
+    const pivots = new Float32Array(3 * J);
+    const m = new THREE.Matrix4();
+    for (let j = 0; j < J; j++) {
+      m.fromArray(input.inverseBindMatrices as ArrayLike<number> as number[], 16 * j).invert();
+      pivots[3 * j] = m.elements[12];
+      pivots[3 * j + 1] = m.elements[13];
+      pivots[3 * j + 2] = m.elements[14];
+    }
+    const neighbours: number[][] = Array.from({ length: J }, () => []);
+    for (let j = 0; j < J; j++) {
+      const p = input.parents[j];
+      if (p >= 0 && p < J) { neighbours[j].push(p); neighbours[p].push(j); }
+    }
+    const own = new Float64Array(J).fill(-1), near = new Float64Array(J).fill(-1);
+    const P = input.positions, Jt = input.joints, W = input.weights;
+    const n = P.length / 3;
+    const reach = (r2: Float64Array, j: number, v: number) => {
+      const dx = P[3 * v] - pivots[3 * j], dy = P[3 * v + 1] - pivots[3 * j + 1], dz = P[3 * v + 2] - pivots[3 * j + 2];
+      const d = dx * dx + dy * dy + dz * dz;
+      if (d > r2[j]) r2[j] = d;
+    };
+    for (let v = 0; v < n; v++) {
+      for (let k = 0; k < 4; k++) {
+        if (!(W[4 * v + k] > 0)) continue;
+        const j = Jt[4 * v + k];
+        if (j >= J) continue;
+        reach(own, j, v);
+        reach(near, j, v);
+        for (const q of neighbours[j]) reach(near, q, v);
+      }
+    }
+    const balls = (r2: Float64Array): BoneBalls => {
+      const joints: number[] = [];
+      const radii = new Float32Array(J);
+      for (let j = 0; j < J; j++) if (r2[j] >= 0) { joints.push(j); radii[j] = Math.sqrt(r2[j]) * (1 + 1e-6); }
+      return { joints: Uint32Array.from(joints), radii };
+    };
+    return { pivots, own: balls(own), near: balls(near) };
+  }
+
+  /** Rebuilds the deformer (e.g. a new section count); the geometry is replaced, `mesh` stays. */
   rebuild(method: DeformerKind = this.method, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): void {
+    this.live();
+    // Build first: if it throws, the current deformer and geometry stay as they were.
+    this.commit(this.prepare(method, options));
+  }
+
+  /** @internal Builds the next deformer and its geometry without showing them. */
+  prepare(method: DeformerKind, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): PendingBuild {
     const gcsOptions = { ...this.options.gcs, ...options.gcs };
     const classicOptions = { ...this.options.classic, ...options.classic };
-    // Build first: if it throws, the current deformer and geometry stay as they were.
-    const next = method === 'gcs' ? this.rig.buildGcs(gcsOptions)
-      : method === 'classic' ? this.rig.buildClassic(classicOptions) : this.rig.build(method);
-    this.deformer?.dispose();
-    this.deformer = next;
-    this.method = method;
-    this.options = { ...this.options, gcs: gcsOptions, classic: classicOptions, method };
-    const geometry = new THREE.BufferGeometry();
-    geometry.setIndex(new THREE.BufferAttribute(next.indices, 1));
-    geometry.setAttribute('position', new THREE.BufferAttribute(next.positions, 3).setUsage(THREE.DynamicDrawUsage));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(next.normals, 3).setUsage(THREE.DynamicDrawUsage));
-    const source = next.sourceVertex;
-    if (source && this.sourceUv) {
-      const uv = new Float32Array(source.length * 2);
-      for (let i = 0; i < source.length; i++) {
-        uv[2 * i] = this.sourceUv.getX(source[i]);
-        uv[2 * i + 1] = this.sourceUv.getY(source[i]);
+    const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
+      : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
+    const deformer = build(this.rig);
+    let tangentDeformer: Deformer | null = null;
+    try {
+      const sourceVertex = deformer.sourceVertex;
+      const morph = method === 'classic' ? null : morphData(this.source.geometry);
+      if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
+      if (this.tangentRig && sourceVertex) {
+        tangentDeformer = build(this.tangentRig);
+        // Same positions and weights, so the same vertex order; checked, not assumed.
+        const order = tangentDeformer.sourceVertex;
+        if (!order || order.length !== sourceVertex.length || order.some((v, i) => v !== sourceVertex[i])) {
+          tangentDeformer.dispose();
+          tangentDeformer = null;
+        }
       }
-      geometry.setAttribute('uv', new THREE.BufferAttribute(uv, 2));
+      const geometry = this.makeGeometry(deformer, sourceVertex, tangentDeformer);
+      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null };
+    } catch (e) {
+      tangentDeformer?.dispose();
+      deformer.dispose();
+      throw e;
     }
+  }
+
+  /** @internal Shows a prepared build; the previous deformer and geometry are freed. */
+  commit(next: PendingBuild): void {
+    this.deformer?.dispose();
+    this.tangentDeformer?.dispose();
+    this.deformer = next.deformer;
+    this.tangentDeformer = next.tangentDeformer;
+    this.tangentOut = next.tangentDeformer ? (next.geometry.getAttribute('tangent') as THREE.BufferAttribute).array as Float32Array : null;
+    this.maxDelta = next.maxDelta;
+    const paper = next.method === 'gcs' && (next.gcs.criterion === 'y' || next.gcs.criterion === 'axial');
+    this.balls = paper || next.method === 'classic' ? this.nearBalls : this.ownBalls;
+    this.ballFactor = next.method === 'classic' ? 1 + CLASSIC_LIMITS.maxBulge : 1;
+    this.method = next.method;
+    this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method };
     const old = this.mesh.geometry;
-    this.mesh.geometry = geometry;
+    this.mesh.geometry = next.geometry;
     old.dispose();
     this.update();
   }
 
+  /** @internal Frees a prepared build that will not be shown. */
+  discard(next: PendingBuild): void {
+    next.tangentDeformer?.dispose();
+    next.deformer.dispose();
+    next.geometry.dispose();
+  }
+
+  private makeGeometry(deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null): THREE.BufferGeometry {
+    const src = this.source.geometry;
+    const geometry = new THREE.BufferGeometry();
+    const indices = deformer.indices;
+    geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    if (sourceVertex) {
+      for (const [name, attr] of Object.entries(src.attributes))
+        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+      if (tangentDeformer && this.tangentW) {
+        const w = new Float32Array(4 * sourceVertex.length);
+        for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = this.tangentW[sourceVertex[o]];
+        geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
+      }
+    }
+    // Groups (multi-material) and the draw range count index entries: they carry over when the
+    // deformer kept the triangles in order (GCS, LBS, DQS remap vertex ids only; checked here).
+    let sameOrder = !!sourceVertex;
+    if (sourceVertex) {
+      const srcIndex = src.index;
+      for (let i = 0; i < indices.length && sameOrder; i++)
+        sameOrder = sourceVertex[indices[i]] === (srcIndex ? srcIndex.getX(i) : i);
+      if (srcIndex && indices.length !== srcIndex.count) sameOrder = false;
+    }
+    if (sameOrder) {
+      for (const g of src.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
+      geometry.setDrawRange(src.drawRange.start, src.drawRange.count);
+    } else if (Array.isArray(this.mesh.material)) {
+      geometry.addGroup(0, Infinity, 0); // resampled triangles: the first material for all
+    }
+    geometry.boundingBox = this.box;
+    geometry.boundingSphere = this.sphere;
+    return geometry;
+  }
+
   /**
    * Poses from the skeleton and deforms. Call once per frame, after the mixer. By default it
-   * first updates the world matrices of the source's scene graph (the bones as the mixer left
-   * them); pass `{ updateMatrixWorld: false }` when several deformers share a scene and the
-   * caller has already done that once this frame.
+   * first updates the world matrices of the smallest subtree holding the source and its bones
+   * (and of their ancestors); pass `{ updateMatrixWorld: false }` when the caller has already
+   * done that this frame (GcsCharacter does, once for all its skins). In place, an invisible
+   * source (`source.visible === false`) hides the mesh and skips the deform.
+   *
+   * Bounds for frustum culling, per frame from the bones rather than the output (a JavaScript
+   * pass over 17 k output vertices costs about as much as the wasm deform itself; this is
+   * O(joints)): each joint j's posed position p_j = S_j b_j and a ball of radius
+   * s_j·(k·r_j + Σ|w_t|·maxDelta_t) (s_j the largest axis scale of S_j, w_t the morph
+   * influences, b_j and r_j from boneBounds()). LBS moves a vertex to a convex combination of
+   * the S_j v, each in its joint's ball, so the box of the balls always holds it. GCS (weights)
+   * and DQS blend rigid motions of the vertex's own joints: where those agree at a joint (a
+   * connected skeleton) the blend turns about it, so the vertex stays within r_j of that posed
+   * joint. The paper's criteria also move a part's skin with its parent's and child's motions,
+   * so they use the 'near' radii; the classic model's contours swell by at most 1 + bulge, so
+   * it uses the 'near' radii times k = 1 + maxBulge (k = 1 otherwise). Checked on 30 frames of
+   * every clip of the default human and the shared test characters (CesiumMan, Fox,
+   * RobotExpressive, Soldier), every method and criterion: every vertex inside. The sphere
+   * circumscribes the box (generous: culling must never drop a visible mesh; a whole body's
+   * sphere came out 1.2–1.5× the exact one, classic about 5×). Raycasts get exact bounds
+   * instead (DeformedMesh). No allocation: matrices, vectors and bounds are preallocated.
    */
-  update(options: { updateMatrixWorld?: boolean } = {}): void {
+  update(options?: { updateMatrixWorld?: boolean }): void {
+    this.live();
     const source = this.source;
-    if (options.updateMatrixWorld !== false) this.root.updateMatrixWorld();
+    const mesh = this.mesh;
+    if (options?.updateMatrixWorld !== false) updateWorld(this.scope);
+    if (this.inPlace) {
+      mesh.visible = source.visible;
+      if (!source.visible) return;
+    }
     const bones = source.skeleton.bones;
     const inverses = source.skeleton.boneInverses;
     const skin = this.skin;
@@ -169,10 +561,92 @@ export class SkinDeformer {
       const e = tmp.elements;
       for (let k = 0; k < 16; k++) skin[16 * j + k] = e[k];
     }
-    this.deformer.deform(skin);
-    this.mesh.matrix.copy(source.matrixWorld);
-    this.mesh.matrixWorld.copy(source.matrixWorld);
+    const deformer = this.deformer;
+    let grow = 0; // how far the morphs can move a vertex this frame
+    const maxDelta = this.maxDelta;
+    if (maxDelta) {
+      const influences = source.morphTargetInfluences;
+      if (influences && influences.length === maxDelta.length) {
+        deformer.setMorphInfluences(influences);
+        for (let t = 0; t < influences.length; t++) grow += Math.abs(influences[t]) * maxDelta[t];
+      }
+    }
+    deformer.deform(skin);
+    this.boundsFromBones(grow);
+    const tangents = this.tangentDeformer;
+    if (tangents) {
+      tangents.deform(skin);
+      const t = tangents.normals, out = this.tangentOut!;
+      for (let o = 0, n = tangents.vertexCount; o < n; o++) {
+        out[4 * o] = t[3 * o];
+        out[4 * o + 1] = t[3 * o + 1];
+        out[4 * o + 2] = t[3 * o + 2];
+      }
+      (mesh.geometry.getAttribute('tangent') as THREE.BufferAttribute).needsUpdate = true;
+    }
+    if (this.inPlace && !this.childOfSource) {
+      mesh.position.copy(source.position);
+      mesh.quaternion.copy(source.quaternion);
+      mesh.scale.copy(source.scale);
+      mesh.matrix.copy(source.matrix);
+      mesh.matrixWorld.copy(source.matrixWorld);
+    } else if (this.childOfSource) {
+      mesh.matrixWorld.copy(source.matrixWorld); // matrix stays identity
+    } else {
+      mesh.matrix.copy(source.matrixWorld);
+      mesh.matrixWorld.copy(source.matrixWorld);
+    }
     this.syncAttributes();
+  }
+
+  /** The per-frame bounds (see update()), from the skin matrices just computed. */
+  private boundsFromBones(grow: number): void {
+    const skin = this.skin, tmp = this.tmp, p = this.point, pivots = this.pivots;
+    const { joints, radii } = this.balls, factor = this.ballFactor;
+    let x0 = Infinity, y0 = Infinity, z0 = Infinity, x1 = -Infinity, y1 = -Infinity, z1 = -Infinity;
+    for (let i = 0; i < joints.length; i++) {
+      const j = joints[i];
+      tmp.fromArray(skin, 16 * j);
+      p.set(pivots[3 * j], pivots[3 * j + 1], pivots[3 * j + 2]).applyMatrix4(tmp);
+      const r = (radii[j] * factor + grow) * tmp.getMaxScaleOnAxis();
+      if (p.x - r < x0) x0 = p.x - r;
+      if (p.y - r < y0) y0 = p.y - r;
+      if (p.z - r < z0) z0 = p.z - r;
+      if (p.x + r > x1) x1 = p.x + r;
+      if (p.y + r > y1) y1 = p.y + r;
+      if (p.z + r > z1) z1 = p.z + r;
+    }
+    this.setBounds(x0, y0, z0, x1, y1, z1);
+    this.exactFresh = false;
+  }
+
+  private setBounds(x0: number, y0: number, z0: number, x1: number, y1: number, z1: number): void {
+    if (!(x0 <= x1 && y0 <= y1 && z0 <= z1)) {
+      this.box.makeEmpty();
+      this.sphere.makeEmpty();
+      return;
+    }
+    this.box.min.set(x0, y0, z0);
+    this.box.max.set(x1, y1, z1);
+    this.box.getCenter(this.sphere.center);
+    this.sphere.radius = 0.5 * Math.sqrt((x1 - x0) ** 2 + (y1 - y0) ** 2 + (z1 - z0) ** 2);
+  }
+
+  /** Exact bounds of the current output (one pass), before raycasts; false when the output is stale. */
+  private exactBounds(): boolean {
+    if (this.isDisposed || (this.inPlace && !this.mesh.visible)) return false;
+    if (this.exactFresh) return true;
+    const a = this.deformer.positions;
+    let x0 = Infinity, y0 = Infinity, z0 = Infinity, x1 = -Infinity, y1 = -Infinity, z1 = -Infinity;
+    for (let i = 0; i < a.length; i += 3) {
+      const x = a[i], y = a[i + 1], z = a[i + 2];
+      x0 = x < x0 ? x : x0; x1 = x > x1 ? x : x1;
+      y0 = y < y0 ? y : y0; y1 = y > y1 ? y : y1;
+      z0 = z < z0 ? z : z0; z1 = z > z1 ? z : z1;
+    }
+    this.setBounds(x0, y0, z0, x1, y1, z1);
+    this.exactFresh = true;
+    return true;
   }
 
   /** Points the attributes at live views (memory growth detaches old ones) and flags the upload. */
@@ -192,10 +666,144 @@ export class SkinDeformer {
     return this.method;
   }
 
-  /** Frees the wasm memory and the geometry (not the material, which the caller may share). */
+  /** True when tangents are deformed this build (the source has them and the method keeps vertices). */
+  get deformsTangents(): boolean {
+    return this.tangentDeformer !== null;
+  }
+
+  private live(): void {
+    if (this.isDisposed) throw new GcsError('DISPOSED', 'this SkinDeformer has been disposed');
+  }
+
+  /**
+   * Frees the wasm memory (deformers and rigs) and the output geometry, removes `mesh` from its
+   * parent and, in place, puts the source back in the render (its layers as they were). Not the
+   * material, which is the source's or the caller's. Safe to call twice.
+   */
   dispose(): void {
+    if (this.isDisposed) return;
+    this.isDisposed = true;
     this.deformer?.dispose();
+    this.tangentDeformer?.dispose();
+    this.tangentDeformer = null;
+    this.tangentRig?.dispose();
     this.rig.dispose();
+    this.mesh.removeFromParent();
     this.mesh.geometry.dispose();
+    (this.mesh as DeformedMesh).exactBounds = null;
+    if (this.inPlace) this.source.layers.mask = this.sourceLayers;
+  }
+
+  get disposed(): boolean {
+    return this.isDisposed;
   }
 }
+
+export interface GcsCharacterOptions {
+  /** Which deformer drives every skin. Default 'gcs'. */
+  method?: DeformerKind;
+  gcs?: GcsOptions;
+  classic?: ClassicOptions;
+  /** See SkinDeformerOptions.tangents. Default 'deform'. */
+  tangents?: 'deform' | 'drop';
+  /** Which SkinnedMeshes under the root to drive. Default: all of them. */
+  filter?: (mesh: THREE.SkinnedMesh) => boolean;
+}
+
+/**
+ * A whole character deformed in wasm, in place: every SkinnedMesh under `root` (a glTF scene or
+ * any Object3D, several skins on one or several skeletons) gets a deformed THREE.Mesh under the
+ * same parent with the same local transform, material (the same object: textures, vertex
+ * colours, normal maps), attributes, shadow flags, name, layers and renderOrder; the SkinnedMesh
+ * leaves the render, shadows and raycasts (its layers are cleared) but stays in the graph, so the
+ * mixer keeps driving its bones and morph influences. Adding `root` to your scene is all it
+ * takes. Morph targets: GCS, LBS and DQS (the classic model resamples the mesh and skips them).
+ *
+ *   const character = new GcsCharacter(gcs, gltf.scene, { method: 'gcs', gcs: { sections: 8 } });
+ *   // each frame: mixer.update(dt); character.update(); renderer.render(scene, camera);
+ *
+ * `dispose()` frees every skin's wasm memory and deformed geometry, removes the deformed meshes
+ * and shows the SkinnedMeshes again. Throws GcsError 'NO_SKIN' if root holds no SkinnedMesh; a
+ * skin that cannot be built (GcsError) undoes the ones already built.
+ */
+export class GcsCharacter {
+  readonly root: THREE.Object3D;
+  /** One per SkinnedMesh, in traversal order. */
+  readonly skins: readonly SkinDeformer[];
+  /** The deformed meshes, in the order of `skins`. */
+  readonly meshes: readonly THREE.Mesh[];
+  /** What update() refreshes: root, or a common ancestor of root and bones kept outside it. */
+  private readonly scope: THREE.Object3D;
+  private isDisposed = false;
+
+  constructor(readonly gcs: GcsSkin, root: THREE.Object3D, options: GcsCharacterOptions = {}) {
+    if (!root || !(root as THREE.Object3D).isObject3D) throw new GcsError('INVALID_ARGUMENT', 'GcsCharacter needs a THREE.Object3D (a glTF scene, a group or a SkinnedMesh)');
+    this.root = root;
+    const sources: THREE.SkinnedMesh[] = [];
+    root.traverse((o) => {
+      const s = o as THREE.SkinnedMesh;
+      if (s.isSkinnedMesh && (!options.filter || options.filter(s))) sources.push(s);
+    });
+    if (!sources.length) throw new GcsError('NO_SKIN', 'no skinned mesh (THREE.SkinnedMesh with a skeleton) under this object: there is nothing to deform');
+    updateWorld(root);
+    const skins: SkinDeformer[] = [];
+    try {
+      for (const source of sources) {
+        skins.push(new SkinDeformer(gcs, source, {
+          method: options.method, gcs: options.gcs, classic: options.classic, tangents: options.tangents, inPlace: true,
+        }));
+      }
+    } catch (e) {
+      for (const s of skins.reverse()) s.dispose();
+      throw e;
+    }
+    this.skins = skins;
+    this.meshes = skins.map((s) => s.mesh);
+    this.scope = commonAncestor([root, ...sources.flatMap((s) => s.skeleton.bones)]);
+  }
+
+  /**
+   * Once per frame, after the mixer: one world-matrix update of the character (ancestors first),
+   * then every skin poses from its skeleton and deforms. No allocation.
+   */
+  update(): void {
+    if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCharacter has been disposed');
+    updateWorld(this.scope);
+    const skins = this.skins;
+    for (let i = 0; i < skins.length; i++) skins[i].update(NO_WORLD_UPDATE);
+  }
+
+  /**
+   * Rebuilds every skin with another method or options (e.g. a new section count). All or
+   * nothing: every new deformer is built before any is shown; on a failure all stay as they were.
+   */
+  rebuild(method: DeformerKind = this.method, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): void {
+    if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCharacter has been disposed');
+    const pending: { skin: SkinDeformer; build: PendingBuild }[] = [];
+    try {
+      for (const skin of this.skins) pending.push({ skin, build: skin.prepare(method, options) });
+    } catch (e) {
+      for (const p of pending) p.skin.discard(p.build);
+      throw e;
+    }
+    for (const p of pending) p.skin.commit(p.build);
+  }
+
+  /** The method of the current build. */
+  get method(): DeformerKind {
+    return this.skins[0].currentMethod;
+  }
+
+  /** Frees every skin (wasm memory, deformed geometry), removes the deformed meshes and shows the SkinnedMeshes again. Safe to call twice. */
+  dispose(): void {
+    if (this.isDisposed) return;
+    this.isDisposed = true;
+    for (const s of this.skins) s.dispose();
+  }
+
+  get disposed(): boolean {
+    return this.isDisposed;
+  }
+}
+
+const NO_WORLD_UPDATE = Object.freeze({ updateMatrixWorld: false });
