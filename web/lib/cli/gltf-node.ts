@@ -1,8 +1,12 @@
 // Loads a glTF skinned character in node (no DOM, no image decoder). The file is first checked by
 // gltf-validate.ts (GLB container, JSON structure, buffer ranges, node graph, skins): a bad file is
 // a GltfError with a code and one sentence, before any loader sees it. Then @gltf-transform/core
-// reads it and drops the textures, and three's GLTFLoader parses the rest into the same objects a
-// browser gets. Used by `gcs-skin report`, the bench scripts and tests.
+// reads it, with the decoders of the three compression extensions the field uses
+// (KHR_mesh_quantization, EXT_meshopt_compression with meshoptimizer's MeshoptDecoder,
+// KHR_draco_mesh_compression with draco3dgltf's decoder), drops the textures, turns the geometry
+// back into plain float attributes (more than 4 influences per vertex: the 4 largest, renormalised)
+// and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
+// gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
 import { readFile } from 'node:fs/promises';
 import { dirname, resolve } from 'node:path';
 import * as THREE from 'three';
@@ -53,6 +57,16 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
   } catch (e) {
     throw new GltfError('UNREADABLE', file, '', `cannot read ${file}: ${reason(e)}`);
   }
+  return readGltfBytes(bytes, file, dirname(file));
+}
+
+/**
+ * Validates the bytes of a .glb or .gltf (gltf-validate.ts); `name` names it in messages. External
+ * buffers are read from `baseDir` (null: bytes with no folder, so a buffer in a file of its own is
+ * an UNREADABLE error). Throws a GltfError for anything wrong.
+ */
+export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: string | null): Promise<GltfFile> {
+  const file = name;
   const { json, bin, glb } = parseGltfContainer(bytes, file);
   const resources: Record<string, Uint8Array> = {};
   const data: (BufferData | undefined)[] = [];
@@ -80,11 +94,14 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
       data.push({ byteLength: inline.byteLength, source: 'its data: URI' });
       continue;
     }
+    if (baseDir === null)
+      throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
+        `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
     let path: string;
     try {
-      path = resolve(dirname(file), decodeURIComponent(uri));
+      path = resolve(baseDir, decodeURIComponent(uri));
     } catch {
-      path = resolve(dirname(file), uri);
+      path = resolve(baseDir, uri);
     }
     try {
       resources[uri] = await readFile(path);
@@ -100,18 +117,153 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
   return { json, resources };
 }
 
-/** Reads a .glb or .gltf file in node into three.js objects (textures dropped). Throws a GltfError for a bad file. */
-export async function loadGltfFile(file: string): Promise<LoadedModel> {
-  const { json, resources } = await readGltfFile(file);
-  const { NodeIO } = await import('@gltf-transform/core');
+/** The compression extensions read (and removed after decoding); gltf-validate.ts rejects every other required one. */
+const COMPRESSION = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression'] as const;
+
+// The decoders, loaded on the first file that needs them and kept (draco's takes ~100 ms to instantiate).
+let meshoptDecoder: Promise<unknown> | undefined;
+let dracoDecoder: Promise<unknown> | undefined;
+const DRACO_MODULE = 'draco3dgltf';
+
+/** A NodeIO that reads the compression extensions `used` by a file, with their decoders registered. */
+async function decodingIO(used: readonly string[]) {
+  const [{ NodeIO }, ext] = await Promise.all([import('@gltf-transform/core'), import('@gltf-transform/extensions')]);
+  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression]);
+  const dependencies: Record<string, unknown> = {};
+  if (used.includes('EXT_meshopt_compression')) {
+    meshoptDecoder ??= import('meshoptimizer').then(async ({ MeshoptDecoder }) => {
+      await MeshoptDecoder.ready;
+      return MeshoptDecoder;
+    });
+    dependencies['meshopt.decoder'] = await meshoptDecoder;
+  }
+  if (used.includes('KHR_draco_mesh_compression')) {
+    // draco3dgltf is CommonJS without types: its default export has createDecoderModule().
+    dracoDecoder ??= import(DRACO_MODULE).then((m) => (m.default ?? m).createDecoderModule());
+    dependencies['draco3d.decoder'] = await dracoDecoder;
+  }
+  return io.registerDependencies(dependencies);
+}
+
+type Doc = import('@gltf-transform/core').Document;
+type Accessor = import('@gltf-transform/core').Accessor;
+
+/** Semantics turned back into FLOAT when KHR_mesh_quantization stored them as integers. */
+const FLOAT_SEMANTICS = /^(POSITION|NORMAL|TANGENT)$/;
+
+/**
+ * Turns decoded, possibly quantized geometry into plain glTF 2.0: POSITION, NORMAL and TANGENT
+ * (and their morph targets) as FLOAT, more than 4 joint influences per vertex reduced to the 4
+ * largest (renormalised, with a warning: the core takes 4), every accessor in one buffer, and the
+ * compression extensions removed, so the GLB written next is uncompressed.
+ */
+function plainGeometry(doc: Doc, warnings: string[]): void {
+  const root = doc.getRoot();
+  const floats = new Map<Accessor, Accessor>();
+  const toFloat = (a: Accessor): Accessor => {
+    if (a.getComponentType() === 5126) return a;
+    let f = floats.get(a);
+    if (!f) {
+      const size = a.getElementSize(), count = a.getCount();
+      const out = new Float32Array(size * count), e: number[] = [];
+      for (let i = 0; i < count; i++) out.set(a.getElement(i, e), i * size);
+      f = doc.createAccessor(a.getName()).setType(a.getType()).setArray(out).setBuffer(a.getBuffer());
+      floats.set(a, f);
+    }
+    return f;
+  };
+  root.listMeshes().forEach((mesh, mi) => mesh.listPrimitives().forEach((prim, pi) => {
+    for (const semantic of prim.listSemantics())
+      if (FLOAT_SEMANTICS.test(semantic)) prim.setAttribute(semantic, toFloat(prim.getAttribute(semantic)!));
+    for (const target of prim.listTargets())
+      for (const semantic of target.listSemantics())
+        if (FLOAT_SEMANTICS.test(semantic)) target.setAttribute(semantic, toFloat(target.getAttribute(semantic)!));
+    const sets = prim.listSemantics().filter((s) => /^JOINTS_[1-9]\d*$/.test(s));
+    if (sets.length) {
+      const name = `mesh ${mi}${mesh.getName() ? ` '${mesh.getName()}'` : ''} primitive ${pi}`;
+      const w = reduceInfluences(doc, prim, name);
+      if (w) warnings.push(w);
+    }
+  }));
+  for (const a of floats.keys()) if (!a.listParents().some((p) => p !== root)) a.dispose();
+  for (const e of root.listExtensionsUsed()) if ((COMPRESSION as readonly string[]).includes(e.extensionName)) e.dispose();
+  // One buffer (a GLB holds one): meshopt's decoded views and a .gltf's several buffers end up in the first.
+  const [first, ...rest] = root.listBuffers();
+  if (first && rest.length) {
+    for (const a of root.listAccessors()) a.setBuffer(first);
+    for (const b of rest) b.dispose();
+  }
+}
+
+/**
+ * JOINTS_0..n / WEIGHTS_0..n (more than 4 influences) → JOINTS_0 / WEIGHTS_0 with the 4 largest
+ * weights of each vertex, renormalised to sum 1. Returns the warning, or null when the extra sets
+ * were all zero.
+ */
+function reduceInfluences(doc: Doc, prim: import('@gltf-transform/core').Primitive, name: string): string | null {
+  const pairs: [Accessor, Accessor][] = [];
+  for (let k = 0; ; k++) {
+    const j = prim.getAttribute(`JOINTS_${k}`), w = prim.getAttribute(`WEIGHTS_${k}`);
+    if (!j || !w) break;
+    pairs.push([j, w]);
+  }
+  const count = prim.getAttribute('POSITION')?.getCount() ?? pairs[0]?.[0].getCount() ?? 0;
+  if (pairs.length < 2) return null;
+  const influences = 4 * pairs.length;
+  const joints = new Uint16Array(4 * count), weights = new Float32Array(4 * count);
+  const jv = new Array<number>(influences), wv = new Array<number>(influences), order = new Array<number>(influences);
+  const je: number[] = [], we: number[] = [];
+  let cut = 0, maxDropped = 0, maxJoint = 0;
+  for (let v = 0; v < count; v++) {
+    pairs.forEach(([j, w], k) => {
+      j.getElement(v, je);
+      w.getElement(v, we);
+      for (let c = 0; c < 4; c++) { jv[4 * k + c] = je[c]; wv[4 * k + c] = we[c]; order[4 * k + c] = 4 * k + c; }
+    });
+    order.sort((a, b) => wv[b] - wv[a] || a - b);
+    let kept = 0;
+    for (let c = 0; c < 4; c++) kept += Math.max(0, wv[order[c]]);
+    const dropped = wv[order[4]] > 0 ? wv[order[4]] : 0;
+    if (dropped > 0) { cut++; maxDropped = Math.max(maxDropped, dropped); }
+    for (let c = 0; c < 4; c++) {
+      const o = order[c];
+      const weight = wv[o] > 0 ? wv[o] : 0;
+      joints[4 * v + c] = weight > 0 ? jv[o] : 0;
+      weights[4 * v + c] = kept > 0 ? weight / kept : 0;
+      maxJoint = Math.max(maxJoint, joints[4 * v + c]);
+    }
+  }
+  const buffer = pairs[0][0].getBuffer();
+  const jointsOut = maxJoint < 256 ? Uint8Array.from(joints) : joints;
+  prim.setAttribute('JOINTS_0', doc.createAccessor().setType('VEC4').setArray(jointsOut).setBuffer(buffer));
+  prim.setAttribute('WEIGHTS_0', doc.createAccessor().setType('VEC4').setArray(weights).setBuffer(buffer));
+  for (let k = 1; k < pairs.length; k++) {
+    prim.setAttribute(`JOINTS_${k}`, null);
+    prim.setAttribute(`WEIGHTS_${k}`, null);
+  }
+  for (const [j, w] of pairs) for (const a of [j, w]) if (a.listParents().every((p) => p === doc.getRoot())) a.dispose();
+  if (!cut) return null;
+  return `${name} has ${influences} joint influences per vertex (JOINTS_0..${pairs.length - 1}, WEIGHTS_0..${pairs.length - 1}); ` +
+    `gcs-skin takes 4: kept the 4 largest of each vertex and renormalised them (${n(cut)} of ${n(count)} vertices lost an influence, the largest lost weight ${maxDropped.toPrecision(3)})`;
+}
+
+/**
+ * Reads a .glb or .gltf file (a path, or its bytes: `name` then names it in messages) in node into
+ * three.js objects: compressed geometry decoded, textures dropped. Throws a GltfError for a bad file.
+ */
+export async function loadGltfFile(file: string | Uint8Array, name = typeof file === 'string' ? file : 'the glTF bytes'): Promise<LoadedModel> {
+  const { json, resources } = typeof file === 'string' ? await readGltfFile(file) : await readGltfBytes(file, name, null);
+  file = name;
   const warnings: string[] = [];
   const logger = { debug() {}, info() {}, warn: (t: string) => void warnings.push(t), error: (t: string) => void warnings.push(t), verbosity: 2 };
-  const io = new NodeIO().setLogger(logger as never);
   let bytes: Uint8Array;
   const zeroWeights = new Map<string, number[]>();
   try {
+    const used: string[] = Array.isArray(json.extensionsUsed) ? json.extensionsUsed : [];
+    const io = (await decodingIO(used)).setLogger(logger as never);
     const doc = await io.readJSON({ json, resources } as Parameters<typeof io.readJSON>[0]);
     for (const texture of doc.getRoot().listTextures()) texture.dispose();
+    plainGeometry(doc, warnings);
     // three's GLTFLoader binds a vertex whose skin weights are all 0 to the first joint ("do
     // something reasonable"): note such vertices, to give them back their zeros below, so that
     // createRig reports them (BAD_WEIGHTS) instead of deforming them with a joint they do not have.

@@ -10,7 +10,9 @@
 // Checked:
 // - the GLB container: the 12-byte header (magic 'glTF', version 2, total length = file size), the
 //   chunks (8-byte headers, lengths inside the file, JSON first, at most one BIN);
-// - the JSON: syntax, asset.version 2.x, no required extension (the loader registers none);
+// - the JSON: syntax, asset.version 2.x, no required extension but the three compression ones the
+//   loader decodes (KHR_mesh_quantization, EXT_meshopt_compression, KHR_draco_mesh_compression),
+//   whose own references (compressed buffer views, Draco attribute ids) are checked too;
 // - buffers: the declared byteLength against the data (BIN chunk, data: URI or external file);
 // - buffer views inside their buffers, accessors (count, type, componentType, byte stride, sparse
 //   parts) inside their buffer views;
@@ -34,8 +36,9 @@ export type GltfErrorCode =
   | 'NODE_CYCLE'      // a node its own child or ancestor (joint hierarchies included)
   | 'NODE_HIERARCHY'  // a node with two parents, a scene root that is someone's child
   | 'BAD_SKIN'        // a skin or skinned node that cannot be skinned
-  | 'UNSUPPORTED'     // a required extension the loader does not read
-  | 'LOAD_FAILED';    // passed these checks but the loaders still failed (their message follows)
+  | 'UNSUPPORTED'     // a required extension the loader does not read (all but READ_EXTENSIONS)
+  | 'LOAD_FAILED'     // passed these checks but the loaders still failed (their message follows)
+  | 'NO_SKINNED_MESH'; // loadCharacter (gcs-skin/gltf): the file has no skinned mesh
 
 /** A glTF file that cannot be loaded, with a stable `code` and a one-line sentence. */
 export class GltfError extends Error {
@@ -64,6 +67,9 @@ export interface GltfContainer {
   bin?: Uint8Array;
   glb: boolean;
 }
+
+/** The required extensions the loader reads (web/lib/cli/gltf-node.ts decodes them); any other is UNSUPPORTED. */
+export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression'];
 
 const GLB_MAGIC = 0x46546c67; // 'glTF'
 const CHUNK_JSON = 0x4e4f534a;
@@ -212,9 +218,11 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
   const required = json.extensionsRequired;
   if (required !== undefined) {
     if (!Array.isArray(required)) fail('BAD_STRUCTURE', '/extensionsRequired', `'extensionsRequired' is not an array`);
-    if (required.length)
+    const unread = required.filter((x: unknown) => !READ_EXTENSIONS.includes(x as string));
+    if (unread.length)
       throw new GltfError('UNSUPPORTED', file, '/extensionsRequired',
-        `${file} requires the glTF extension${required.length > 1 ? 's' : ''} ${required.join(', ')}, which this loader does not read`);
+        `${file} requires the glTF extension${unread.length > 1 ? 's' : ''} ${unread.join(', ')}, which this loader does not read` +
+        ` (it reads ${READ_EXTENSIONS.join(', ')})`);
   }
 
   const accessors = list('accessors'), bufferViews = list('bufferViews'), bufferDefs = list('buffers');
@@ -272,6 +280,24 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer view ${i}'s byteLength is ${JSON.stringify(v.byteLength)}, not a whole number ≥ 1`);
     if (v.byteStride !== undefined && (!Number.isInteger(v.byteStride) || v.byteStride < 4 || v.byteStride > 252))
       fail('BAD_STRUCTURE', `${where}/byteStride`, `buffer view ${i}'s byteStride is ${JSON.stringify(v.byteStride)}, not a whole number from 4 to 252`);
+    const meshopt = v.extensions?.EXT_meshopt_compression;
+    if (meshopt !== undefined) {
+      // The compressed bytes: inside their buffer; decoded, count × byteStride bytes, inside this view.
+      const mw = `${where}/extensions/EXT_meshopt_compression`;
+      if (!isObject(meshopt)) fail('BAD_STRUCTURE', mw, `the EXT_meshopt_compression of buffer view ${i} is not an object`);
+      ref(meshopt.buffer, bufferDefs, 'buffer', `${mw}/buffer`, `the compressed data of buffer view ${i}`, true);
+      const mo = meshopt.byteOffset ?? 0;
+      for (const [key, value] of [['byteOffset', mo], ['byteLength', meshopt.byteLength], ['byteStride', meshopt.byteStride], ['count', meshopt.count]] as const)
+        if (!isIndex(value)) fail('BAD_STRUCTURE', `${mw}/${key}`, `the compressed data of buffer view ${i} has ${key} ${JSON.stringify(value)}, not a whole number`);
+      const data = buffers[meshopt.buffer];
+      const have = data ? Math.min(data.byteLength, bufferDefs[meshopt.buffer].byteLength) : bufferDefs[meshopt.buffer].byteLength;
+      if (mo + meshopt.byteLength > have)
+        fail('OUT_OF_BOUNDS', mw,
+          `the compressed data of buffer view ${i} (bytes ${n(mo)} to ${n(mo + meshopt.byteLength)} of buffer ${meshopt.buffer}) goes past the end of its buffer, which has ${n(have)} bytes`);
+      if (meshopt.count * meshopt.byteStride > v.byteLength)
+        fail('OUT_OF_BOUNDS', mw,
+          `buffer view ${i} decompresses to ${plural(meshopt.count, 'element')} of ${n(meshopt.byteStride)} bytes, more than its byteLength ${n(v.byteLength)}`);
+    }
     const size = bufferDefs[v.buffer].byteLength;
     if (offset + v.byteLength > size)
       fail('OUT_OF_BOUNDS', where,
@@ -344,6 +370,17 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
             `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
       }
       ref(p.indices, accessors, 'accessor', `${where}/indices`, `${prim}'s indices`);
+      const draco = p.extensions?.KHR_draco_mesh_compression;
+      if (draco !== undefined) {
+        const dw = `${where}/extensions/KHR_draco_mesh_compression`;
+        if (!isObject(draco) || !isObject(draco.attributes)) fail('BAD_STRUCTURE', dw, `the KHR_draco_mesh_compression of ${prim} has no attributes`);
+        ref(draco.bufferView, bufferViews, 'buffer view', `${dw}/bufferView`, `the Draco data of ${prim}`, true);
+        for (const [k, id] of Object.entries(draco.attributes)) {
+          if (!isIndex(id)) fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `the Draco attribute id of ${prim}'s ${k} is ${JSON.stringify(id)}, not a whole number`);
+          if (p.attributes[k] === undefined)
+            fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${k} but no ${k} attribute`);
+        }
+      }
       ref(p.material, materials, 'material', `${where}/material`, prim);
       if (p.targets !== undefined) {
         if (!Array.isArray(p.targets)) fail('BAD_STRUCTURE', `${where}/targets`, `${prim}'s morph targets are not an array`);

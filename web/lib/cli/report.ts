@@ -12,7 +12,7 @@ import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
 } from '../measure.js';
 
-export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--json]
+export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--json]
   Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
   method, build ms, median ms per frame and its fidelity over every sampled frame of every clip:
   rigid error, distance from an independent DQS (p95, max), flipped and stretched triangles,
@@ -21,7 +21,9 @@ export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
   --frames N      frames sampled per clip (default 60)
+  --time-ms N     timing budget per clip and method, ms (default 300; fidelity is unaffected)
   --json          machine-readable output (docs/report-json.md)
+  Reads KHR_mesh_quantization, EXT_meshopt_compression and KHR_draco_mesh_compression files.
   exit codes: 0 ok, 1 some method produced non-finite values, 2 bad arguments or unreadable file`;
 
 export interface ReportOptions {
@@ -304,6 +306,7 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
     else if (a === '--clip') options.clip = value();
     else if (a === '--sections') options.sections = integer(3, 256);
     else if (a === '--frames') options.frames = integer(1, 10000);
+    else if (a === '--time-ms') options.timeMs = integer(1, 60000);
     else if (a.startsWith('-')) throw new ReportError(`unknown option '${a}'`);
     else if (file === undefined) file = a;
     else throw new ReportError(`only one model file, got '${file}' and '${a}'`);
