@@ -1,0 +1,440 @@
+// The issue's acceptance test: the README's GcsCharacter example, as an app outside this
+// repository would use it. The library is packed into a tarball (from a copy of its sources, so
+// `prepack` builds there), a fresh Vite + TypeScript app is made in a temp folder with its own
+// package.json (vite, typescript, three, @types/three at this repo's versions, the tarball as a
+// dependency; nothing points into this repo), its src/main.ts (tests/browser/app-fixture) is the
+// README example adapted to draw a known scene. It must type-check with `tsc --noEmit --strict`,
+// build with `vite build` and, served by `vite preview` in headless Chromium, draw:
+// - with GcsCharacter 'lbs', the same picture as three.js's own SkinnedMesh (pixels);
+// - shadows on the ground under the character, both ways;
+// - with GCS (the default), the character at the same place (silhouette overlap);
+// and keep doing it through a clip change, rebuilds ('gcs' → 'dqs' → 'gcs') and dispose (then
+// the original SkinnedMeshes draw again, the same pixels as three's), with no page or WebGL error.
+// Characters from ../shared/models, copied into the temp app at test time only (skipped, with the
+// reason printed, when absent): Soldier (two skinned meshes on their own skeletons) and
+// CesiumMan (textured).
+import { execFileSync, spawn, spawnSync, type ChildProcess } from 'node:child_process';
+import { copyFileSync, cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { BrowserContext, Page } from 'playwright-core';
+import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
+
+const reason = skipReason();
+if (reason) console.log(reason);
+const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
+const WIDTH = 640, HEIGHT = 480;
+
+/** The characters drawn: file, first clip, a second clip for the clip change ('' = none). */
+const CHARACTERS = [
+  { file: 'Soldier.glb', clip: 'Walk', next: 'Run', skinned: 2, textured: true },
+  { file: 'CesiumMan.glb', clip: '', next: '', skinned: 1, textured: true },
+];
+
+/**
+ * Tolerances, from measurements on this machine (Chromium 156, SwiftShader, 640×480 = 307,200
+ * pixels, Soldier at Walk 0.5 s / CesiumMan at 0.5 s). A pixel "differs" when one of its channels
+ * differs by more than DIFF_THRESHOLD (of 255).
+ */
+const DIFF_THRESHOLD = 16;
+/**
+ * GcsCharacter 'lbs' vs three's own skinning, whole frame, share of differing pixels. Measured:
+ * none (2 and 1 pixels differ at all, by 1/255: float rounding of the same sums). The default GCS
+ * differs from three's LBS by 0.6 % (Soldier) and 1.0 % (CesiumMan) of the frame; three's own
+ * picture shifted by one pixel differs by 2.0 % / 1.5 %. 0.05 % stays 12× below the smallest
+ * real difference while leaving room for another rasteriser's rounding along edges.
+ */
+const LBS_TOLERANCE = 0.0005;
+/**
+ * GCS and DQS silhouettes vs three's (intersection over union of the character's pixels, drawn
+ * without the ground). Measured: GCS 0.990 / 0.986 (Soldier Walk / Run), 0.959 (CesiumMan, thin
+ * limbs: most of its pixels are near an edge); DQS, the reference GCS converges to, 0.986 and
+ * 0.970. Three's own silhouette shifted by 2 pixels: 0.924 (Soldier), 0.883 (CesiumMan).
+ */
+const SILHOUETTE_IOU = 0.93;
+/**
+ * Shadows: ground pixels outside the character that are darker by more than 20 (luminance) than
+ * in the same frame without the character, per pixel of the character's silhouette. Measured
+ * with three's skinning: 0.20 (Soldier), 0.34 (CesiumMan); LBS the same, GCS 1.00× / 0.99× that.
+ * Required: three's above 0.1, and each method's at least 0.9× three's.
+ */
+const SHADOW_MIN = 0.1;
+
+/**
+ * Lines of the README example that the fixture replaces (code only, comments stripped): the
+ * file name (?model=), the method (?method=, 'three' = no GcsCharacter), the clip (?clip=) and
+ * THREE.Timer (a fixed time). Every other line of the README's block must be in src/main.ts.
+ */
+const REPLACED = [
+  "const gltf = await new GLTFLoader().loadAsync('character.glb');",
+  "const character = new GcsCharacter(gcs, gltf.scene, { method: 'gcs', gcs: { sections: 8 } });",
+  'const clip = gltf.animations[0];',
+  'const timer = new THREE.Timer();',
+  'timer.connect(document);',
+  'renderer.setAnimationLoop((time: number) => {',
+  'timer.update(time);',
+  'mixer.update(timer.getDelta());',
+  'character.update();',
+  '});',
+];
+
+function versionOf(pkg: string): string {
+  return JSON.parse(readFileSync(join(ROOT, 'node_modules', pkg, 'package.json'), 'utf8')).version;
+}
+
+async function freePort(): Promise<number> {
+  return new Promise((resolvePort, reject) => {
+    const srv = createServer();
+    srv.once('error', reject);
+    srv.listen(0, '127.0.0.1', () => {
+      const { port } = srv.address() as { port: number };
+      srv.close(() => resolvePort(port));
+    });
+  });
+}
+
+let dir = '';
+let app = '';
+let preview: ChildProcess | null = null;
+let url = '';
+let context: BrowserContext | null = null;
+let lab: Page;
+const timings: Record<string, number> = {};
+const missing = CHARACTERS.filter((c) => !existsSync(join(MODELS_DIR, c.file))).map((c) => c.file);
+if (missing.length) console.log(`app test: ${missing.join(', ')} not in ${MODELS_DIR}: those characters are skipped`);
+
+function run(cmd: string, args: string[], cwd: string): string {
+  const r = spawnSync(cmd, args, { cwd, encoding: 'utf8', env: { ...process.env, NO_COLOR: '1' } });
+  if (r.status !== 0) throw new Error(`${cmd} ${args.join(' ')} failed (${r.status}):\n${r.stdout}\n${r.stderr}`);
+  return r.stdout;
+}
+
+function timed<T>(name: string, f: () => T): T {
+  const t0 = performance.now();
+  try {
+    return f();
+  } finally {
+    timings[name] = Math.round(performance.now() - t0);
+  }
+}
+
+describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (installed tarball)', () => {
+  beforeAll(async () => {
+    dir = mkdtempSync(join(tmpdir(), 'gcs-skin-app-'));
+    // Pack from a copy of the package sources (as tests/package.test.ts): `prepack` builds dist/ there.
+    const src = join(dir, 'src');
+    for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'bin', 'docs/node.md', 'docs/report-json.md', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
+      if (existsSync(join(ROOT, entry))) cpSync(join(ROOT, entry), join(src, entry), { recursive: true });
+    symlinkSync(join(ROOT, 'node_modules'), join(src, 'node_modules'));
+    timed('pack', () => execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: src, stdio: ['ignore', 'pipe', 'pipe'] }));
+    const tarball = readdirSync(dir).find((f) => f.endsWith('.tgz'));
+    if (!tarball) throw new Error('npm pack wrote no tarball');
+    rmSync(src, { recursive: true, force: true });
+
+    // The app: the fixture (index.html, tsconfig.json, src/main.ts) and its own package.json.
+    app = join(dir, 'app');
+    cpSync(join(ROOT, 'tests/browser/app-fixture'), app, { recursive: true });
+    writeFileSync(join(app, 'package.json'), JSON.stringify({
+      name: 'gcs-skin-app', private: true, type: 'module',
+      scripts: { build: 'tsc --noEmit --strict && vite build', preview: 'vite preview' },
+      dependencies: { 'gcs-skin': `file:../${tarball}`, three: versionOf('three') },
+      devDependencies: { vite: versionOf('vite'), typescript: versionOf('typescript'), '@types/three': versionOf('@types/three') },
+    }, null, 2));
+    timed('install', () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline'], app));
+    // The characters, copied at test time only (never into the repository).
+    mkdirSync(join(app, 'public'), { recursive: true });
+    for (const c of CHARACTERS) if (!missing.includes(c.file)) copyFileSync(join(MODELS_DIR, c.file), join(app, 'public', c.file));
+
+    const port = await freePort();
+    preview = spawn(join(app, 'node_modules/.bin/vite'), ['preview', '--host', '127.0.0.1', '--port', String(port), '--strictPort'], {
+      cwd: app, stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, NO_COLOR: '1' }, detached: false,
+    });
+    url = `http://127.0.0.1:${port}/`;
+  }, 240000);
+
+  afterAll(async () => {
+    await context?.close();
+    if (preview && preview.exitCode === null) {
+      const p = preview;
+      await new Promise<void>((r) => { p.once('exit', () => r()); p.kill('SIGTERM'); setTimeout(r, 5000); });
+    }
+    if (dir) rmSync(dir, { recursive: true, force: true });
+    console.log(`app test timings (ms): ${JSON.stringify(timings)}, screenshots ${JSON.stringify(shotMs)}, console warnings ${JSON.stringify([...new Set(warnings)])}`);
+  });
+
+  test('src/main.ts type-checks with tsc --noEmit --strict and builds with vite build', () => {
+    // The app's own tools, from its own node_modules.
+    timed('tsc', () => run(join(app, 'node_modules/.bin/tsc'), ['--noEmit', '--strict', '-p', '.'], app));
+    timed('vite build', () => run(join(app, 'node_modules/.bin/vite'), ['build'], app));
+    const assets = readdirSync(join(app, 'dist/assets'));
+    expect(assets.some((f) => /^gcs-skin.*\.wasm$/.test(f)), assets.join(' ')).toBe(true);
+    // The app resolved the installed package, not this checkout.
+    expect(existsSync(join(app, 'node_modules/gcs-skin/dist/three.js'))).toBe(true);
+    expect(readFileSync(join(app, 'package.json'), 'utf8')).not.toContain(ROOT);
+    for (const f of assets.filter((a) => a.endsWith('.js'))) expect(readFileSync(join(app, 'dist/assets', f), 'utf8')).not.toContain(ROOT);
+  }, 120000);
+
+  for (const c of CHARACTERS) {
+    test.skipIf(missing.includes(c.file))(`${c.file}: GcsCharacter 'lbs' draws three's pixels, GCS the same silhouette, shadows both ways; clip change, rebuilds, dispose`, async () => {
+      expect(existsSync(join(app, 'dist/index.html')), 'the app was not built').toBe(true);
+      await waitForServer(url);
+      if (!context) {
+        context = await launchChromium();
+        lab = await context.newPage();
+        await lab.setViewportSize({ width: 64, height: 64 });
+      }
+      const t0 = performance.now();
+      const steps: Record<string, number> = {};
+      let last = t0;
+      const lap = (name: string) => { const now = performance.now(); steps[name] = Math.round(now - last); last = now; };
+      const q = (method: string) => `${url}?model=${c.file}&method=${method}${c.clip ? `&clip=${c.clip}` : ''}`;
+
+      // three.js's own SkinnedMesh: the reference.
+      const three = await open(context, q('three'));
+      lap('open three');
+      expect(await three.page.evaluate(() => window.__app.deformedMeshes())).toBe(0);
+      expect(await three.page.evaluate(() => window.__app.skinnedMeshes())).toBe(c.skinned);
+      expect(await three.page.evaluate(() => window.__app.textured())).toBe(c.textured);
+      const ref = {
+        full: await shot(three.page, { ground: true, character: true }),
+        sil: await shot(three.page, { ground: false, character: true }),
+        empty: await shot(three.page, { ground: true, character: false }),
+      };
+      let ref2 = ref;
+      if (c.next) {
+        await three.page.evaluate((n) => window.__app.play(n), c.next);
+        ref2 = { full: await shot(three.page, { ground: true, character: true }), sil: await shot(three.page, { ground: false, character: true }), empty: ref.empty };
+      }
+      await three.close();
+      lap('three shots');
+
+      // GcsCharacter, LBS: three's pixels.
+      const lbs = await open(context, q('lbs'));
+      lap('open lbs');
+      expect(await lbs.page.evaluate(() => window.__app.deformedMeshes())).toBe(c.skinned);
+      const lbsFull = await shot(lbs.page, { ground: true, character: true });
+      await lbs.close();
+      lap('lbs shots');
+
+      // GCS (the default method): same place; then the lifecycle.
+      const gcsPage = await open(context, q('gcs'));
+      const page = gcsPage.page;
+      lap('open gcs');
+      expect(await page.evaluate(() => window.__app.method())).toBe('gcs');
+      const gcsFull = await shot(page, { ground: true, character: true });
+      const gcsSil = await shot(page, { ground: false, character: true });
+      if (c.next) await page.evaluate((n) => window.__app.play(n), c.next);
+      await animate(page, 3);
+      const gcs2Full = await shot(page, { ground: true, character: true });
+      const gcs2Sil = await shot(page, { ground: false, character: true });
+      await page.evaluate(() => window.__app.rebuild('dqs'));
+      expect(await page.evaluate(() => window.__app.method())).toBe('dqs');
+      const dqsSil = await shot(page, { ground: false, character: true });
+      await animate(page, 3);
+      await page.evaluate(() => window.__app.rebuild('gcs'));
+      expect(await page.evaluate(() => window.__app.method())).toBe('gcs');
+      const regcsFull = await shot(page, { ground: true, character: true });
+      await animate(page, 3);
+      await page.evaluate(() => window.__app.dispose());
+      expect(await page.evaluate(() => window.__app.deformedMeshes())).toBe(0);
+      const disposedFull = await shot(page, { ground: true, character: true });
+      await animate(page, 3);
+      await gcsPage.close();
+      lap('gcs lifecycle');
+
+      const m = {
+        silhouetteArea: await area(lab, ref.sil),
+        lbsFullDiff: await diff(lab, lbsFull, ref.full),
+        lbsExact: await exact(lab, lbsFull, ref.full),
+        shadowThree: await shadow(lab, ref.full, ref.empty, ref.sil),
+        shadowLbs: await shadow(lab, lbsFull, ref.empty, ref.sil), // the same silhouette: lbsFull equals ref.full
+        shadowGcs: await shadow(lab, gcsFull, ref.empty, gcsSil),
+        gcsIou: await iou(lab, gcsSil, ref.sil),
+        gcsFullDiff: await diff(lab, gcsFull, ref.full),
+        gcs2Iou: await iou(lab, gcs2Sil, ref2.sil),
+        dqsIou: await iou(lab, dqsSil, ref2.sil),
+        regcsDiff: await diff(lab, regcsFull, gcs2Full),
+        disposedDiff: await diff(lab, disposedFull, ref2.full),
+        disposedExact: await exact(lab, disposedFull, ref2.full),
+        steps: (lap('measures'), steps),
+        errors: [...three.errors, ...lbs.errors, ...gcsPage.errors],
+        ms: Math.round(performance.now() - t0),
+      };
+      console.log(`app test ${c.file}: ${JSON.stringify(m)}`);
+      if (process.env.APP_TEST_SHOTS) { // keep the pictures to look at
+        mkdirSync(process.env.APP_TEST_SHOTS, { recursive: true });
+        const shots = { refFull: ref.full, refSil: ref.sil, refEmpty: ref.empty, ref2Full: ref2.full, lbsFull, gcsFull, gcs2Full, dqsSil, disposedFull };
+        for (const [k, v] of Object.entries(shots)) writeFileSync(join(process.env.APP_TEST_SHOTS, `${c.file}-${k}.png`), Buffer.from(v, 'base64'));
+      }
+      expect(m.errors).toEqual([]);
+      expect(m.silhouetteArea).toBeGreaterThan(0.03); // the character is in the picture
+      expect(m.lbsFullDiff).toBeLessThanOrEqual(LBS_TOLERANCE);
+      expect(m.shadowThree).toBeGreaterThan(SHADOW_MIN);
+      expect(m.shadowLbs).toBeGreaterThan(0.9 * m.shadowThree);
+      expect(m.shadowGcs).toBeGreaterThan(0.9 * m.shadowThree);
+      expect(m.gcsIou).toBeGreaterThan(SILHOUETTE_IOU);
+      expect(m.gcs2Iou).toBeGreaterThan(SILHOUETTE_IOU);
+      expect(m.dqsIou).toBeGreaterThan(SILHOUETTE_IOU);
+      expect(m.regcsDiff).toBeLessThanOrEqual(LBS_TOLERANCE); // the same build again draws the same picture
+      expect(m.disposedDiff).toBeLessThanOrEqual(LBS_TOLERANCE); // three's own skinning again
+    }, 150000);
+  }
+});
+
+test("src/main.ts is the README's example: every line of it is there, but the ones the fixture replaces", () => {
+  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
+  const section = readme.slice(readme.indexOf('## Using it with three.js'));
+  const block = /```ts\n([\s\S]*?)```/.exec(section);
+  expect(block, 'no ```ts block under "## Using it with three.js" in README.md').not.toBeNull();
+  const code = (line: string) => line.replace(/\s+\/\/.*$/, '').trim();
+  const readmeLines = block![1].split('\n').map(code).filter((l) => l && !l.startsWith('//'));
+  const mainLines = new Set(readFileSync(join(ROOT, 'tests/browser/app-fixture/src/main.ts'), 'utf8').split('\n').map(code));
+  for (const line of REPLACED) expect(readmeLines, `REPLACED lists a line the README no longer has: ${line}`).toContain(line);
+  const absent = readmeLines.filter((l) => !mainLines.has(l) && !REPLACED.includes(l));
+  expect(absent, 'README lines missing from tests/browser/app-fixture/src/main.ts (update the fixture, or list them in REPLACED)').toEqual([]);
+});
+
+async function waitForServer(address: string): Promise<void> {
+  const t0 = performance.now();
+  for (;;) {
+    try {
+      const r = await fetch(address);
+      if (r.ok) return;
+    } catch { /* not yet */ }
+    if (preview?.exitCode !== null) throw new Error(`vite preview exited (${preview?.exitCode})`);
+    if (performance.now() - t0 > 30000) throw new Error(`vite preview did not answer at ${address}`);
+    await new Promise((r) => setTimeout(r, 100));
+  }
+}
+
+interface AppHook {
+  frames(): number;
+  clips(): string[];
+  skinnedMeshes(): number;
+  deformedMeshes(): number;
+  method(): string;
+  textured(): boolean;
+  play(name: string): void;
+  rebuild(method: 'gcs' | 'lbs' | 'dqs' | 'classic'): void;
+  dispose(): void;
+  show(what: { ground?: boolean; character?: boolean }): void;
+  still(stop: boolean): void;
+  glError(): number;
+}
+declare global {
+  interface Window { __app: AppHook }
+}
+
+/** Console warnings of every page, printed (not asserted). */
+const warnings: string[] = [];
+/** Opens the app, collects page errors, console errors and WebGL messages, waits until it draws. */
+async function open(ctx: BrowserContext, address: string): Promise<{ page: Page; errors: string[]; close(): Promise<void> }> {
+  const page = await ctx.newPage();
+  await page.setViewportSize({ width: WIDTH, height: HEIGHT });
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+  page.on('response', (r) => { if (r.status() >= 400) errors.push(`HTTP ${r.status()} ${r.url()}`); });
+  page.on('console', (msg) => {
+    const text = msg.text();
+    if (msg.type() === 'error' || /GL_INVALID|GL ERROR|WebGL: |THREE\.WebGL/i.test(text)) errors.push(`console.${msg.type()}: ${text}`);
+    else if (msg.type() === 'warning') warnings.push(text);
+  });
+  await page.goto(address);
+  await page.waitForFunction(() => document.title === 'ready' && window.__app?.frames() >= 2, undefined, { timeout: 60000, polling: 100 })
+    .catch((e) => { throw new Error(`${address} did not draw: ${errors.join('; ') || (e as Error).message}`); });
+  return {
+    page,
+    errors,
+    close: async () => {
+      const gl = await page.evaluate(() => window.__app.glError());
+      if (gl !== 0) errors.push(`gl.getError() = 0x${gl.toString(16)}`);
+      await page.close();
+    },
+  };
+}
+
+/** Lets the README's loop run `n` frames (the pose is fixed: the same picture each time). */
+async function animate(page: Page, n: number): Promise<void> {
+  const f = await page.evaluate(() => { window.__app.still(false); return window.__app.frames(); });
+  await page.waitForFunction((k) => window.__app.frames() >= k, f + n, { timeout: 30000, polling: 50 });
+}
+
+const shotMs: number[] = [];
+/** Shows or hides the ground and the character, lets a frame draw, and screenshots the page. */
+async function shot(page: Page, what: { ground: boolean; character: boolean }): Promise<string> {
+  const f = await page.evaluate((w) => { window.__app.show(w); window.__app.still(true); return window.__app.frames(); }, what);
+  await page.waitForFunction((n) => window.__app.frames() >= n, f + 1, { timeout: 30000, polling: 50 });
+  const gl = await page.evaluate(() => window.__app.glError());
+  if (gl !== 0) throw new Error(`gl.getError() = 0x${gl.toString(16)}`);
+  const t = performance.now();
+  const png = (await page.screenshot({ type: 'png' })).toString('base64');
+  shotMs.push(Math.round(performance.now() - t));
+  return png;
+}
+
+/**
+ * Pixel measures, run in a blank page of the same browser (PNG decoding without npm packages).
+ * Silhouettes come from pictures without the ground: a pixel is the character's when it differs
+ * from the background (the top-left pixel) by more than 40 in some channel.
+ */
+async function measure(page: Page, kind: 'diff' | 'anydiff' | 'maxdiff' | 'iou' | 'shadow' | 'area', images: string[]): Promise<number> {
+  return page.evaluate(async ({ kind, images, threshold }) => {
+    const decode = async (b64: string) => {
+      const bytes = Uint8Array.from(atob(b64), (ch) => ch.charCodeAt(0));
+      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+      const ctx = canvas.getContext('2d')!;
+      ctx.drawImage(bitmap, 0, 0);
+      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
+    };
+    const imgs = await Promise.all(images.map(decode));
+    const n = imgs[0].width * imgs[0].height;
+    const mask = (img: ImageData) => {
+      const d = img.data, out = new Uint8Array(n);
+      for (let i = 0; i < n; i++)
+        out[i] = Math.max(Math.abs(d[4 * i] - d[0]), Math.abs(d[4 * i + 1] - d[1]), Math.abs(d[4 * i + 2] - d[2])) > 40 ? 1 : 0;
+      return out;
+    };
+    const lum = (d: Uint8ClampedArray, i: number) => 0.2126 * d[4 * i] + 0.7152 * d[4 * i + 1] + 0.0722 * d[4 * i + 2];
+    if (kind === 'diff' || kind === 'anydiff' || kind === 'maxdiff') {
+      const [a, b] = imgs;
+      let over = 0, any = 0, max = 0;
+      for (let i = 0; i < n; i++) {
+        const d = Math.max(Math.abs(a.data[4 * i] - b.data[4 * i]), Math.abs(a.data[4 * i + 1] - b.data[4 * i + 1]), Math.abs(a.data[4 * i + 2] - b.data[4 * i + 2]));
+        if (d > threshold) over++;
+        if (d > 0) any++;
+        if (d > max) max = d;
+      }
+      return kind === 'diff' ? over / n : kind === 'anydiff' ? any / n : max;
+    }
+    if (kind === 'area') {
+      const m = mask(imgs[0]);
+      let k = 0;
+      for (let i = 0; i < n; i++) k += m[i];
+      return k / n;
+    }
+    if (kind === 'iou') {
+      const a = mask(imgs[0]), b = mask(imgs[1]);
+      let inter = 0, union = 0;
+      for (let i = 0; i < n; i++) { inter += a[i] & b[i]; union += a[i] | b[i]; }
+      return union ? inter / union : 0;
+    }
+    // shadow: [full, empty (no character), silhouette]: darker ground pixels outside the character, per silhouette pixel.
+    const [full, empty, sil] = imgs;
+    const m = mask(sil);
+    let dark = 0, area = 0;
+    for (let i = 0; i < n; i++) {
+      area += m[i];
+      if (!m[i] && lum(empty.data, i) - lum(full.data, i) > 20) dark++;
+    }
+    return area ? dark / area : 0;
+  }, { kind, images, threshold: DIFF_THRESHOLD });
+}
+const diff = (p: Page, a: string, b: string) => measure(p, 'diff', [a, b]);
+/** For the record: share of pixels that differ at all, and the largest channel difference. */
+const exact = async (p: Page, a: string, b: string) => ({ any: await measure(p, 'anydiff', [a, b]), max: await measure(p, 'maxdiff', [a, b]) });
+const iou = (p: Page, a: string, b: string) => measure(p, 'iou', [a, b]);
+const area = (p: Page, a: string) => measure(p, 'area', [a]);
+const shadow = (p: Page, full: string, empty: string, sil: string) => measure(p, 'shadow', [full, empty, sil]);
