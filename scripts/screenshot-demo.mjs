@@ -3,8 +3,10 @@
 // and photographs it in headless Chromium (SwiftShader).
 //
 //   node scripts/screenshot-demo.mjs            → docs/demo.png (the default: weights criterion),
-//                                                 docs/demo-sections.png (colour by section, 8 sections)
+//                                                 docs/demo-sections.png (colour by section, 8 sections),
+//                                                 docs/demo-fox.png (the shipped Fox, all three views)
 //   node scripts/screenshot-demo.mjs --out DIR  → the same files in DIR
+//   node scripts/screenshot-demo.mjs --only demo-fox.png → only that one
 //   EXTRA='?criterion=y&colour=1' node scripts/screenshot-demo.mjs → also extra.png
 // A page that shows a message (e.g. the wasm failed to load) or throws is an error: no picture.
 import { existsSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
@@ -17,6 +19,8 @@ import { chromium } from 'playwright-core';
 const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 const outIndex = process.argv.indexOf('--out');
 const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
+const onlyIndex = process.argv.indexOf('--only');
+const only = onlyIndex > 0 ? process.argv[onlyIndex + 1] : null;
 const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
 if (!existsSync(chromiumPath)) {
   console.error(`screenshot-demo: ${chromiumPath} not found (set CHROMIUM=/path/to/chromium)`);
@@ -41,8 +45,10 @@ try {
   const shots = [
     { file: 'demo.png', query: '' },
     { file: 'demo-sections.png', query: '?colour=1&sections=8' },
+    { file: 'demo-fox.png', query: '?model=fox&lbs=1' },
     ...(process.env.EXTRA ? [{ file: 'extra.png', query: process.env.EXTRA }] : []),
-  ];
+  ].filter((s) => !only || s.file === only);
+  if (!shots.length) throw new Error(`--only ${only}: no such shot`);
   for (const shot of shots) {
     const page = await context.newPage();
     const errors = [];
@@ -50,6 +56,7 @@ try {
     await page.goto(url + shot.query);
     await page.waitForFunction(() => window.__demo !== undefined);
     await page.evaluate(() => window.__demo.ready);
+    await page.evaluate(() => window.__demo.idle());
     const message = await page.evaluate(() => window.__demo.error());
     if (message) throw new Error(`${shot.file}: the page says: ${message}`);
     // A stride of the walk with legs apart, then hold it so every view shows the same pose.

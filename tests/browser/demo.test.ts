@@ -1,11 +1,14 @@
 // The demo page in headless Chromium: both views render, animate, follow the GUI's section
 // slider in each GCS criterion (weights, the default; the paper's Y and axial), load a dropped
-// character, and keep the old one when a file is broken.
+// character, and keep the old one when a file is broken. The three characters shipped in public/
+// (Fox, Cesium Man, Robot Expressive) load from the menu and from ?model=, each complete and in
+// its own materials in every view, animated, with its licence on the page.
+import { createHash } from 'node:crypto';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
-import { analyse, existsSync, launchChromium, MODELS_DIR, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { analyse, existsSync, launchChromium, MODELS_DIR, ROOT, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -67,6 +70,17 @@ async function drop(page: Page, files: { name: string; bytes: Buffer }[]): Promi
     await window.__demo.idle();
   }, files.map((f) => ({ name: f.name, b64: f.bytes.toString('base64') })));
 }
+
+/** The characters shipped in public/: menu label, ?model= key, file, sha256 (../shared/models/SOURCES.md), licence named on the page. */
+const SHIPPED = [
+  { label: 'Fox', key: 'fox', file: 'Fox.glb', sha256: 'd97044e701822bac5a62696459b27d7b375aada5de8574ed4362edbba94771f7', licence: /CC0 1\.0.*CC BY 4\.0/, textured: true },
+  { label: 'Cesium Man', key: 'cesiumman', file: 'CesiumMan.glb', sha256: 'd3868164b6d5df6f097b2ee3e056c572ebcf064d064016429a4f1ce66e4a58c8', licence: /CC BY 4\.0.*trademark/, textured: true },
+  { label: 'Robot Expressive', key: 'robot', file: 'RobotExpressive.glb', sha256: '047f5e5fb3bb6d378bd1df16ca6137f2a596c99b3a1b5690b4020c05aaf6f319', licence: /CC0 1\.0/, textured: false },
+];
+
+/** The character menu's select. */
+const characterMenu = (page: Page) =>
+  page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^character$/ }) }).locator('select');
 
 describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
   let server: DemoServer;
@@ -327,6 +341,9 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     expect(state.error).toBe('');
     expect(state.character).toBe(name);
     expect(state.sections).toBeGreaterThan(10);
+    // The menu lists the dropped file and shows it; no shipped attribution for the user's own file.
+    await expect(characterMenu(page).evaluate((el: HTMLSelectElement) => el.options[el.selectedIndex].text)).resolves.toBe(name);
+    expect(await page.evaluate(() => window.__demo.credit())).toMatch(/your own file/);
     await setNumber(page, 'speed', 0.3); // shots a moment apart are never a whole cycle apart
     await frames(page, 3);
     const regions = await viewRegions(page);
@@ -351,6 +368,106 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     expect(await other.evaluate(() => window.__demo.character())).toMatch(/Human/);
     await other.close();
   });
+
+  test('the build ships Fox, Cesium Man and Robot Expressive byte-exact, with LICENSES.md (and no Soldier)', async () => {
+    for (const m of SHIPPED) {
+      const res = await fetch(server.url + m.file);
+      expect(res.status, m.file).toBe(200);
+      const bytes = Buffer.from(await res.arrayBuffer());
+      expect(createHash('sha256').update(bytes).digest('hex'), m.file).toBe(m.sha256);
+      expect(bytes.equals(readFileSync(join(ROOT, 'public', m.file))), `${m.file} as in public/`).toBe(true);
+    }
+    const licences = await fetch(`${server.url}LICENSES.md`);
+    expect(licences.status).toBe(200);
+    const text = await licences.text();
+    for (const words of ['PixelMannen', '@tomkranis', '@AsoboStudio', '@scurest', 'Cesium Trademark Terms', 'Tomás Laulhé', 'Don McCurdy', 'CC BY 4.0', 'CC0 1.0'])
+      expect(text, words).toContain(words);
+    // Soldier.glb (Mixamo) is test data only: never shipped.
+    expect(existsSync(join(ROOT, 'public', 'Soldier.glb'))).toBe(false);
+  });
+
+  // Each shipped character from the menu, in all three views: the GCS and classic views must
+  // show it as completely as three.js does (the robot's rigid limbs are not skinned: they hang on
+  // its bones) and in its own materials (textures: the classic model's resampled skin gets
+  // texture coordinates from the source surface).
+  for (const m of SHIPPED) {
+    test(`the character menu loads ${m.label}: complete, in its own materials in every view, animated, credited`, async () => {
+      const errorsBefore = pageErrors.length;
+      await characterMenu(page).selectOption(m.label);
+      await page.waitForFunction((key) => window.__demo.model() === key && !window.__demo.busy(), m.key, { timeout: 60000 });
+      await page.evaluate(() => window.__demo.idle());
+      expect(await page.evaluate(() => window.__demo.error())).toBe('');
+      expect(await page.evaluate(() => window.__demo.character())).toBe(m.label);
+      await expect(characterMenu(page).evaluate((el: HTMLSelectElement) => el.options[el.selectedIndex].text)).resolves.toBe(m.label);
+
+      const parts = await page.evaluate(() => window.__demo.parts());
+      expect(parts.skinned).toBeGreaterThan(0);
+      expect(parts.gcs, 'a GCS mesh per skinned mesh').toBe(parts.skinned);
+      expect(parts.classic, 'a classic mesh per skinned mesh').toBe(parts.skinned);
+      expect(parts.ownMaterials, 'every deformed mesh wears its source material').toEqual({ gcs: true, classic: true });
+      expect(parts.textured).toEqual({ gcs: m.textured, classic: m.textured });
+      if (m.key === 'robot') expect(parts.rigid, 'the robot\'s rigid parts').toBeGreaterThan(10);
+
+      const credit = await page.evaluate(() => window.__demo.credit());
+      expect(credit).toMatch(m.licence);
+      await expect(page.locator('#credit a').getAttribute('href')).resolves.toBe('LICENSES.md');
+      await expect(page.locator('#credit').isVisible()).resolves.toBe(true);
+
+      if (!(await page.evaluate(() => window.__demo.views())).some((v) => v.kind === 'lbs')) await toggle(page, 'three.js LBS view');
+      await setNumber(page, 'speed', 0.3); // shots a moment apart are never a whole cycle apart
+      try {
+        await frames(page, 3);
+        const regions = await viewRegions(page);
+        const t0 = await page.evaluate(() => window.__demo.time());
+        const a = await page.screenshot();
+        await page.waitForTimeout(300);
+        await frames(page, 3);
+        const stats = await analyse(page, await page.screenshot(), regions, a);
+        expect(await page.evaluate(() => window.__demo.time())).toBeGreaterThan(t0);
+        const [gcsView, classicView, lbsView] = stats;
+        stats.forEach((st, i) => {
+          expect(st.colours, `${m.label}: distinct colours in view ${i}`).toBeGreaterThan(150);
+          expect(st.changed, `${m.label}: view ${i} animates`).toBeGreaterThan(0.002);
+        });
+        // Complete: as much of the fox's and the robot's orange in the GCS and classic views as in three.js's own.
+        if (lbsView.skin > 0.01) {
+          expect(gcsView.skin, `${m.label}: GCS view as complete as LBS`).toBeGreaterThan(0.7 * lbsView.skin);
+          expect(classicView.skin, `${m.label}: classic view as complete as LBS`).toBeGreaterThan(0.6 * lbsView.skin);
+        }
+      } finally {
+        await setNumber(page, 'speed', 1);
+      }
+      expect(pageErrors.slice(errorsBefore)).toEqual([]);
+    });
+  }
+
+  test('the character menu goes back to the default human', async () => {
+    if ((await page.evaluate(() => window.__demo.views())).some((v) => v.kind === 'lbs')) await toggle(page, 'three.js LBS view');
+    await characterMenu(page).selectOption('default human');
+    await page.waitForFunction(() => window.__demo.model() === 'human' && !window.__demo.busy(), null, { timeout: 60000 });
+    expect(await page.evaluate(() => ({ character: window.__demo.character(), error: window.__demo.error() }))).toEqual({ character: 'Human (procedural)', error: '' });
+    expect(await page.evaluate(() => window.__demo.credit())).toMatch(/MIT/);
+  });
+
+  test('?model=fox|cesiumman|robot opens that character, credited, rendering in both views', async () => {
+    for (const m of SHIPPED) {
+      const other = await context.newPage();
+      const errors: string[] = [];
+      other.on('pageerror', (e) => errors.push(e.message));
+      await other.goto(`${server.url}?model=${m.key}`);
+      await other.waitForFunction(() => window.__demo !== undefined);
+      await other.evaluate(() => window.__demo.ready);
+      await other.evaluate(() => window.__demo.idle());
+      expect(await other.evaluate(() => ({ model: window.__demo.model(), character: window.__demo.character(), error: window.__demo.error() })))
+        .toEqual({ model: m.key, character: m.label, error: '' });
+      expect(await other.evaluate(() => window.__demo.credit())).toMatch(m.licence);
+      await frames(other, 2);
+      const stats = await analyse(other, await other.screenshot(), await viewRegions(other));
+      stats.forEach((st, i) => expect(st.colours, `?model=${m.key}: distinct colours in view ${i}`).toBeGreaterThan(150));
+      expect(errors, `?model=${m.key}: page errors`).toEqual([]);
+      await other.close();
+    }
+  }, 180000);
 
   test('no uncaught errors in the page', () => {
     expect(pageErrors).toEqual([]);

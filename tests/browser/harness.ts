@@ -126,6 +126,15 @@ export interface DemoHook {
   busy(): boolean;
   error(): string;
   character(): string;
+  /** The character menu's value: 'human', 'fox', 'cesiumman', 'robot' or 'file'. */
+  model(): string;
+  /** The attribution line on the page ('' when hidden). */
+  credit(): string;
+  parts(): {
+    skinned: number; rigid: number; gcs: number; classic: number;
+    ownMaterials: { gcs: boolean; classic: boolean };
+    textured: { gcs: boolean; classic: boolean };
+  };
   sectionCount(): number;
   sectionsPerPart(): number;
   setSections(n: number): void;

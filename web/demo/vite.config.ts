@@ -9,6 +9,9 @@ export default defineConfig({
   root: here,
   // Relative asset URLs: the built page works from any folder (GitHub Pages, file servers).
   base: './',
+  // Static assets at the repository's top level (public/): the shipped characters (Fox.glb,
+  // CesiumMan.glb, RobotExpressive.glb) and their LICENSES.md, copied as they are to the build's root.
+  publicDir: fileURLToPath(new URL('../../public', import.meta.url)),
   server: { fs: { allow: [repo] } },
   // The human character is generated in a module worker (it imports three).
   worker: { format: 'es' },
