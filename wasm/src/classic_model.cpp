@@ -39,6 +39,13 @@ glm::vec3 orthonormal(const glm::vec3& u, const glm::vec3& n) {
   return len > 1e-6f ? p / len : anyPerpendicular(n);
 }
 
+// |v| without overflow or underflow: divided by its largest component first (the posed bone and
+// the columns of a ×1e20 skin matrix square past FLT_MAX; those of a ×1e-20 one underflow).
+float lengthOf(const glm::vec3& v) {
+  float big = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
+  return big > 0.0f ? big * glm::length(v / big) : 0.0f;
+}
+
 glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
   glm::vec3 s = a + b;
   float len = glm::length(s);
@@ -580,11 +587,11 @@ void ClassicModel::deform(const glm::mat4* skin) {
     P.posedA = glm::vec3(skin[j] * glm::vec4(jointCentres[j], 1.0f));
     P.posedB = glm::vec3(skin[P.child] * glm::vec4(jointCentres[P.child], 1.0f));
     glm::vec3 d = P.posedB - P.posedA;
-    float len = glm::length(d);
+    float len = lengthOf(d);  // glm::length overflowed for a 1e20-long posed bone: a zero direction, NaN contours
     P.posedDir = len > 1e-6f * height ? d / len : glm::normalize(P.rotation * P.axis);
     P.posedU = P.rotation * P.u;
-    P.scale = (glm::length(glm::vec3(skin[j][0])) + glm::length(glm::vec3(skin[j][1])) +
-               glm::length(glm::vec3(skin[j][2]))) / 3.0f;
+    P.scale = (lengthOf(glm::vec3(skin[j][0])) + lengthOf(glm::vec3(skin[j][1])) +  // ×1e20 columns: no overflow
+               lengthOf(glm::vec3(skin[j][2]))) / 3.0f;
     const glm::vec3 cd = parts[P.child].direction;
     glm::vec3 straight = P.rotation * cd;
     glm::vec3 actual = glm::mat3_cast(rotationOf(skin[P.child])) * cd;
@@ -628,14 +635,26 @@ void ClassicModel::deform(const glm::mat4* skin) {
       out[3 * r] = p.x, out[3 * r + 1] = p.y, out[3 * r + 2] = p.z;
     }
   }
-  // Tube normals: area-weighted from the deformed tube triangles.
+  // Tube normals: area-weighted from the deformed tube triangles. Edges are divided by the tube's
+  // extent first: the cross products of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.
+  float extent = 0.0f;
+  if (tubeVertexCount) {
+    glm::vec3 lo(positions[0], positions[1], positions[2]), hi = lo;
+    for (uint32_t v = 1; v < tubeVertexCount; ++v) {
+      glm::vec3 p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+      lo = glm::min(lo, p), hi = glm::max(hi, p);
+    }
+    glm::vec3 e = hi - lo;
+    extent = std::fmax(e.x, std::fmax(e.y, e.z));
+  }
+  if (!(extent > 0.0f)) extent = 1.0f;
   std::memset(normals.data(), 0, size_t(tubeVertexCount) * 3 * sizeof(float));
   for (uint32_t i = 0; i < tubeIndexCount; i += 3) {
     uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
     glm::vec3 pa(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
     glm::vec3 pb(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
     glm::vec3 pc(positions[3 * c], positions[3 * c + 1], positions[3 * c + 2]);
-    glm::vec3 f = glm::cross(pb - pa, pc - pa);
+    glm::vec3 f = glm::cross((pb - pa) / extent, (pc - pa) / extent);
     for (uint32_t v : {a, b, c}) {
       normals[3 * v] += f.x;
       normals[3 * v + 1] += f.y;
@@ -644,9 +663,9 @@ void ClassicModel::deform(const glm::mat4* skin) {
   }
   for (uint32_t v = 0; v < tubeVertexCount; ++v) {
     float* nn = &normals[3 * size_t(v)];
-    float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-    if (len > 0.0f) nn[0] /= len, nn[1] /= len, nn[2] /= len;
-    else nn[0] = 0.0f, nn[1] = 1.0f, nn[2] = 0.0f;
+    // unitOr scales before squaring: a tiny sum was left unnormalised (its square underflowed to 0).
+    glm::vec3 n = unitOr(glm::vec3(nn[0], nn[1], nn[2]), glm::vec3(0.0f, 1.0f, 0.0f));
+    nn[0] = n.x, nn[1] = n.y, nn[2] = n.z;
   }
   // Caps: rim copies and the centre, normal along the contour normal (outward).
   for (const ClassicCap& cap : caps) {
