@@ -156,10 +156,14 @@ bool buildRig(const float* positions, const float* normals, uint32_t vertexCount
                       "vertex %u is skinned to joint %u, but the skeleton has %u joints", v, j, jointCount);
         rig.joints[v][i] = w > 0.0f ? j : 0u;  // unused slots point at joint 0 with weight 0
         rig.weights[v][i] = w;
-        sum += w;
       }
-      if (!(sum > 0.0f))
+      // Normalise by the largest weight first: four weights near FLT_MAX would overflow the sum.
+      const glm::vec4 wv = rig.weights[v];
+      const float big = std::fmax(std::fmax(wv.x, wv.y), std::fmax(wv.z, wv.w));
+      if (!(big > 0.0f))
         return fail(GCS_ERR_BAD_WEIGHTS, "vertex %u has no skin weight (its weights sum to 0)", v);
+      rig.weights[v] /= big;
+      sum = rig.weights[v].x + rig.weights[v].y + rig.weights[v].z + rig.weights[v].w;
       rig.weights[v] /= sum;
     }
     rig.indices.assign(indices, indices + indexCount);

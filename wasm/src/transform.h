@@ -70,7 +70,7 @@ inline glm::quat rotationOf(const glm::mat4& m) {
 // Divides by the largest component first so tiny vectors do not underflow.
 inline glm::vec3 unitOr(const glm::vec3& v, const glm::vec3& fallback) {
   float big = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
-  if (!(big > 1e-30f)) return fallback;
+  if (!(big > 0.0f) || !std::isfinite(big)) return fallback;  // denormal components still divide exactly
   glm::vec3 u = v / big;
   return u / glm::length(u);
 }
@@ -120,7 +120,13 @@ inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, boo
     renormalise = false;
     return r;
   }
-  glm::mat3 c = cofactor(k);
+  // Scale k to entries ≤ 1 first: the cofactor multiplies entries pairwise (×1e20 would overflow).
+  float kbig = 0.0f;
+  for (int col = 0; col < 3; ++col)
+    for (int i = 0; i < 3; ++i) kbig = std::fmax(kbig, std::fabs(k[col][i]));
+  renormalise = true;
+  if (!(kbig > 1e-30f)) return glm::mat3_cast(rotation);
+  glm::mat3 c = cofactor(k / kbig);
   float big = 0.0f;
   for (int col = 0; col < 3; ++col)
     for (int i = 0; i < 3; ++i) big = std::fmax(big, std::fabs(c[col][i]));
@@ -275,8 +281,13 @@ inline v128_t affine(v128_t c0, v128_t c1, v128_t c2, v128_t c3, const float* p)
                         wasm_f32x4_add(wasm_f32x4_mul(c2, wasm_v128_load32_splat(p + 2)), c3));
 }
 // v divided by the length of its xyz lanes (lane 4 must be 0, as normal matrices make it); a zero
-// vector stays zero. All in SIMD: no lane extraction.
+// vector stays zero. All in SIMD: no lane extraction. Divided by its largest component first, so
+// that tiny vectors (a normal through a 1e-20 scale) do not underflow when squared.
 inline v128_t normalise3(v128_t v) {
+  v128_t a = wasm_f32x4_abs(v);
+  v128_t m = wasm_f32x4_max(a, wasm_i32x4_shuffle(a, a, 1, 0, 3, 2));
+  m = wasm_f32x4_max(m, wasm_i32x4_shuffle(m, m, 2, 3, 0, 1));
+  v = wasm_f32x4_div(v, wasm_f32x4_max(m, wasm_f32x4_splat(1e-45f)));  // denormals too
   v128_t sq = wasm_f32x4_mul(v, v);
   v128_t t = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
   v128_t sum = wasm_f32x4_add(t, wasm_i32x4_shuffle(t, t, 2, 3, 0, 1));
@@ -284,9 +295,15 @@ inline v128_t normalise3(v128_t v) {
 }
 #endif
 
+// A normal the transform has annihilated (a flattening scale maps some directions to 0) keeps
+// its rest direction, so that every output normal is unit.
+inline void keepUnit(float* out, const float* rest) {
+  if (out[0] == 0.0f && out[1] == 0.0f && out[2] == 0.0f) out[0] = rest[0], out[1] = rest[1], out[2] = rest[2];
+}
+
 inline void normaliseInPlace(float* n) {
-  float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (len > 0.0f) n[0] /= len, n[1] /= len, n[2] /= len;
+  glm::vec3 v = unitOr(glm::vec3(n[0], n[1], n[2]), glm::vec3(n[0], n[1], n[2]));
+  n[0] = v.x, n[1] = v.y, n[2] = v.z;
 }
 
 // Transforms `count` interleaved xyz points by the affine matrix m and their normals by the 3×3
@@ -304,6 +321,7 @@ inline void transformRunT(const glm::mat4& m, const glm::mat4& nm, const float* 
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));  // lane 4 spills into the next vertex
     v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
     wasm_v128_store(outNrm + 3 * i, Renormalise ? normalise3(rn) : rn);
+    if (Renormalise) keepUnit(outNrm + 3 * i, inNrm + 3 * i);
   }
 #else
   for (uint32_t i = 0; i < count; ++i) {
@@ -313,7 +331,7 @@ inline void transformRunT(const glm::mat4& m, const glm::mat4& nm, const float* 
       outPos[3 * i + r] = m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r];
       outNrm[3 * i + r] = nm[0][r] * n[0] + nm[1][r] * n[1] + nm[2][r] * n[2];
     }
-    if (Renormalise) normaliseInPlace(outNrm + 3 * i);
+    if (Renormalise) normaliseInPlace(outNrm + 3 * i), keepUnit(outNrm + 3 * i, n);
   }
 #endif
 }
@@ -360,6 +378,7 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
       wasm_v128_store(outNrm + 3 * i, rn);
     } else {
       wasm_v128_store(outNrm + 3 * i, normalise3(rn));
+      keepUnit(outNrm + 3 * i, inNrm + 3 * i);
     }
   }
 #else
@@ -377,6 +396,7 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
       outNrm[3 * i + r] = w;
     }
     normaliseInPlace(outNrm + 3 * i);
+    keepUnit(outNrm + 3 * i, n);
   }
 #endif
 }
