@@ -5,6 +5,7 @@ import { describe, expect, test } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
+import { gridRig } from '../helpers/grid.js';
 
 const CHUNK = 256 * 1024 * 1024;
 
@@ -19,29 +20,8 @@ function fill(gcs: GcsSkin, stop: () => boolean): number[] {
   return held;
 }
 
-/** A flat grid rig of `side`² vertices, two joints. */
-function grid(side: number) {
-  const n = side * side;
-  const positions = new Float32Array(3 * n), joints = new Uint32Array(4 * n), weights = new Float32Array(4 * n);
-  for (let i = 0; i < side; i++)
-    for (let j = 0; j < side; j++) {
-      const v = i * side + j;
-      positions[3 * v] = i / side; positions[3 * v + 1] = j / side;
-      joints[4 * v] = i < side / 2 ? 0 : 1; weights[4 * v] = 1;
-    }
-  const indices = new Uint32Array(6 * (side - 1) * (side - 1));
-  let k = 0;
-  for (let i = 0; i + 1 < side; i++)
-    for (let j = 0; j + 1 < side; j++) {
-      const a = i * side + j;
-      indices.set([a, a + side, a + 1, a + 1, a + side, a + side + 1], k);
-      k += 6;
-    }
-  const ibm = new Float32Array(32);
-  ibm.set(new THREE.Matrix4().elements, 0);
-  ibm.set(new THREE.Matrix4().makeTranslation(-0.5, 0, 0).elements, 16);
-  return { positions, indices, joints, weights, parents: [-1, 0], inverseBindMatrices: ibm };
-}
+/** A flat grid rig of `side`² vertices in a unit square, two joints. */
+const grid = (side: number) => gridRig(side, 1 / side);
 
 describe('wasm memory at its limits', () => {
   test('above 2 GiB: rigs and deformers live at high addresses and give the same output', async () => {
