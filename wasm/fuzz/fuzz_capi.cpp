@@ -837,6 +837,8 @@ void checkFrame(Built& b, const RigInput& in, const Frame& fr, bool restExact) {
   }
 }
 
+void checkGpuSections(const Built& b, const RigInput& in, const Frame& fr);  // below
+
 // restExact: no morph influence is active, so the identity frame must give the rig's positions
 // (and welded vertices must stay together).
 void deformOk(Built& b, const RigInput& in, const Frame& fr, bool restExact) {
@@ -844,6 +846,7 @@ void deformOk(Built& b, const RigInput& in, const Frame& fr, bool restExact) {
   CHECK(rc == 1, "deform rejected valid skin matrices");
   checkOk("deform");
   checkFrame(b, in, fr, restExact);
+  if (b.kind == GCS_KIND_GCS) checkGpuSections(b, in, fr);
 }
 
 struct Snapshot {
@@ -857,6 +860,50 @@ struct Snapshot {
            std::memcmp(normals.data(), b.normals, normals.size() * 4) == 0;
   }
 };
+
+// The GPU path (gcs_gcs_compute_sections): for two instances posed by this frame, the packed rows
+// are the section matrices gcs_deformer_deform just used, bit for bit; the output mesh is not
+// touched; a rejected call (no instances, a non-finite matrix in the second instance) writes
+// nothing. Smooth blend data: other sections in range, factors in [0, 1]; null in plain mode.
+void checkGpuSections(const Built& b, const RigInput& in, const Frame& fr) {
+  GcsDeformer* d = b.d;
+  const uint32_t S = b.sections, J = in.jointCount;
+  std::vector<float> matrices(gcs_gcs_section_matrices(d), gcs_gcs_section_matrices(d) + size_t(S) * 16);
+  Snapshot before;
+  before.take(b);
+  std::vector<float> skins(fr.skin);
+  skins.insert(skins.end(), fr.skin.begin(), fr.skin.end());
+  std::vector<float> out(size_t(S) * 24, -7.0f);
+  CHECK(gcs_gcs_compute_sections(d, skins.data(), J, 2, out.data()) == 1, "compute_sections rejected a valid frame");
+  checkOk("compute_sections");
+  CHECK(before.same(b), "compute_sections changed the output mesh");
+  for (uint32_t k = 0; k < 2; ++k)
+    for (uint32_t i = 0; i < S; ++i)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) {
+          const float got = out[(size_t(k) * S + i) * 12 + 4 * r + c], want = matrices[16 * size_t(i) + 4 * c + r];
+          CHECK(std::memcmp(&got, &want, 4) == 0, "instance %u section %u row %d col %d: packed %g, deform used %g", k, i, r,
+                c, double(got), double(want));
+        }
+  std::vector<float> kept(out);
+  CHECK(gcs_gcs_compute_sections(d, skins.data(), J, 0, out.data()) == 0, "compute_sections took 0 instances");
+  checkRejected("compute_sections(0 instances)", [](int c) { return c == GCS_ERR_OUT_OF_RANGE; });
+  CHECK(gcs_gcs_compute_sections(d, skins.data(), J + 1, 1, out.data()) == 0, "compute_sections took a wrong joint count");
+  checkRejected("compute_sections(joint count)", [](int c) { return c == GCS_ERR_LENGTH_MISMATCH; });
+  skins[size_t(J) * 16 + 16 * size_t(J - 1) + 3] = NAN;
+  CHECK(gcs_gcs_compute_sections(d, skins.data(), J, 2, out.data()) == 0, "compute_sections took NaN");
+  checkRejected("compute_sections(NaN)", [](int c) { return c == GCS_ERR_NON_FINITE; });
+  CHECK(std::memcmp(kept.data(), out.data(), out.size() * 4) == 0, "a rejected compute_sections wrote its output");
+  const uint32_t* other = gcs_gcs_blend_other(d);
+  const float* factor = gcs_gcs_blend_factor(d);
+  CHECK((other != nullptr) == (b.smooth != 0) && (factor != nullptr) == (b.smooth != 0), "blend data present %d, smooth %d",
+        other != nullptr, b.smooth);
+  if (other)
+    for (uint32_t o = 0; o < b.vertexCount; ++o) {
+      CHECK(other[o] < S, "output vertex %u blends with section %u of %u", o, other[o], S);
+      CHECK(factor[o] >= 0.0f && factor[o] <= 1.0f, "output vertex %u blend factor %g", o, double(factor[o]));
+    }
+}
 
 // Morph targets (GCS, LBS, DQS): deltas in the rig's vertex order, the same for every deformer.
 struct Morphs {

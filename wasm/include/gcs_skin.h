@@ -236,6 +236,50 @@ const float* gcs_gcs_section_info(const GcsDeformer* deformer);
 /* The transform (16 floats, column-major) of each section in the last frame; sectionCount × 16. */
 const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
 
+/* ---------------------------------------------------------------- GCS on the GPU */
+
+/*
+ * The GPU path (design.md §6): the mesh stays in GPU memory in the bind pose, section by section
+ * as gcs_deformer_source_vertex orders it; per vertex the static data is its section
+ * (gcs_gcs_section_of_vertex) and, in smooth mode, the other section it blends with and the factor
+ * towards it (below); per frame only the section transforms change, computed here, and a vertex
+ * shader applies them.
+ *
+ * Smooth mode only (null for a GCS deformer built without smooth mode, and for other deformers):
+ *   gcs_gcs_blend_other    output vertexCount uint32: the section each output vertex blends with
+ *                          (its own section when it does not blend).
+ *   gcs_gcs_blend_factor   output vertexCount floats in [0, 1]: the factor towards that section.
+ * A vertex p of own section A, other section B and factor f (plain mode: f = 0) moves to
+ *   p' = (A + f·(B − A))·(p, 1)   (entrywise on the 3×4 affine matrices packed below),
+ * which is what gcs_deformer_deform computes. Its normal turns by the cofactor of the 3×3 part
+ * (docs/gpu.md: the same direction as gcs_deformer_deform's normal matrix).
+ */
+#define GCS_GPU_TEXELS_PER_SECTION 3
+#define GCS_MAX_INSTANCES 65536
+const uint32_t* gcs_gcs_blend_other(const GcsDeformer* deformer);
+const float* gcs_gcs_blend_factor(const GcsDeformer* deformer);
+/*
+ * Section transforms only, for instanceCount poses of the same model (a crowd), packed for an
+ * RGBA32F texture; no per-vertex work.
+ *   deformer       a GCS deformer (any criterion, plain or smooth).
+ *   skinMatrices   instanceCount × jointCount × 16 floats: instance k's S_j (as gcs_deformer_deform
+ *                  takes them) at offset (k · jointCount + j) · 16; finite.
+ *   jointCount     must equal the rig's joint count.
+ *   instanceCount  1 .. GCS_MAX_INSTANCES; instanceCount · sectionCount · 48 bytes and
+ *                  instanceCount · jointCount · 64 bytes must fit in 4 GiB (else GCS_ERR_OUT_OF_RANGE).
+ *   out            instanceCount × sectionCount × GCS_GPU_TEXELS_PER_SECTION × 4 floats, written as
+ *                  texels: section s of instance k starts at texel (k · sectionCount + s) · 3; its
+ *                  three texels are the rows r = 0, 1, 2 of the section's affine transform
+ *                  (m[0][r], m[1][r], m[2][r], m[3][r]) — the same matrices gcs_deformer_deform
+ *                  applies (gcs_gcs_section_matrices), bit for bit.
+ * Morph targets are not applied (they act on vertices: the shader applies them before the section
+ * transforms). The deformer's positions and normals are not written; gcs_gcs_section_matrices
+ * afterwards holds the last instance's transforms. Nothing is allocated.
+ * Returns 1, or 0 with the error recorded (then nothing was written: every matrix is checked first).
+ */
+int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                             uint32_t instanceCount, float* out);
+
 
 /* ---------------------------------------------------------------- classic cross-sections */
 
@@ -250,25 +294,39 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
  *
  * Parts are the GCS parts (vertices by dominant weight, welded by position; parent part = nearest
  * ancestor joint owning vertices). A part is resampled when it is cylinder-like:
- *   - it has exactly one child part (a chain part: upper arm, forearm, thigh, shank, spine, neck);
- *     leaves (head, hands without fingers, feet, finger tips) and branching parts (pelvis, chest,
- *     a hand with fingers) are carried rigidly;
+ *   - it has exactly one child part (a chain part: upper arm, forearm, thigh, shank, spine, neck),
+ *     or it is a branching part of the trunk (GCS_CLASSIC_TRUNK, below); leaves (head, hands
+ *     without fingers, feet, finger tips) and other branching parts (a hand with fingers) are
+ *     carried rigidly;
  *   - its bone (joint → child part's joint) is at least 3 % of the model height (a zero-length or
  *     tiny bone is carried rigidly);
  *   - at most 30 % of its rays miss its own triangles (triangles with a vertex in the part), after
  *     hits farther than 3 × the contour's median are dropped as misses (e.g. a clavicle, or a part
  *     of an open mesh with a side missing, is carried rigidly);
- *   - its bone turns by at most 45° from its resampled parent's bone (a foot on a shank is rigid).
- * A resampled part gets contour planes at even spacing t = i/(m−1) from its joint (t = 0) to its
- * child part's joint (t = 1), each with `rays` star rays at angles 2πr/rays in a frame
- * parallel-transported along the limb; a ray's contour point is its outermost hit with the part's
- * own triangles; a ray that misses takes the radius interpolated from its nearest hit neighbours.
- * Two resampled neighbours share their joint contour (stored once, cast against both parts'
- * triangles, its plane normal the bisector of the two bones). Where a tube meets a rigid part, the
- * tube is closed by a flat cap (a fan) in its end contour plane; the rigid part keeps every input
- * triangle that has a vertex in a rigid part (its vertices that belong to a resampled part move
- * rigidly with that part's bone), so the rigid mesh overlaps the capped tube end: no see-through
- * hole, but a visible step where the original surface and the tube differ.
+ *   - its bone turns by at most 45° from its resampled parent's bone (a foot on a shank is carried);
+ *   - where it meets the carried mesh, the boundary is one closed ring around its bone at an end
+ *     that is not shared with a resampled neighbour (else GCS_CLASSIC_SEAM: a tube cannot join it
+ *     without a gap or an overlap).
+ * The trunk (Shen et al. resample it like the limbs): a branching part is resampled along the one
+ * child bone that continues the trunk — after a resampled parent, the child within 45° of the
+ * parent's bone (a chest's neck); with none, the child whose siblings' joints all lie before a
+ * quarter of its bone (a pelvis's spine, the hips below) — over the span of its bone away from its
+ * branches: its vertices beyond 1/20 bone short of the nearest vertex that shares a triangle with
+ * a branch (shoulders, thighs) stay carried (the crotch, the shoulders), the rest is resampled as
+ * part of the spine's tube; at least a quarter of the bone must remain.
+ * A resampled part gets contour planes at even spacing from tLo to tHi along its bone (t = 0 at
+ * its joint, 1 at its child part's joint), each with `rays` star rays at angles 2πr/rays in a
+ * frame parallel-transported along the limb; a ray's contour point is its outermost hit with the
+ * part's own triangles; a ray that misses takes the radius interpolated from its nearest hit
+ * neighbours. Two resampled neighbours share their joint contour (stored once, cast against both
+ * parts' triangles, its plane normal the bisector of the two bones): tLo = 0 / tHi = 1 there.
+ * Where a tube meets the carried mesh (every triangle with a carried vertex, kept as it is, its
+ * vertices moving rigidly with their own part's S_j), the tube ends at the innermost point of
+ * the boundary loop of those triangles (tLo = the loop's largest t at a proximal end, tHi its
+ * smallest at a distal one), and a band of triangles zips the tube's end ring to that loop: every
+ * edge of the ring and of the loop is used once, so a closed input gives a closed output (no gap,
+ * no overlap, the loop's vertices shared by both sides). An end with nothing beyond it (an open
+ * input) stays open, the tube spanning the part's own vertices (up to half a bone past the joint).
  *
  *   contours  contour count of the LONGEST resampled-candidate bone, in
  *             [GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS]; every other part gets
@@ -287,13 +345,15 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
  * inner contours interpolate the end normals linearly (normalised); a contour's frame is the
  * bone's full rotation (its twist included) then the minimal rotation from the bone direction to
  * the contour normal (a shared contour takes the mean of both sides' frames: half the twist).
- * Tube normals are area-weighted from the deformed tube triangles; caps use the contour normal.
- * Uniform scale in S_j (mesh-node transforms) scales the radii. Nothing is allocated per frame.
+ * Tube normals are area-weighted from the deformed tube and band triangles, unit length whatever
+ * the scale of the skin matrices; carried normals go through their S_j's normal matrix. Uniform
+ * scale in S_j (mesh-node transforms) scales the radii. Nothing is allocated per frame.
+ * The muscle bulge applies to chain parts, not to a trunk part's tube.
  *
  * Its output mesh is its own: the rings of the tubes first (chains laid out root → leaf, so a
- * part's rings are contiguous and a shared ring ends one part and starts the next), then the cap
- * vertices, then the carried input vertices grouped by part. Triangles: tube quads (2 each,
- * outward), caps, then carried input triangles. gcs_deformer_source_vertex is null.
+ * part's rings are contiguous and a shared ring ends one part and starts the next), then the
+ * carried input vertices grouped by part. Triangles: tube quads (2 each, outward), bands, then the
+ * carried input triangles. gcs_deformer_source_vertex is null.
  * If no part can be resampled the model still builds (every part rigid; the report says so).
  * Errors: GCS_ERR_INVALID_ARGUMENT (null rig), GCS_ERR_OUT_OF_RANGE (a count or the bulge outside
  * its limits; the message states them), GCS_ERR_OUT_OF_MEMORY.
@@ -303,22 +363,38 @@ GcsDeformer* gcs_build_classic(const GcsRig* rig, uint32_t contours, uint32_t ra
 /* Changes the bulge gain of a classic deformer without rebuilding (takes effect at the next
    deform). Returns 1, or 0 on error (not a classic deformer; bulge outside [0, GCS_CLASSIC_MAX_BULGE]). */
 int gcs_classic_set_bulge(GcsDeformer* deformer, float bulge);
+/* Why a part of a classic model is or is not resampled (the fifth entry of its report). */
+typedef enum GcsClassicReason {
+  GCS_CLASSIC_RESAMPLED = 0,  /* a chain part, resampled from joint to joint */
+  GCS_CLASSIC_LEAF = 1,       /* carried: no child part (head, hands, feet, finger tips) */
+  GCS_CLASSIC_BRANCHING = 2,  /* carried: several child parts and not a trunk part (a hand with fingers) */
+  GCS_CLASSIC_TOO_SHORT = 3,  /* carried: bone shorter than 3 % of the height (fingers, zero-length bones) */
+  GCS_CLASSIC_RAYS_MISS = 4,  /* carried: over 30 % of its rays miss its own triangles (a clavicle) */
+  GCS_CLASSIC_BENT = 5,       /* carried: bone turned > 45° from its resampled parent's (a foot) */
+  GCS_CLASSIC_SEAM = 6,       /* carried: its boundary with the carried mesh is not one ring at an end */
+  GCS_CLASSIC_TRUNK = 7       /* resampled along the trunk; its branch region (crotch, shoulders) carried */
+} GcsClassicReason;
 /*
- * Per-part report of a classic model: partCount × 4 int32 per part, parts in joint order:
- *   [joint id, resampled (1) or carried rigidly (0), first output vertex, output vertex count].
+ * Per-part report of a classic model: partCount × 5 int32 per part, parts in joint order:
+ *   [joint id, resampled (1) or carried rigidly (0), first output vertex, output vertex count,
+ *    reason (GcsClassicReason)].
  * Resampled part: its rings, contours × rays vertices, proximal ring first (a shared joint ring is
- * in both neighbours' ranges). Rigid part: its carried input vertices. Not in any range: cap
- * vertices, and input vertices of resampled parts carried by triangles of a rigid neighbour.
+ * in both neighbours' ranges). Rigid part: its carried input vertices. Not in any range: input
+ * vertices of resampled parts kept by carried triangles (a band's loop; a trunk part's branch region).
  * gcs_classic_part_count gives partCount. Null (and 0) for other deformers.
  */
 uint32_t gcs_classic_part_count(const GcsDeformer* deformer);
 const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
+/* For each output vertex (vertexCount int32): the contour its ring belongs to (0 … contours − 1,
+   the order of GCS_STAT_SECTIONS), or −1 for a carried input vertex. Null for other deformers. */
+const int32_t* gcs_classic_contour_of_vertex(const GcsDeformer* deformer);
 /*
- * Detail loss of resampling (the paper's Fig. 5): for each input vertex of a resampled part, the
- * distance to the bind-pose resampled surface (the nearest triangle among its part's tube cells
- * within ±2 contour intervals and ±2 ray sectors, following shared contours into the neighbour,
- * and its part's caps; a vertex farther than 0.5 % of the height from those is tested against
- * every tube and cap triangle), as a percentage of model height. which = 0: RMS, 1: max. 0 when nothing
+ * Detail loss of resampling (the paper's Fig. 5): for each input vertex the tubes and bands replace
+ * (welded; vertices kept by carried triangles are not counted), the distance to the bind-pose
+ * resampled surface (the nearest triangle among its part's tube cells within ±2 contour intervals
+ * and ±2 ray sectors, following shared contours into the neighbour, and its part's bands; a
+ * vertex farther than 0.5 % of the height from those is tested against every tube and band
+ * triangle), as a percentage of model height. which = 0: RMS, 1: max. 0 when nothing
  * is resampled; NaN for other deformers or another `which`. Computed on the first call (it is not
  * part of the build time).
  */

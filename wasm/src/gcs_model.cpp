@@ -817,15 +817,18 @@ uint32_t GcsDeformerImpl::countAdjusted() const {
   return adjusted;
 }
 
-void GcsDeformerImpl::deform(const glm::mat4* skin) {
+void GcsDeformerImpl::computeSections(const glm::mat4* skin) {
   const uint32_t J = jointCount;
   const ScaleState scale = decomposeAll(skin, J, poses.data());
   if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, scale);
   else sectionTransformsPaper(skin, scale);
-
   // The adjusted-section statistic is computed when asked for (stat), from a copy of the skin.
   std::memcpy(lastSkin.data(), skin, size_t(J) * sizeof(glm::mat4));
   adjustedValid = false;
+}
+
+void GcsDeformerImpl::deform(const glm::mat4* skin) {
+  computeSections(skin);
   const uint32_t S = uint32_t(sections.size());
   if (settings.smooth) {
     for (const BlendRun& run : blendRuns) {

@@ -51,6 +51,9 @@ class GcsDeformerImpl final : public Deformer {
  public:
   GcsDeformerKind kind() const override { return GCS_KIND_GCS; }
   void deform(const glm::mat4* skin) override;
+  // The per-frame section transforms only (sectionMatrices, normalMatrices, renormalise), no
+  // per-vertex work: the first half of deform(). The GPU path (gcs_gcs_compute_sections).
+  void computeSections(const glm::mat4* skin);
   std::vector<float>* morphableRestPositions() override { return &restPositions; }
   std::vector<float>* morphableRestNormals() override { return &restNormals; }
   float stat(GcsStat which) const override;

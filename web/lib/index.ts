@@ -99,9 +99,24 @@ export interface SectionInfo {
   beta: number;
 }
 
+/**
+ * Why a part of the classic model is resampled or carried rigidly (gcs_skin.h, GcsClassicReason):
+ * `resampled` a chain part, joint to joint; `trunk` a branching trunk part (pelvis, chest)
+ * resampled along the spine with its branch region (crotch, shoulders) carried; carried ones:
+ * `leaf` (head, hands, feet, finger tips), `branching` (a hand with fingers), `too-short`
+ * (fingers, zero-length bones), `rays-miss` (a clavicle), `bent` (a foot on a shank), `seam`
+ * (its boundary with the carried mesh is not one ring around an end).
+ */
+export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk';
+/** The reasons in the order of their codes (GcsClassicReason). */
+export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk'];
+
 export interface ClassicPart {
   joint: number;
   resampled: boolean;
+  /** Why it is resampled or carried (see ClassicReason). */
+  reason: ClassicReason;
+  /** Resampled: its rings (contours × rays vertices); carried: its carried input vertices. */
   firstVertex: number;
   vertexCount: number;
 }
@@ -524,7 +539,34 @@ export class GcsDeformer extends Deformer {
     const h = this.live();
     return this.gcs.viewF32(this.gcs.core.gcs_gcs_section_matrices(h), this.sectionCount * 16).slice();
   }
+  /** Smooth mode: for each output vertex the section it blends with (its own when none), a copy; null in plain mode. */
+  blendOther(): Uint32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_blend_other(this.live());
+    return ptr ? this.gcs.viewU32(ptr, this.vertexCount).slice() : null;
+  }
+  /** Smooth mode: for each output vertex the factor towards blendOther() (0..1), a copy; null in plain mode. */
+  blendFactor(): Float32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_blend_factor(this.live());
+    return ptr ? this.gcs.viewF32(ptr, this.vertexCount).slice() : null;
+  }
+  /**
+   * The GPU path's per-frame work: section transforms only, for `instanceCount` poses at once,
+   * written as texels (GPU_TEXELS_PER_SECTION RGBA32F texels per section: the rows of its affine
+   * 3×4) at byte offset `outPtr` in wasm memory; `skinPtr` holds instanceCount × J × 16 floats.
+   * Pointers, not arrays, so that a crowd's buffers live in wasm memory and are never copied
+   * (SectionBuffer in gcs-skin/gpu owns such a pair). No allocation.
+   */
+  computeSectionsAt(skinPtr: number, instanceCount: number, outPtr: number): void {
+    const h = this.live();
+    if (!this.gcs.core.gcs_gcs_compute_sections(h, skinPtr, this.jointCount, instanceCount, outPtr))
+      this.gcs.raise('computing the section transforms failed');
+  }
 }
+
+/** RGBA32F texels per GCS section in the GPU path's buffer (the rows of its affine 3×4 transform). */
+export const GPU_TEXELS_PER_SECTION = 3;
+/** Most instances one computeSectionsAt call takes. */
+export const MAX_INSTANCES = 65536;
 
 /** The classic cross-section deformer (resampled contours). */
 export class ClassicDeformer extends Deformer {
@@ -534,11 +576,23 @@ export class ClassicDeformer extends Deformer {
     const n = this.gcs.core.gcs_classic_part_count(h);
     const ptr = this.gcs.core.gcs_classic_parts(h);
     if (!ptr) return [];
-    const a = this.gcs.viewI32(ptr, n * 4);
+    const a = this.gcs.viewI32(ptr, n * 5);
     const out: ClassicPart[] = [];
     for (let i = 0; i < n; i++)
-      out.push({ joint: a[4 * i], resampled: a[4 * i + 1] === 1, firstVertex: a[4 * i + 2], vertexCount: a[4 * i + 3] });
+      out.push({
+        joint: a[5 * i], resampled: a[5 * i + 1] === 1, reason: CLASSIC_REASONS[a[5 * i + 4]] ?? 'leaf',
+        firstVertex: a[5 * i + 2], vertexCount: a[5 * i + 3],
+      });
     return out;
+  }
+  /**
+   * For each output vertex, the contour (ring) it lies on, 0 … sectionCount − 1, or −1 for a
+   * carried input vertex: what the demo colours by. A copy (valid until the next rebuild).
+   */
+  get contourOfVertex(): Int32Array {
+    const h = this.live();
+    const ptr = this.gcs.core.gcs_classic_contour_of_vertex(h);
+    return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
   }
   /** Resampling detail loss, % of model height: RMS and max distance of original vertices to the resampled surface. */
   get detailLoss(): { rms: number; max: number } {
@@ -551,5 +605,109 @@ export class ClassicDeformer extends Deformer {
     if (!(bulge >= 0 && bulge <= CLASSIC_LIMITS.maxBulge))
       throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${CLASSIC_LIMITS.maxBulge}; got ${bulge}`);
     if (!this.gcs.core.gcs_classic_set_bulge(h, bulge)) this.gcs.raise('setBulge failed');
+  }
+}
+
+/**
+ * The GPU path's per-frame buffers for one GCS model and `instanceCount` poses of it (a crowd),
+ * both in wasm memory: the skin matrices in (instanceCount × J × 16 floats) and the packed section
+ * transforms out, `width × height` RGBA32F texels (section s of instance k at texel
+ * (k·S + s)·3, rows of its affine 3×4; the tail past the last section is padding). A float texture
+ * views `texels` as it is: nothing is copied. `compute()` is one wasm call for every instance.
+ * Views are re-created when wasm memory grew (check `texels.buffer` against `gcs.memory.buffer`,
+ * or just read the getters each frame). The deformer stays the caller's; `dispose()` frees only
+ * these buffers.
+ */
+export class SectionTransforms {
+  readonly instanceCount: number;
+  readonly sectionCount: number;
+  readonly jointCount: number;
+  /** Texture size in texels: width × height ≥ instanceCount × sectionCount × 3. */
+  readonly width: number;
+  readonly height: number;
+  private skinPtr: number;
+  private texelPtr: number;
+  private skinView: Float32Array;
+  private texelView: Float32Array;
+
+  /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). */
+  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
+    if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
+    if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms need a GCS deformer (rig.buildGcs)');
+    if (!Number.isInteger(instanceCount) || instanceCount < 1 || instanceCount > MAX_INSTANCES)
+      throw new GcsError('OUT_OF_RANGE', `the instance count must be a whole number from 1 to ${MAX_INSTANCES}; got ${instanceCount}`);
+    if (!Number.isInteger(maxWidth) || maxWidth < GPU_TEXELS_PER_SECTION)
+      throw new GcsError('OUT_OF_RANGE', `maxWidth must be a whole number ≥ ${GPU_TEXELS_PER_SECTION}; got ${maxWidth}`);
+    this.instanceCount = instanceCount;
+    this.sectionCount = deformer.sectionCount;
+    this.jointCount = deformer.jointCount;
+    const texels = instanceCount * this.sectionCount * GPU_TEXELS_PER_SECTION;
+    this.width = Math.min(maxWidth, texels);
+    this.height = Math.ceil(texels / this.width);
+    const gcs = deformer.gcs;
+    const skinBytes = instanceCount * this.jointCount * 64, texelBytes = this.width * this.height * 16;
+    if (skinBytes + texelBytes > 0xffff0000) throw new GcsError('OUT_OF_MEMORY', `${instanceCount} instances need ${skinBytes + texelBytes} bytes: more than wasm memory holds`);
+    this.skinPtr = gcs.core.gcs_alloc(skinBytes);
+    if (!this.skinPtr) gcs.raise('out of memory for the skin matrices');
+    this.texelPtr = gcs.core.gcs_alloc(texelBytes);
+    if (!this.texelPtr) {
+      gcs.core.gcs_free(this.skinPtr);
+      gcs.raise('out of memory for the section transforms');
+    }
+    this.skinView = gcs.viewF32(this.skinPtr, instanceCount * this.jointCount * 16);
+    this.texelView = gcs.viewF32(this.texelPtr, this.width * this.height * 4);
+    this.texelView.fill(0);
+    // Every instance starts in the bind pose (identity skins), so the texture is valid at once.
+    this.skinView.fill(0);
+    for (let k = 0; k < instanceCount * this.jointCount; k++)
+      for (let c = 0; c < 4; c++) this.skinView[16 * k + 5 * c] = 1;
+    this.compute();
+  }
+
+  private live(): void {
+    if (!this.skinPtr) throw new GcsError('DISPOSED', 'these section transforms have been disposed');
+  }
+
+  /** Every instance's skin matrices (instanceCount × J × 16 floats), a view on wasm memory: write them, then compute(). */
+  get skins(): Float32Array {
+    this.live();
+    if (this.skinView.buffer !== this.deformer.gcs.memory.buffer)
+      this.skinView = this.deformer.gcs.viewF32(this.skinPtr, this.instanceCount * this.jointCount * 16);
+    return this.skinView;
+  }
+
+  /** The packed texels (width × height × 4 floats), a view on wasm memory. */
+  get texels(): Float32Array {
+    this.live();
+    if (this.texelView.buffer !== this.deformer.gcs.memory.buffer)
+      this.texelView = this.deformer.gcs.viewF32(this.texelPtr, this.width * this.height * 4);
+    return this.texelView;
+  }
+
+  /** Bytes of texels that hold section transforms of `instances` instances (what an upload of them moves). */
+  bytesFor(instances = this.instanceCount): number {
+    return instances * this.sectionCount * GPU_TEXELS_PER_SECTION * 16;
+  }
+
+  /** Section transforms of the first `count` instances from their skins (default: all). No allocation. */
+  compute(count = this.instanceCount): void {
+    this.live();
+    if (!Number.isInteger(count) || count < 0 || count > this.instanceCount)
+      throw new GcsError('OUT_OF_RANGE', `compute(count): count must be a whole number from 0 to ${this.instanceCount}; got ${count}`);
+    if (count === 0) return;
+    this.deformer.computeSectionsAt(this.skinPtr, count, this.texelPtr);
+  }
+
+  /** Frees the two buffers (not the deformer). Safe to call twice. */
+  dispose(): void {
+    if (!this.skinPtr) return;
+    this.deformer.gcs.core.gcs_free(this.skinPtr);
+    this.deformer.gcs.core.gcs_free(this.texelPtr);
+    this.skinPtr = 0;
+    this.texelPtr = 0;
+  }
+
+  get disposed(): boolean {
+    return this.skinPtr === 0;
   }
 }
