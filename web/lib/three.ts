@@ -18,7 +18,11 @@
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
-import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
+import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
+import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes } from './gpu.js';
+
+/** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
+export type Backend = 'cpu' | 'gpu';
 
 export interface SkinDeformerOptions {
   /** Which deformer drives the mesh. Default 'gcs'. */
@@ -45,6 +49,15 @@ export interface SkinDeformerOptions {
    * offered. Ignored by the classic model.
    */
   tangents?: 'deform' | 'drop';
+  /**
+   * 'cpu' (default): wasm deforms every vertex and three.js uploads the vertex buffers each frame.
+   * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the section
+   * transforms (a few KB, into a float texture) and the vertex shader of a patched clone of the
+   * material applies them (docs/gpu.md). GCS only: other methods, and materials that cannot be
+   * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
+   * `backendNote` why.
+   */
+  backend?: Backend;
 }
 
 /** Reads the rig (bind-pose mesh, skin, skeleton) out of a SkinnedMesh as GLTFLoader gives it. */
@@ -220,10 +233,18 @@ function updateWorld(object: THREE.Object3D): void {
 class DeformedMesh extends THREE.Mesh<THREE.BufferGeometry, THREE.Material | THREE.Material[]> {
   /** @internal Set by the SkinDeformer that owns the mesh. */
   exactBounds: (() => boolean) | null = null;
+  /** @internal GPU backend: the CPU-deformed geometry that raycasts test (the drawn one stays in the bind pose). */
+  raycastGeometry: THREE.BufferGeometry | null = null;
   override raycast(raycaster: THREE.Raycaster, intersects: THREE.Intersection[]): void {
     // false: an in-place mesh hidden with its source, not deformed since (stale): no hits.
     if (this.exactBounds && !this.exactBounds()) return;
-    super.raycast(raycaster, intersects);
+    const drawn = this.geometry;
+    if (this.raycastGeometry) this.geometry = this.raycastGeometry;
+    try {
+      super.raycast(raycaster, intersects);
+    } finally {
+      this.geometry = drawn;
+    }
   }
 }
 
@@ -244,6 +265,28 @@ interface PendingBuild {
   geometry: THREE.BufferGeometry;
   /** Per morph target, the largest delta length; null without morphs. */
   maxDelta: Float32Array | null;
+  /** The GPU backend's state, or null (CPU). */
+  gpu: GpuBuild | null;
+  /** Why 'gpu' was asked for and 'cpu' runs, or ''. */
+  note: string;
+  /** The backend asked for. */
+  backend: Backend;
+}
+
+/** What rebuild() may change. */
+export interface RebuildOptions {
+  gcs?: GcsOptions;
+  classic?: ClassicOptions;
+  backend?: Backend;
+}
+
+/** The GPU backend of one build: section texture, patched materials, the geometry raycasts test. */
+interface GpuBuild {
+  sections: GpuSections;
+  material: THREE.Material | THREE.Material[];
+  depth: THREE.Material;
+  distance: THREE.Material;
+  raycast: THREE.BufferGeometry;
 }
 
 /**
@@ -299,6 +342,13 @@ export class SkinDeformer {
   private readonly sphere = new THREE.Sphere();
   private exactFresh = false;
   private isDisposed = false;
+  /** GPU backend of the current build, or null. */
+  private gpu: GpuBuild | null = null;
+  /** GPU backend: the deformer's CPU output matches the last update() (for raycasts). */
+  private cpuFresh = false;
+  private note = '';
+  /** The material drawn by the CPU backend (the source's or options.material). */
+  private readonly baseMaterial: THREE.Material | THREE.Material[];
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
@@ -331,7 +381,8 @@ export class SkinDeformer {
     this.balls = this.ownBalls;
     this.scope = commonAncestor([source, ...source.skeleton.bones]);
 
-    const mesh = new DeformedMesh(new THREE.BufferGeometry(), options.material ?? source.material);
+    this.baseMaterial = options.material ?? source.material;
+    const mesh = new DeformedMesh(new THREE.BufferGeometry(), this.baseMaterial);
     mesh.exactBounds = () => this.exactBounds();
     mesh.name = source.name;
     mesh.castShadow = source.castShadow;
@@ -417,25 +468,35 @@ export class SkinDeformer {
     return { pivots, own: balls(own), near: balls(near) };
   }
 
-  /** Rebuilds the deformer (e.g. a new section count); the geometry is replaced, `mesh` stays. */
-  rebuild(method: DeformerKind = this.method, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): void {
+  /** Rebuilds the deformer (e.g. a new section count, another backend); the geometry is replaced, `mesh` stays. */
+  rebuild(method: DeformerKind = this.method, options: RebuildOptions = {}): void {
     this.live();
     // Build first: if it throws, the current deformer and geometry stay as they were.
     this.commit(this.prepare(method, options));
   }
 
   /** @internal Builds the next deformer and its geometry without showing them. */
-  prepare(method: DeformerKind, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): PendingBuild {
+  prepare(method: DeformerKind, options: RebuildOptions = {}): PendingBuild {
     const gcsOptions = { ...this.options.gcs, ...options.gcs };
     const classicOptions = { ...this.options.classic, ...options.classic };
+    const backend = options.backend ?? this.options.backend ?? 'cpu';
+    if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got '${String(backend)}'`);
+    const note = backend === 'gpu' ? this.gpuUnsupported(method) : '';
+    const onGpu = backend === 'gpu' && !note;
     const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
       : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
     const deformer = build(this.rig);
     let tangentDeformer: Deformer | null = null;
+    let gpu: GpuBuild | null = null;
     try {
       const sourceVertex = deformer.sourceVertex;
       const morph = method === 'classic' ? null : morphData(this.source.geometry);
       if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
+      if (onGpu) {
+        gpu = this.prepareGpu(deformer as GcsDeformer);
+        const geometry = this.makeGeometry(deformer, sourceVertex, null, gpu);
+        return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend };
+      }
       if (this.tangentRig && sourceVertex) {
         tangentDeformer = build(this.tangentRig);
         // Same positions and weights, so the same vertex order; checked, not assumed.
@@ -445,19 +506,58 @@ export class SkinDeformer {
           tangentDeformer = null;
         }
       }
-      const geometry = this.makeGeometry(deformer, sourceVertex, tangentDeformer);
-      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null };
+      const geometry = this.makeGeometry(deformer, sourceVertex, tangentDeformer, null);
+      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend };
     } catch (e) {
+      if (gpu) disposeGpu(gpu);
       tangentDeformer?.dispose();
       deformer.dispose();
       throw e;
     }
   }
 
+  /** Why this build cannot run on the GPU, or ''. */
+  private gpuUnsupported(method: DeformerKind): string {
+    if (method !== 'gcs') return `the GPU backend runs GCS; '${method}' runs on the CPU`;
+    for (const m of Array.isArray(this.baseMaterial) ? this.baseMaterial : [this.baseMaterial]) {
+      const reason = gpuMaterialSupport(m);
+      if (reason) return reason;
+    }
+    return '';
+  }
+
+  /** The section texture and the patched materials of a GPU build. */
+  private prepareGpu(deformer: GcsDeformer): GpuBuild {
+    const sections = new GpuSections(deformer, 1);
+    const { uniforms, smooth } = sections;
+    const base = this.baseMaterial;
+    const material = Array.isArray(base) ? base.map((m) => gcsMaterial(m, uniforms, smooth)) : gcsMaterial(base, uniforms, smooth);
+    const first = Array.isArray(base) ? base[0] : base;
+    const shadow = gcsShadowMaterials(first, uniforms, smooth);
+    const raycast = new THREE.BufferGeometry();
+    raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
+    raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
+    raycast.boundingBox = this.box;
+    raycast.boundingSphere = this.sphere;
+    return { sections, material, depth: shadow.depth, distance: shadow.distance, raycast };
+  }
+
   /** @internal Shows a prepared build; the previous deformer and geometry are freed. */
   commit(next: PendingBuild): void {
     this.deformer?.dispose();
     this.tangentDeformer?.dispose();
+    if (this.gpu) disposeGpu(this.gpu);
+    this.gpu = next.gpu;
+    this.note = next.note;
+    const mesh = this.mesh as DeformedMesh;
+    mesh.material = next.gpu ? next.gpu.material : this.baseMaterial;
+    mesh.customDepthMaterial = next.gpu ? next.gpu.depth : this.source.customDepthMaterial;
+    mesh.customDistanceMaterial = next.gpu ? next.gpu.distance : this.source.customDistanceMaterial;
+    mesh.raycastGeometry = next.gpu ? next.gpu.raycast : null;
+    // GPU: three.js applies the morph targets in the shader, from the source's influences (the same array).
+    const gpuMorphs = next.gpu && next.geometry.morphAttributes.position;
+    mesh.morphTargetInfluences = gpuMorphs ? this.source.morphTargetInfluences : undefined;
+    mesh.morphTargetDictionary = gpuMorphs ? this.source.morphTargetDictionary : undefined;
     this.deformer = next.deformer;
     this.tangentDeformer = next.tangentDeformer;
     this.tangentOut = next.tangentDeformer ? (next.geometry.getAttribute('tangent') as THREE.BufferAttribute).array as Float32Array : null;
@@ -466,7 +566,7 @@ export class SkinDeformer {
     this.balls = paper || next.method === 'classic' ? this.nearBalls : this.ownBalls;
     this.ballFactor = next.method === 'classic' ? 1 + CLASSIC_LIMITS.maxBulge : 1;
     this.method = next.method;
-    this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method };
+    this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method, backend: next.backend };
     const old = this.mesh.geometry;
     this.mesh.geometry = next.geometry;
     old.dispose();
@@ -475,21 +575,48 @@ export class SkinDeformer {
 
   /** @internal Frees a prepared build that will not be shown. */
   discard(next: PendingBuild): void {
+    if (next.gpu) disposeGpu(next.gpu);
     next.tangentDeformer?.dispose();
     next.deformer.dispose();
     next.geometry.dispose();
   }
 
-  private makeGeometry(deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null): THREE.BufferGeometry {
+  /** Identity skin matrices (the bind pose), J × 16. */
+  private identity(): Float32Array {
+    const out = new Float32Array(this.rig.jointCount * 16);
+    for (let j = 0; j < this.rig.jointCount; j++) for (let c = 0; c < 4; c++) out[16 * j + 5 * c] = 1;
+    return out;
+  }
+
+  private makeGeometry(deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null, gpu: GpuBuild | null): THREE.BufferGeometry {
     const src = this.source.geometry;
     const geometry = new THREE.BufferGeometry();
     const indices = deformer.indices;
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));
-    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    if (gpu) {
+      // The bind pose, uploaded once (a bind-pose deform is bit-exact), and the section data.
+      deformer.deform(this.identity());
+      geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
+      geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
+      const { name, attribute } = sectionAttributes(deformer as GcsDeformer);
+      geometry.setAttribute(name, attribute);
+    } else {
+      geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
+      geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    }
     if (sourceVertex) {
       for (const [name, attr] of Object.entries(src.attributes))
         if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+      const tangent = src.getAttribute('tangent');
+      if (gpu && tangent && this.options.tangents !== 'drop') geometry.setAttribute('tangent', remapAttribute(tangent, sourceVertex));
+      if (gpu) {
+        // three.js morphs in the shader, before the section transform (its order).
+        for (const key of ['position', 'normal'] as const) {
+          const list = src.morphAttributes[key];
+          if (list?.length) geometry.morphAttributes[key] = list.map((a) => remapAttribute(a, sourceVertex));
+        }
+        geometry.morphTargetsRelative = src.morphTargetsRelative;
+      }
       if (tangentDeformer && this.tangentW) {
         const w = new Float32Array(4 * sourceVertex.length);
         for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = this.tangentW[sourceVertex[o]];
@@ -562,16 +689,23 @@ export class SkinDeformer {
       for (let k = 0; k < 16; k++) skin[16 * j + k] = e[k];
     }
     const deformer = this.deformer;
+    const gpu = this.gpu;
     let grow = 0; // how far the morphs can move a vertex this frame
     const maxDelta = this.maxDelta;
     if (maxDelta) {
       const influences = source.morphTargetInfluences;
       if (influences && influences.length === maxDelta.length) {
-        deformer.setMorphInfluences(influences);
+        if (!gpu) deformer.setMorphInfluences(influences); // the GPU backend morphs in the shader
         for (let t = 0; t < influences.length; t++) grow += Math.abs(influences[t]) * maxDelta[t];
       }
     }
-    deformer.deform(skin);
+    if (gpu) {
+      gpu.sections.skins.set(skin);
+      gpu.sections.update(); // section transforms only; the texture is uploaded at the next render
+      this.cpuFresh = false;
+    } else {
+      deformer.deform(skin);
+    }
     this.boundsFromBones(grow);
     const tangents = this.tangentDeformer;
     if (tangents) {
@@ -596,7 +730,7 @@ export class SkinDeformer {
       mesh.matrix.copy(source.matrixWorld);
       mesh.matrixWorld.copy(source.matrixWorld);
     }
-    this.syncAttributes();
+    if (!gpu) this.syncAttributes();
   }
 
   /** The per-frame bounds (see update()), from the skin matrices just computed. */
@@ -636,6 +770,15 @@ export class SkinDeformer {
   private exactBounds(): boolean {
     if (this.isDisposed || (this.inPlace && !this.mesh.visible)) return false;
     if (this.exactFresh) return true;
+    const gpu = this.gpu;
+    if (gpu && !this.cpuFresh) {
+      // GPU backend: the vertices exist only in the shader; deform on the CPU for this raycast.
+      const influences = this.source.morphTargetInfluences;
+      if (this.maxDelta && influences && influences.length === this.maxDelta.length) this.deformer.setMorphInfluences(influences);
+      this.deformer.deform(this.skin);
+      (gpu.raycast.getAttribute('position') as THREE.BufferAttribute).array = this.deformer.positions;
+      this.cpuFresh = true;
+    }
     const a = this.deformer.positions;
     let x0 = Infinity, y0 = Infinity, z0 = Infinity, x1 = -Infinity, y1 = -Infinity, z1 = -Infinity;
     for (let i = 0; i < a.length; i += 3) {
@@ -666,6 +809,32 @@ export class SkinDeformer {
     return this.method;
   }
 
+  /** The backend of the current build: 'gpu' only when asked for and possible (see backendNote). */
+  get backend(): Backend {
+    return this.gpu ? 'gpu' : 'cpu';
+  }
+
+  /** Why the GPU backend was asked for and the CPU runs ('' otherwise). */
+  get backendNote(): string {
+    return this.note;
+  }
+
+  /** GPU backend: the section transforms and their texture (null on the CPU backend). */
+  get gpuSections(): GpuSections | null {
+    return this.gpu?.sections ?? null;
+  }
+
+  /** Bytes this skin sends to the GPU per update(): the vertex buffers (CPU backend) or the section texture (GPU backend). */
+  get bytesPerFrame(): number {
+    if (this.gpu) return this.gpu.sections.bytesPerUpdate;
+    let bytes = 0;
+    for (const name of ['position', 'normal', 'tangent']) {
+      const a = this.mesh.geometry.getAttribute(name) as THREE.BufferAttribute | undefined;
+      if (a && a.usage === THREE.DynamicDrawUsage) bytes += a.array.byteLength;
+    }
+    return bytes;
+  }
+
   /** True when tangents are deformed this build (the source has them and the method keeps vertices). */
   get deformsTangents(): boolean {
     return this.tangentDeformer !== null;
@@ -686,6 +855,10 @@ export class SkinDeformer {
     this.deformer?.dispose();
     this.tangentDeformer?.dispose();
     this.tangentDeformer = null;
+    if (this.gpu) disposeGpu(this.gpu);
+    this.gpu = null;
+    const mesh = this.mesh as DeformedMesh;
+    mesh.raycastGeometry = null;
     this.tangentRig?.dispose();
     this.rig.dispose();
     this.mesh.removeFromParent();
@@ -708,6 +881,8 @@ export interface GcsCharacterOptions {
   tangents?: 'deform' | 'drop';
   /** Which SkinnedMeshes under the root to drive. Default: all of them. */
   filter?: (mesh: THREE.SkinnedMesh) => boolean;
+  /** See SkinDeformerOptions.backend: 'cpu' (default) or 'gpu' (GCS section transforms in the vertex shader). */
+  backend?: Backend;
 }
 
 /**
@@ -751,6 +926,7 @@ export class GcsCharacter {
       for (const source of sources) {
         skins.push(new SkinDeformer(gcs, source, {
           method: options.method, gcs: options.gcs, classic: options.classic, tangents: options.tangents, inPlace: true,
+          backend: options.backend,
         }));
       }
     } catch (e) {
@@ -777,7 +953,7 @@ export class GcsCharacter {
    * Rebuilds every skin with another method or options (e.g. a new section count). All or
    * nothing: every new deformer is built before any is shown; on a failure all stay as they were.
    */
-  rebuild(method: DeformerKind = this.method, options: { gcs?: GcsOptions; classic?: ClassicOptions } = {}): void {
+  rebuild(method: DeformerKind = this.method, options: RebuildOptions = {}): void {
     if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCharacter has been disposed');
     const pending: { skin: SkinDeformer; build: PendingBuild }[] = [];
     try {
@@ -794,6 +970,11 @@ export class GcsCharacter {
     return this.skins[0].currentMethod;
   }
 
+  /** 'gpu' when every skin runs on the GPU backend, else 'cpu' (see each skin's backendNote). */
+  get backend(): Backend {
+    return this.skins.every((s) => s.backend === 'gpu') ? 'gpu' : 'cpu';
+  }
+
   /** Frees every skin (wasm memory, deformed geometry), removes the deformed meshes and shows the SkinnedMeshes again. Safe to call twice. */
   dispose(): void {
     if (this.isDisposed) return;
@@ -807,3 +988,12 @@ export class GcsCharacter {
 }
 
 const NO_WORLD_UPDATE = Object.freeze({ updateMatrixWorld: false });
+
+/** Frees a GPU build: its wasm buffers, texture, patched materials and raycast geometry. */
+function disposeGpu(gpu: GpuBuild): void {
+  gpu.sections.dispose();
+  for (const m of Array.isArray(gpu.material) ? gpu.material : [gpu.material]) m.dispose();
+  gpu.depth.dispose();
+  gpu.distance.dispose();
+  gpu.raycast.dispose();
+}

@@ -1,0 +1,148 @@
+// The GPU backend of the three.js adapter, in node (no WebGL here: what the shader computes is
+// checked in headless Chromium, tests/browser/gpu.test.ts): the geometry is the bind pose plus the
+// static section data, uploaded once; update() computes only the section texture; materials are
+// patched clones (shadows too); unsupported methods and materials fall back to the CPU and say
+// why; raycasts hit the deformed skin; rebuilds switch backends; dispose frees.
+import { beforeAll, describe, expect, test } from 'vitest';
+import * as THREE from 'three';
+import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
+import { GcsCharacter, SkinDeformer } from '../../web/lib/three.js';
+import { gpuMaterialSupport, patchVertexShader } from '../../web/lib/gpu.js';
+import { createHuman, type Human } from '../../web/lib/human/index.js';
+
+let gcs: GcsSkin;
+let human: Human;
+beforeAll(async () => {
+  gcs = await initGcsSkin();
+  human = createHuman();
+});
+
+/** The human in a group, walking at time t. */
+function walking(t: number) {
+  const h = { ...human, mesh: human.mesh.clone() };
+  const group = new THREE.Group();
+  group.add(h.mesh);
+  const mixer = new THREE.AnimationMixer(group);
+  mixer.clipAction(human.clips.find((c) => c.name === 'walk')!).play();
+  mixer.setTime(t);
+  group.updateMatrixWorld(true);
+  return { group, mesh: h.mesh, mixer };
+}
+
+describe('GPU backend (three.js adapter)', () => {
+  test('patches three.js built-in shaders, and refuses a shader without skinning chunks', () => {
+    for (const name of ['standard', 'physical', 'lambert', 'phong', 'basic', 'toon', 'matcap', 'normal', 'depth', 'distance'] as const) {
+      const src = THREE.ShaderLib[name].vertexShader;
+      for (const smooth of [false, true]) {
+        const out = patchVertexShader(src, smooth);
+        expect(out).not.toContain('#include <skinning_vertex>');
+        expect(out).not.toContain('#include <skinbase_vertex>');
+        expect(out).toContain('gcsRows');
+        expect(out.startsWith('#define GCS_SMOOTH')).toBe(smooth);
+      }
+    }
+    expect(() => patchVertexShader('void main() { gl_Position = vec4(0.0); }', false)).toThrow(GcsError);
+    expect(gpuMaterialSupport(new THREE.MeshStandardMaterial())).toBeNull();
+    expect(gpuMaterialSupport(new THREE.ShaderMaterial())).toMatch(/custom shader/);
+  });
+
+  test('the bind pose and section data are uploaded once; a frame moves only the section texture', () => {
+    const { mesh, group, mixer } = walking(0.3);
+    const character = new GcsCharacter(gcs, group, { backend: 'gpu' });
+    expect(character.backend).toBe('gpu');
+    const skin = character.skins[0];
+    expect(skin.backendNote).toBe('');
+    const g = skin.mesh.geometry;
+    const position = g.getAttribute('position') as THREE.BufferAttribute;
+    expect(position.usage).toBe(THREE.StaticDrawUsage);
+    expect(position.array.buffer).not.toBe(gcs.memory.buffer);
+    expect(g.getAttribute('gcsSection')).toBeDefined();
+    // Bind-pose positions: the rig's own, in output order.
+    const src = skin.deformer.sourceVertex!;
+    const rest = mesh.geometry.getAttribute('position');
+    for (let o = 0; o < src.length; o += 997) expect(position.getY(o)).toBe(rest.getY(src[o]));
+    // The material is a patched clone of the source's; shadows have patched depth materials.
+    expect(skin.mesh.material).not.toBe(mesh.material);
+    expect((skin.mesh.material as THREE.Material).type).toBe((mesh.material as THREE.Material).type);
+    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-plain');
+    expect(skin.mesh.customDepthMaterial?.customProgramCacheKey()).toContain('gcs-plain');
+    expect(skin.mesh.customDistanceMaterial?.customProgramCacheKey()).toContain('gcs-plain');
+    const sections = skin.gpuSections!;
+    const S = skin.deformer.sectionCount;
+    expect(skin.bytesPerFrame).toBe(sections.transforms.width * sections.transforms.height * 16);
+    expect(skin.bytesPerFrame).toBeLessThan(S * 48 + 2048 * 16);
+    const positionVersion = position.version, textureVersion = sections.texture.version;
+    mixer.setTime(0.6);
+    character.update();
+    expect(position.version).toBe(positionVersion);
+    expect(sections.texture.version).toBe(textureVersion + 1);
+    // The texture views wasm memory (no copy) and holds this frame's section transforms.
+    const data = sections.texture.image.data as Float32Array;
+    expect(data.buffer).toBe(gcs.memory.buffer);
+    skin.deformer.deform((skin as unknown as { skin: Float32Array }).skin); // this frame's S_j, on the CPU
+    const m = (skin.deformer as import('../../web/lib/index.js').GcsDeformer).sectionMatrices();
+    for (let s = 0; s < S; s += 7) for (let r = 0; r < 3; r++) for (let c = 0; c < 4; c++) expect(data[12 * s + 4 * r + c]).toBe(m[16 * s + 4 * c + r]);
+    character.dispose();
+  });
+
+  test('raycasts hit the deformed skin as on the CPU backend', () => {
+    const hits: Record<string, THREE.Vector3> = {};
+    for (const backend of ['cpu', 'gpu'] as const) {
+      const { group } = walking(0.45);
+      const character = new GcsCharacter(gcs, group, { backend, gcs: { smooth: true } });
+      expect(character.backend).toBe(backend);
+      const ray = new THREE.Raycaster(new THREE.Vector3(3, 1.0, 0.02), new THREE.Vector3(-1, 0, 0));
+      const hit = ray.intersectObject(group, true)[0];
+      expect(hit).toBeDefined();
+      hits[backend] = hit.point;
+      character.dispose();
+    }
+    expect(hits.gpu.distanceTo(hits.cpu)).toBeLessThan(1e-5);
+  });
+
+  test('falls back to the CPU with a reason, and rebuilds switch backends', () => {
+    const { group, mesh } = walking(0.2);
+    const character = new GcsCharacter(gcs, group, { backend: 'gpu', method: 'dqs' });
+    const skin = character.skins[0];
+    expect(skin.backend).toBe('cpu');
+    expect(skin.backendNote).toMatch(/GCS/);
+    character.rebuild('gcs', { gcs: { smooth: true } });
+    expect(skin.backend).toBe('gpu');
+    expect(skin.mesh.geometry.getAttribute('gcsBlend')).toBeDefined();
+    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-smooth');
+    character.rebuild('gcs', { backend: 'cpu' });
+    expect(skin.backend).toBe('cpu');
+    expect(skin.mesh.material).toBe(mesh.material);
+    expect((skin.mesh.geometry.getAttribute('position') as THREE.BufferAttribute).array.buffer).toBe(gcs.memory.buffer);
+    expect(() => character.rebuild('gcs', { backend: 'webgpu' as 'gpu' })).toThrow(GcsError);
+    expect(skin.backend).toBe('cpu');
+    character.dispose();
+    const custom = walking(0.2);
+    custom.mesh.material = new THREE.ShaderMaterial();
+    const alone = new SkinDeformer(gcs, custom.mesh, { backend: 'gpu' });
+    expect(alone.backend).toBe('cpu');
+    expect(alone.backendNote).toMatch(/custom shader/);
+    alone.dispose();
+  });
+
+  test('morph targets stay on the mesh for three.js to apply in the shader', () => {
+    const { mesh, group } = walking(0.1);
+    const g = mesh.geometry.clone();
+    const n = g.getAttribute('position').count;
+    const delta = new Float32Array(3 * n);
+    for (let i = 0; i < n; i++) delta[3 * i + 1] = 0.01;
+    g.morphAttributes.position = [new THREE.BufferAttribute(delta, 3)];
+    g.morphTargetsRelative = true;
+    mesh.geometry = g;
+    mesh.updateMorphTargets();
+    mesh.morphTargetInfluences![0] = 0.5;
+    const character = new GcsCharacter(gcs, group, { backend: 'gpu' });
+    const skin = character.skins[0];
+    expect(skin.backend).toBe('gpu');
+    const morph = skin.mesh.geometry.morphAttributes.position[0];
+    const src = skin.deformer.sourceVertex!;
+    expect(morph.count).toBe(src.length);
+    expect(skin.mesh.morphTargetInfluences).toBe(mesh.morphTargetInfluences);
+    character.dispose();
+  });
+});
