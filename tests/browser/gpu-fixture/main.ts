@@ -1,0 +1,201 @@
+// The page of tests/browser/gpu.test.ts: draws GCS on the GPU backend and reads back what the
+// vertex shader computed, to compare with the CPU backend on the same frames.
+//   positions and normals: the GLSL of gcs-skin/gpu (patchVertexShader, the same function the
+//     patched materials use) in a Points pass over every vertex, with the skin's own section
+//     texture and attributes, written to an RGBA32F render target and read back;
+//   pictures: the character drawn by its patched source material (GPU backend) and by the CPU
+//     backend, same frame, same camera, read back as pixels.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib/index.js';
+import { GcsCharacter, type Backend } from '../../../web/lib/three.js';
+import { patchVertexShader } from '../../../web/lib/gpu.js';
+import { createHuman } from '../../../web/lib/human/index.js';
+
+const W = 512, H = 512;
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+renderer.setSize(W, H);
+renderer.setPixelRatio(1);
+document.body.append(renderer.domElement);
+const gcsReady = initGcsSkin();
+
+const READ_VERTEX = /* glsl */ `
+#include <common>
+#include <skinning_pars_vertex>
+uniform int readWidth;
+uniform int readHeight;
+uniform int readWhat;
+varying vec4 vOut;
+void main() {
+	#include <beginnormal_vertex>
+	#include <skinbase_vertex>
+	#include <skinnormal_vertex>
+	#include <begin_vertex>
+	#include <skinning_vertex>
+	vOut = readWhat == 0 ? vec4( transformed, 1.0 ) : vec4( objectNormal, 0.0 );
+	int x = gl_VertexID % readWidth, y = gl_VertexID / readWidth;
+	gl_Position = vec4( ( float( x ) + 0.5 ) / float( readWidth ) * 2.0 - 1.0, ( float( y ) + 0.5 ) / float( readHeight ) * 2.0 - 1.0, 0.0, 1.0 );
+	gl_PointSize = 1.0;
+}`;
+const READ_FRAGMENT = /* glsl */ `
+varying vec4 vOut;
+void main() { gl_FragColor = vOut; }`;
+
+/** What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals, float32. */
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform>, smooth: boolean): { positions: Float32Array; normals: Float32Array } {
+  const src = mesh.geometry;
+  const V = src.getAttribute('position').count;
+  const rw = 1024, rh = Math.ceil(V / rw);
+  const points = new THREE.BufferGeometry(); // not indexed: gl_VertexID is the vertex
+  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend']) {
+    const a = src.getAttribute(name);
+    if (a) points.setAttribute(name, a);
+  }
+  const material = new THREE.ShaderMaterial({
+    uniforms: { ...uniforms, readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
+    vertexShader: patchVertexShader(READ_VERTEX, smooth),
+    fragmentShader: READ_FRAGMENT,
+  });
+  const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
+  const scene = new THREE.Scene();
+  const cloud = new THREE.Points(points, material);
+  cloud.frustumCulled = false;
+  scene.add(cloud);
+  const camera = new THREE.Camera();
+  const out = { positions: new Float32Array(3 * V), normals: new Float32Array(3 * V) };
+  const pixels = new Float32Array(4 * rw * rh);
+  for (const what of [0, 1]) {
+    material.uniforms.readWhat.value = what;
+    renderer.setRenderTarget(target);
+    renderer.setClearColor(0x000000, 0);
+    renderer.clear();
+    renderer.render(scene, camera);
+    renderer.readRenderTargetPixels(target, 0, 0, rw, rh, pixels);
+    const dst = what === 0 ? out.positions : out.normals;
+    for (let v = 0; v < V; v++) for (let c = 0; c < 3; c++) dst[3 * v + c] = pixels[4 * v + c];
+  }
+  renderer.setRenderTarget(null);
+  target.dispose();
+  material.dispose();
+  return out;
+}
+
+interface Loaded { root: THREE.Object3D; clips: THREE.AnimationClip[] }
+
+async function load(model: string): Promise<Loaded> {
+  if (model === 'human') {
+    const h = createHuman();
+    const root = new THREE.Group();
+    root.add(h.mesh);
+    return { root, clips: h.clips };
+  }
+  const gltf = await new GLTFLoader().loadAsync(model);
+  return { root: gltf.scene, clips: gltf.animations };
+}
+
+export interface CheckResult {
+  skins: number;
+  backends: string[];
+  notes: string[];
+  height: number;
+  /** worst |GPU − CPU| position distance over every vertex and frame, divided by the height */
+  positionError: number;
+  /** worst distance between the GPU normal and the CPU normal (both unit) */
+  normalError: number;
+  /** the same comparison against the bind pose: how far the frames moved the skin (not vacuous) */
+  motion: number;
+  vertices: number;
+  frames: number;
+  /** share of pixels differing (any channel > 16/255) between the GPU and CPU backends' pictures, per frame */
+  pixelDiff: number[];
+  /** share of pixels covered by the character */
+  coverage: number;
+  /** share of pixels differing between the GPU backend's first frame and each later one: the picture moves */
+  pixelMotion: number;
+  extColorBufferFloat: boolean;
+}
+
+/** Share of pixels of which a channel differs by more than 16 (of 255). */
+function differing(a: Uint8Array, b: Uint8Array): number {
+  let n = 0;
+  for (let o = 0; o < a.length; o += 4)
+    if (Math.abs(a[o] - b[o]) > 16 || Math.abs(a[o + 1] - b[o + 1]) > 16 || Math.abs(a[o + 2] - b[o + 2]) > 16) n++;
+  return n / (a.length / 4);
+}
+
+/** Loads a character, deforms it on both backends on the same frames and compares. */
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string): Promise<CheckResult> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const scene = new THREE.Scene();
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2));
+  const sun = new THREE.DirectionalLight(0xffffff, 2);
+  sun.position.set(2, 4, 3);
+  scene.add(sun);
+  scene.add(root);
+  const mixer = new THREE.AnimationMixer(root);
+  const clip = clips.find((c) => c.name === clipName) ?? clips[0];
+  mixer.clipAction(clip).play();
+  const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu' });
+  // Frame the character from its bind-pose box.
+  root.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(root);
+  const centre = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length();
+  const camera = new THREE.PerspectiveCamera(40, W / H, size / 100, size * 10);
+  camera.position.copy(centre).add(new THREE.Vector3(0.6, 0.3, 1).normalize().multiplyScalar(size * 1.3));
+  camera.lookAt(centre);
+  const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), notes: character.skins.map((s) => s.backendNote),
+    height: 0, positionError: 0, normalError: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
+    extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float') };
+  const pixels = (backend: Backend): Uint8Array => {
+    if (character.backend !== backend) character.rebuild(undefined, { backend });
+    character.update();
+    renderer.setClearColor(0x000000, 1);
+    renderer.render(scene, camera);
+    const gl = renderer.getContext();
+    const out = new Uint8Array(4 * W * H);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return out;
+  };
+  let first: Uint8Array | null = null;
+  for (const t of times) {
+    mixer.setTime(t);
+    if (character.backend !== 'gpu') character.rebuild(undefined, { backend: 'gpu' });
+    character.update();
+    for (const skin of character.skins) {
+      const mesh = skin.mesh as THREE.Mesh;
+      const sections = skin.gpuSections!;
+      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth);
+      const d = skin.deformer as GcsDeformer;
+      d.deform((skin as unknown as { skin: Float32Array }).skin); // the same frame on the CPU
+      const cpuP = d.positions, cpuN = d.normals;
+      const rest = mesh.geometry.getAttribute('position').array as Float32Array;
+      const height = skin.rig.height;
+      result.height = Math.max(result.height, height);
+      result.vertices += t === times[0] ? d.vertexCount : 0;
+      for (let v = 0; v < d.vertexCount; v++) {
+        const dp = Math.hypot(gpuOut.positions[3 * v] - cpuP[3 * v], gpuOut.positions[3 * v + 1] - cpuP[3 * v + 1], gpuOut.positions[3 * v + 2] - cpuP[3 * v + 2]) / height;
+        const moved = Math.hypot(rest[3 * v] - cpuP[3 * v], rest[3 * v + 1] - cpuP[3 * v + 1], rest[3 * v + 2] - cpuP[3 * v + 2]) / height;
+        const l = Math.hypot(cpuN[3 * v], cpuN[3 * v + 1], cpuN[3 * v + 2]) || 1;
+        const dn = Math.hypot(gpuOut.normals[3 * v] - cpuN[3 * v] / l, gpuOut.normals[3 * v + 1] - cpuN[3 * v + 1] / l, gpuOut.normals[3 * v + 2] - cpuN[3 * v + 2] / l);
+        if (!(dp <= result.positionError)) result.positionError = Number.isNaN(dp) ? Infinity : dp;
+        if (!(dn <= result.normalError)) result.normalError = Number.isNaN(dn) ? Infinity : dn;
+        if (moved > result.motion) result.motion = moved;
+      }
+    }
+    const a = pixels('gpu'), b = pixels('cpu');
+    first ??= a;
+    let covered = 0;
+    for (let i = 0; i < W * H; i++) if (a[4 * i] + a[4 * i + 1] + a[4 * i + 2] > 0) covered++;
+    result.pixelDiff.push(differing(a, b));
+    result.pixelMotion = Math.max(result.pixelMotion, differing(a, first));
+    result.coverage = Math.max(result.coverage, covered / (W * H));
+  }
+  character.dispose();
+  return result;
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check } }
+}
+window.__gpu = { check };
