@@ -5,10 +5,13 @@
 // why; raycasts hit the deformed skin; rebuilds switch backends; dispose frees.
 import { beforeAll, describe, expect, test } from 'vitest';
 import * as THREE from 'three';
+import * as SkeletonUtils from 'three/addons/utils/SkeletonUtils.js';
 import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { GcsCharacter, SkinDeformer } from '../../web/lib/three.js';
 import { gpuMaterialSupport, patchVertexShader } from '../../web/lib/gpu.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
+import { bakeClip, GcsCrowd } from '../../web/lib/crowd.js';
+import { SectionTransforms } from '../../web/lib/index.js';
 
 let gcs: GcsSkin;
 let human: Human;
@@ -19,14 +22,14 @@ beforeAll(async () => {
 
 /** The human in a group, walking at time t. */
 function walking(t: number) {
-  const h = { ...human, mesh: human.mesh.clone() };
+  const mesh = SkeletonUtils.clone(human.mesh) as THREE.SkinnedMesh; // its own bones
   const group = new THREE.Group();
-  group.add(h.mesh);
+  group.add(mesh);
   const mixer = new THREE.AnimationMixer(group);
   mixer.clipAction(human.clips.find((c) => c.name === 'walk')!).play();
   mixer.setTime(t);
   group.updateMatrixWorld(true);
-  return { group, mesh: h.mesh, mixer };
+  return { group, mesh, mixer };
 }
 
 describe('GPU backend (three.js adapter)', () => {
@@ -144,5 +147,41 @@ describe('GPU backend (three.js adapter)', () => {
     expect(morph.count).toBe(src.length);
     expect(skin.mesh.morphTargetInfluences).toBe(mesh.morphTargetInfluences);
     character.dispose();
+  });
+
+  test('a crowd: one instanced mesh, every instance its own pose, one wasm call and one texture per frame', () => {
+    const { mesh } = walking(0);
+    const N = 5;
+    const crowd = new GcsCrowd(gcs, mesh, N, { gcs: { smooth: true } });
+    expect(crowd.mesh).toBeInstanceOf(THREE.InstancedMesh);
+    expect(crowd.mesh.count).toBe(N);
+    expect((crowd.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-smooth');
+    const S = crowd.deformer.sectionCount;
+    expect(crowd.bytesPerFrame).toBe(crowd.sections.transforms.width * crowd.sections.transforms.height * 16);
+    expect(crowd.bytesPerFrame).toBeLessThan(N * S * 48 + 2048 * 16);
+    const walk = bakeClip(mesh, human.clips.find((c) => c.name === 'walk')!, 30);
+    expect(walk.frames).toBe(Math.round(walk.duration * 30));
+    const times = [0, 0.21, 0.5, -0.3, 7.9];
+    times.forEach((t, i) => crowd.setBakedPose(i, walk, t));
+    const version = crowd.sections.texture.version;
+    crowd.update();
+    expect(crowd.sections.texture.version).toBe(version + 1);
+    // Instance i's texels are the section transforms of its own pose (the baked frame at its time).
+    const one = new SectionTransforms(crowd.deformer, 1);
+    const J = crowd.jointCount, S12 = S * 12;
+    const all = crowd.sections.transforms.texels;
+    times.forEach((t, i) => {
+      let f = Math.floor(t * walk.fps) % walk.frames;
+      if (f < 0) f += walk.frames;
+      one.skins.set(walk.data.subarray(f * J * 16, (f + 1) * J * 16));
+      one.compute();
+      expect(Array.from(all.subarray(i * S12, (i + 1) * S12))).toEqual(Array.from(one.texels.subarray(0, S12)));
+    });
+    expect(Array.from(all.subarray(0, S12))).not.toEqual(Array.from(all.subarray(S12, 2 * S12)));
+    one.dispose();
+    expect(() => crowd.offsetOf(N)).toThrow(GcsError);
+    expect(() => new GcsCrowd(gcs, mesh, 0)).toThrow(GcsError);
+    crowd.dispose();
+    expect(() => crowd.update()).toThrow(GcsError);
   });
 });

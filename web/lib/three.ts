@@ -60,6 +60,24 @@ export interface SkinDeformerOptions {
   backend?: Backend;
 }
 
+/**
+ * Writes the skin matrices S_j = bindMatrixInverse · boneWorld · boneInverse · bindMatrix (mesh
+ * space, J × 16 floats, what deformers take) of `source`'s skeleton as it is posed now (world
+ * matrices up to date) into `out` at `offset`. No allocation when `tmp` is given.
+ */
+export function writeSkinMatrices(source: THREE.SkinnedMesh, out: Float32Array, offset = 0, tmp = new THREE.Matrix4()): void {
+  const bones = source.skeleton.bones;
+  const inverses = source.skeleton.boneInverses;
+  for (let j = 0; j < bones.length; j++) {
+    tmp.multiplyMatrices(bones[j].matrixWorld, inverses[j]);
+    tmp.premultiply(source.bindMatrixInverse);
+    tmp.multiply(source.bindMatrix);
+    const e = tmp.elements;
+    const o = offset + 16 * j;
+    for (let k = 0; k < 16; k++) out[o + k] = e[k];
+  }
+}
+
 /** Reads the rig (bind-pose mesh, skin, skeleton) out of a SkinnedMesh as GLTFLoader gives it. */
 export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
   if (!source || !(source as THREE.SkinnedMesh).isSkinnedMesh || !source.skeleton)
@@ -124,8 +142,8 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
 type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
 type TypedArray = Float32Array | Float64Array | Int8Array | Uint8Array | Uint8ClampedArray | Int16Array | Uint16Array | Int32Array | Uint32Array;
 
-/** The attributes a deformer replaces or consumes: everything else is carried to the output. */
-const SKINNING_ATTRIBUTES = new Set(['position', 'normal', 'tangent', 'skinIndex', 'skinWeight']);
+/** @internal The attributes a deformer replaces or consumes: everything else is carried to the output. */
+export const SKINNING_ATTRIBUTES: ReadonlySet<string> = new Set(['position', 'normal', 'tangent', 'skinIndex', 'skinWeight']);
 
 /** Raw (un-normalised) element i·itemSize+k of an attribute, interleaved or not. */
 function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offset: number } {
@@ -135,8 +153,8 @@ function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offs
     : { array: (attr as THREE.BufferAttribute).array as TypedArray, stride: attr.itemSize, offset: 0 };
 }
 
-/** A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
-function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
+/** @internal A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
+export function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
   const { array, stride, offset } = rawArray(attr);
   const size = attr.itemSize;
   const Ctor = array.constructor as new (length: number) => TypedArray;
@@ -676,18 +694,8 @@ export class SkinDeformer {
       mesh.visible = source.visible;
       if (!source.visible) return;
     }
-    const bones = source.skeleton.bones;
-    const inverses = source.skeleton.boneInverses;
     const skin = this.skin;
-    const tmp = this.tmp;
-    for (let j = 0; j < bones.length; j++) {
-      // S_j in mesh space: bindMatrixInverse · boneWorld · boneInverse · bindMatrix.
-      tmp.multiplyMatrices(bones[j].matrixWorld, inverses[j]);
-      tmp.premultiply(source.bindMatrixInverse);
-      tmp.multiply(source.bindMatrix);
-      const e = tmp.elements;
-      for (let k = 0; k < 16; k++) skin[16 * j + k] = e[k];
-    }
+    writeSkinMatrices(source, skin, 0, this.tmp);
     const deformer = this.deformer;
     const gpu = this.gpu;
     let grow = 0; // how far the morphs can move a vertex this frame

@@ -1,0 +1,193 @@
+/**
+ * gcs-skin/crowd: many characters sharing one mesh and one GCS model, each in its own pose, drawn
+ * by one THREE.InstancedMesh (one draw call, plus one per shadow pass) whose per-instance section
+ * transforms live in one float texture (docs/gpu.md).
+ *
+ *   const crowd = new GcsCrowd(gcs, skinnedMesh, 200);         // 200 instances of its skin
+ *   scene.add(crowd.mesh);
+ *   crowd.mesh.setMatrixAt(i, placement);                       // where each one stands
+ *   const walk = bakeClip(skinnedMesh, clip);                   // or your own skeletons:
+ *   // each frame: crowd.setBakedPose(i, walk, t_i) (or writeSkinMatrices(mesh_i, crowd.skins, crowd.offsetOf(i)))
+ *   //             crowd.update(); renderer.render(scene, camera);
+ *
+ * Per frame the CPU does O(instances × sections): one wasm call computes every instance's section
+ * transforms into the texture's memory, and three.js uploads it (instances × sections × 48 bytes).
+ */
+import * as THREE from 'three';
+import { GcsError } from './errors.js';
+import type { GcsDeformer, GcsOptions, GcsSkin, Rig } from './index.js';
+import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes } from './gpu.js';
+import { remapAttribute, rigInputFromSkinnedMesh, SKINNING_ATTRIBUTES, writeSkinMatrices } from './three.js';
+
+export { writeSkinMatrices } from './three.js';
+
+/** A clip sampled once into skin matrices: `frames` poses of J × 16 floats, `fps` apart. */
+export interface BakedClip {
+  name: string;
+  fps: number;
+  frames: number;
+  duration: number;
+  jointCount: number;
+  /** frames × J × 16 floats */
+  data: Float32Array;
+}
+
+/**
+ * Samples `clip` on `source`'s skeleton at `fps` (the whole clip, looped) into skin matrices, so
+ * that any number of instances can play it at their own time for the cost of a copy. Build time
+ * only: it poses the skeleton through a temporary AnimationMixer on `source`'s root and leaves it
+ * in the clip's last sampled pose.
+ */
+export function bakeClip(source: THREE.SkinnedMesh, clip: THREE.AnimationClip, fps = 60): BakedClip {
+  if (!source?.isSkinnedMesh || !source.skeleton) throw new GcsError('NO_SKIN', 'bakeClip needs a THREE.SkinnedMesh with a skeleton');
+  if (!(fps > 0 && fps <= 1000)) throw new GcsError('OUT_OF_RANGE', `fps must be in (0, 1000]; got ${fps}`);
+  let root: THREE.Object3D = source;
+  while (root.parent) root = root.parent;
+  const J = source.skeleton.bones.length;
+  const frames = Math.max(1, Math.round(clip.duration * fps));
+  const data = new Float32Array(frames * J * 16);
+  const mixer = new THREE.AnimationMixer(root);
+  const action = mixer.clipAction(clip);
+  action.play();
+  const tmp = new THREE.Matrix4();
+  for (let f = 0; f < frames; f++) {
+    mixer.setTime(f / fps);
+    root.updateMatrixWorld(true);
+    writeSkinMatrices(source, data, f * J * 16, tmp);
+  }
+  action.stop();
+  mixer.uncacheRoot(root);
+  return { name: clip.name, fps, frames, duration: frames / fps, jointCount: J, data };
+}
+
+export interface GcsCrowdOptions {
+  /** The GCS model (default: the weights criterion, 6 sections, plain). */
+  gcs?: GcsOptions;
+  /** Drawn with a patched clone of this material. Default: the source's own. */
+  material?: THREE.Material | THREE.Material[];
+  /** The widest row of the section texture (default 2048, what WebGL2 guarantees). */
+  maxTextureWidth?: number;
+}
+
+/**
+ * `count` instances of `source`'s skin, each with its own pose. `source` is only read (its
+ * geometry, skin and material): it is not changed and need not be in the scene. Poses are skin
+ * matrices per instance (`skins`, J × 16 floats each at `offsetOf(i)`, what deformers take).
+ * Placement: `mesh.setMatrixAt(i, matrix)` (three.js InstancedMesh). Frustum culling is off
+ * (one draw call draws every instance). Morph targets are not carried (three.js's per-instance
+ * morphs would need a morph texture per instance). `dispose()` frees the wasm memory, geometry,
+ * texture and patched materials (not the source's material).
+ */
+export class GcsCrowd {
+  readonly mesh: THREE.InstancedMesh;
+  readonly rig: Rig;
+  readonly deformer: GcsDeformer;
+  readonly sections: GpuSections;
+  readonly count: number;
+  readonly jointCount: number;
+  private isDisposed = false;
+
+  constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, count: number, options: GcsCrowdOptions = {}) {
+    const input = rigInputFromSkinnedMesh(source);
+    const material = options.material ?? source.material;
+    for (const m of Array.isArray(material) ? material : [material]) {
+      const reason = gpuMaterialSupport(m);
+      if (reason) throw new GcsError('INVALID_ARGUMENT', `GcsCrowd draws on the GPU only: ${reason}`);
+    }
+    this.rig = gcs.createRig(input);
+    let deformer: GcsDeformer | null = null, sections: GpuSections | null = null;
+    try {
+      deformer = this.rig.buildGcs(options.gcs ?? {});
+      sections = new GpuSections(deformer, count, options.maxTextureWidth ?? 2048);
+    } catch (e) {
+      deformer?.dispose();
+      this.rig.dispose();
+      throw e;
+    }
+    this.deformer = deformer;
+    this.sections = sections;
+    this.count = count;
+    this.jointCount = this.rig.jointCount;
+    // The bind pose (a bind-pose deform is bit-exact), the section data, the carried attributes.
+    const identity = new Float32Array(this.jointCount * 16);
+    for (let j = 0; j < this.jointCount; j++) for (let c = 0; c < 4; c++) identity[16 * j + 5 * c] = 1;
+    deformer.deform(identity);
+    const geometry = new THREE.BufferGeometry();
+    geometry.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
+    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
+    const { name, attribute } = sectionAttributes(deformer);
+    geometry.setAttribute(name, attribute);
+    const sourceVertex = deformer.sourceVertex!;
+    for (const [key, attr] of Object.entries(source.geometry.attributes))
+      if (!SKINNING_ATTRIBUTES.has(key) || key === 'tangent') geometry.setAttribute(key, remapAttribute(attr, sourceVertex));
+    for (const g of source.geometry.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
+    const { uniforms, smooth } = sections;
+    const patched = Array.isArray(material) ? material.map((m) => gcsMaterial(m, uniforms, smooth)) : gcsMaterial(material, uniforms, smooth);
+    this.mesh = new THREE.InstancedMesh(geometry, patched, count);
+    const shadow = gcsShadowMaterials(Array.isArray(material) ? material[0] : material, uniforms, smooth);
+    this.mesh.customDepthMaterial = shadow.depth;
+    this.mesh.customDistanceMaterial = shadow.distance;
+    this.mesh.castShadow = source.castShadow;
+    this.mesh.receiveShadow = source.receiveShadow;
+    this.mesh.frustumCulled = false;
+    this.mesh.name = `${source.name || 'skin'} (GCS crowd)`;
+  }
+
+  private live(): void {
+    if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCrowd has been disposed');
+  }
+
+  /** Every instance's skin matrices (count × J × 16 floats), a view on wasm memory: write poses here. */
+  get skins(): Float32Array {
+    this.live();
+    return this.sections.skins;
+  }
+
+  /** Where instance i's J × 16 skin matrices start in `skins`. */
+  offsetOf(i: number): number {
+    if (!Number.isInteger(i) || i < 0 || i >= this.count) throw new GcsError('OUT_OF_RANGE', `instance ${i} is out of range: the crowd has ${this.count}`);
+    return i * this.jointCount * 16;
+  }
+
+  /** Poses instance i at `time` seconds into a baked clip (looped; the nearest sampled frame). A copy of J × 16 floats. */
+  setBakedPose(i: number, clip: BakedClip, time: number): void {
+    if (clip.jointCount !== this.jointCount) throw new GcsError('LENGTH_MISMATCH', `the clip was baked for ${clip.jointCount} joints; the crowd has ${this.jointCount}`);
+    const o = this.offsetOf(i);
+    const n = this.jointCount * 16;
+    let f = Math.floor(time * clip.fps) % clip.frames;
+    if (f < 0) f += clip.frames;
+    if (!(f >= 0)) f = 0; // NaN or infinite time: the first frame
+    const src = clip.data, dst = this.skins, s = f * n;
+    for (let k = 0; k < n; k++) dst[o + k] = src[s + k];
+  }
+
+  /** Once per frame after posing: every instance's section transforms (one wasm call); the texture uploads at the next render. */
+  update(): void {
+    this.live();
+    this.sections.update();
+  }
+
+  /** Bytes uploaded per update(): the section texture. */
+  get bytesPerFrame(): number {
+    return this.sections.bytesPerUpdate;
+  }
+
+  dispose(): void {
+    if (this.isDisposed) return;
+    this.isDisposed = true;
+    this.mesh.removeFromParent();
+    this.mesh.geometry.dispose();
+    for (const m of Array.isArray(this.mesh.material) ? this.mesh.material : [this.mesh.material]) m.dispose();
+    this.mesh.customDepthMaterial?.dispose();
+    this.mesh.customDistanceMaterial?.dispose();
+    this.mesh.dispose();
+    this.sections.dispose();
+    this.deformer.dispose();
+    this.rig.dispose();
+  }
+
+  get disposed(): boolean {
+    return this.isDisposed;
+  }
+}
