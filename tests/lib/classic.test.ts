@@ -96,7 +96,8 @@ describe('classic cross-sections on analytic tubes', () => {
         worst = Math.max(worst, Math.abs(Math.hypot(pos[3 * v], pos[3 * v + 2]) - t.radius) / t.radius);
     // A 48-gon's chord is at cos(π/48) = 0.9979 of the radius: rays between its corners see that.
     expect(worst).toBeLessThan(0.01);
-    // Tube triangles face away from the axis; rigid triangles are the input's (also outward).
+    // Tube and band triangles (a band zips part 1's end ring to the carried leaf's border) face away
+    // from the axis; carried triangles are the input's (also outward).
     const idx = d.indices;
     let inward = 0, tube = 0;
     const tubeEnd = d.parts[1].firstVertex + d.parts[1].vertexCount;
@@ -123,6 +124,7 @@ describe('classic cross-sections on analytic tubes', () => {
   test('bent 90°: the joint contour lies on the bisector plane, every value finite', () => {
     const rig = gcs.createRig(tube3().input);
     const d = rig.buildClassic({ contours: 25, rays: 40, bulge: 0 });
+    const bindY = Array.from({ length: d.vertexCount }, (_, v) => d.positions[3 * v + 1]);
     d.deform(bendSkin(Math.PI / 2));
     const pos = d.positions;
     expect(allFinite(pos)).toBe(true);
@@ -139,10 +141,16 @@ describe('classic cross-sections on analytic tubes', () => {
     }
     expect(off).toBeLessThan(1e-5);
     expect(rad).toBeLessThan(0.002);
-    // Inner contours of the lower part lie on planes turning from the bisector to −X.
+    // The lower part's last ring (where its tube meets the carried leaf: just inside the band, at
+    // bind height 1 + t) lies on the plane through the posed bone at t whose normal turns from the
+    // bisector (t = 0) to −X (t = 1): normalize((1 − t) · N_o + t · (−X)).
     const last = first + (25 - 1) * 40;
-    const end = new THREE.Vector3(-1, 1, 0);
-    for (let v = last; v < last + 40; v++) expect(Math.abs(vec(pos, v).sub(end).dot(new THREE.Vector3(-1, 0, 0)))).toBeLessThan(1e-5);
+    const t = bindY[last] - 1;
+    expect(t).toBeGreaterThan(0.9);
+    expect(t).toBeLessThan(1);
+    const end = new THREE.Vector3(-t, 1, 0);
+    const normal = bis.clone().multiplyScalar(1 - t).add(new THREE.Vector3(-t, 0, 0)).normalize();
+    for (let v = last; v < last + 40; v++) expect(Math.abs(vec(pos, v).sub(end).dot(normal))).toBeLessThan(1e-5);
     d.dispose();
     rig.dispose();
   });
@@ -151,6 +159,7 @@ describe('classic cross-sections on analytic tubes', () => {
     const rig = gcs.createRig(tube3().input);
     const b = 0.8;
     const d = rig.buildClassic({ contours: 25, rays: 40, bulge: b });
+    const bindY = Array.from({ length: d.vertexCount }, (_, v) => d.positions[3 * v + 1]);
     const angle = Math.PI / 2;
     d.deform(bendSkin(angle));
     const flex = angle / Math.PI;
@@ -176,7 +185,7 @@ describe('classic cross-sections on analytic tubes', () => {
     d.deform(bendSkin(angle));
     const p1 = d.parts[1];
     let worst = 0;
-    const c1 = new THREE.Vector3(-0.5, 1, 0); // mid-point of the bent lower bone
+    const c1 = new THREE.Vector3(-(bindY[p1.firstVertex + 40 * 12] - 1), 1, 0); // its centre on the bent lower bone
     for (let r = 0; r < 40; r++) worst = Math.max(worst, Math.abs(vec(pos, p1.firstVertex + 40 * 12 + r).sub(c1).length() - 0.1));
     expect(worst).toBeLessThan(0.002);
     d.dispose();
@@ -229,7 +238,7 @@ describe('classic cross-sections on analytic tubes', () => {
     // Joint 2 at the same point as joint 1: part 1 (y in [1, 2)) has a zero-length bone.
     const rig = gcs.createRig(tube3({ joint2: 1 }).input);
     const d = rig.buildClassic();
-    expect(d.parts.map((p) => p.resampled)).toEqual([true, false, false]);
+    expect(d.parts.map((p) => [p.resampled, p.reason])).toEqual([[true, 'resampled'], [false, 'too-short'], [false, 'leaf']]);
     d.deform(bendSkin(0.7));
     expect(allFinite(d.positions)).toBe(true);
     d.dispose();
@@ -240,7 +249,7 @@ describe('classic cross-sections on analytic tubes', () => {
       inverseBindMatrices: new Float32Array(new THREE.Matrix4().elements) };
     const rig1 = gcs.createRig(input);
     const d1 = rig1.buildClassic();
-    expect(d1.parts).toEqual([{ joint: 0, resampled: false, firstVertex: 0, vertexCount: rig1.vertexCount }]);
+    expect(d1.parts).toEqual([{ joint: 0, resampled: false, reason: 'leaf', firstVertex: 0, vertexCount: rig1.vertexCount }]);
     expect(d1.indices.length).toBe(input.indices.length);
     expect(d1.sectionCount).toBe(0);
     d1.deform(new Float32Array(new THREE.Matrix4().makeTranslation(1, 2, 3).elements));

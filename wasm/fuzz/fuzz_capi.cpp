@@ -696,7 +696,7 @@ void checkStructure(Built& b, const RigInput& in) {
     for (uint32_t i = 0; i < I; ++i)
       CHECK(src[idx[i]] == in.indices[i], "output triangle index %u: rig vertex %u, the rig's triangle has %u", i,
             src[idx[i]], in.indices[i]);
-    CHECK(gcs_classic_part_count(d) == 0 && gcs_classic_parts(d) == nullptr, "classic report on a non-classic deformer");
+    CHECK(gcs_classic_part_count(d) == 0 && gcs_classic_parts(d) == nullptr && !gcs_classic_contour_of_vertex(d), "classic report on a non-classic deformer");
     CHECK(std::isnan(gcs_classic_detail_loss(d, 0)), "classic detail loss on a non-classic deformer");
     CHECK(gcs_classic_set_bulge(d, 1.0f) == 0, "set_bulge accepted on a non-classic deformer");
     checkRejected("set_bulge on a non-classic deformer", [](int c) { return c == GCS_ERR_INVALID_ARGUMENT; });
@@ -747,17 +747,26 @@ void checkStructure(Built& b, const RigInput& in) {
     CHECK(gcs_deformer_stat(d, GCS_STAT_ADJUSTED_SECTIONS) == statSections, "classic adjusted sections %g, contours %g",
           double(gcs_deformer_stat(d, GCS_STAT_ADJUSTED_SECTIONS)), double(statSections));
     int32_t prevJoint = -1;
-    log("classic: %u output vertices, %g contours, parts (joint, resampled, first, count):", N, double(statSections));
-    for (uint32_t p = 0; p < P; ++p) log(" (%d %d %d %d)", parts[4 * p], parts[4 * p + 1], parts[4 * p + 2], parts[4 * p + 3]);
+    log("classic: %u output vertices, %g contours, parts (joint, resampled, first, count, reason):", N, double(statSections));
+    for (uint32_t p = 0; p < P; ++p)
+      log(" (%d %d %d %d %d)", parts[5 * p], parts[5 * p + 1], parts[5 * p + 2], parts[5 * p + 3], parts[5 * p + 4]);
     log("\n");
     for (uint32_t p = 0; p < P; ++p) {
-      const int32_t* e = &parts[4 * size_t(p)];
+      const int32_t* e = &parts[5 * size_t(p)];
       CHECK(e[0] > prevJoint && e[0] < int32_t(in.jointCount), "classic part %u joint %d", p, e[0]);
       prevJoint = e[0];
       CHECK(e[1] == 0 || e[1] == 1, "classic part %u resampled flag %d", p, e[1]);
+      CHECK(e[4] >= GCS_CLASSIC_RESAMPLED && e[4] <= GCS_CLASSIC_TRUNK &&
+                (e[1] == 1) == (e[4] == GCS_CLASSIC_RESAMPLED || e[4] == GCS_CLASSIC_TRUNK),
+            "classic part %u reason %d with resampled flag %d", p, e[4], e[1]);
       CHECK(e[2] >= 0 && e[3] >= 0 && int64_t(e[2]) + e[3] <= int64_t(N), "classic part %u range [%d, +%d) outside %u",
             p, e[2], e[3], N);
     }
+    const int32_t* contourOf = gcs_classic_contour_of_vertex(d);
+    CHECK(contourOf != nullptr || N == 0, "classic contour of vertex is null");
+    for (uint32_t o = 0; contourOf && o < N; ++o)
+      CHECK(contourOf[o] >= -1 && float(contourOf[o]) < statSections, "output vertex %u on contour %d of %g", o,
+            contourOf[o], double(statSections));
     for (uint32_t which = 0; which < 3; ++which) {
       const float a = gcs_classic_detail_loss(d, which), again = gcs_classic_detail_loss(d, which);
       if (which == 2) {

@@ -321,9 +321,9 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
  * neighbours. Two resampled neighbours share their joint contour (stored once, cast against both
  * parts' triangles, its plane normal the bisector of the two bones): tLo = 0 / tHi = 1 there.
  * Where a tube meets the carried mesh (every triangle with a carried vertex, kept as it is, its
- * vertices moving rigidly with their own part's S_j), the tube ends at the innermost point of
- * the boundary loop of those triangles (tLo = the loop's largest t at a proximal end, tHi its
- * smallest at a distal one), and a band of triangles zips the tube's end ring to that loop: every
+ * vertices moving rigidly with their own part's S_j), the tube ends just inside the innermost point of
+ * the boundary loop of those triangles (tLo = the loop's largest t + 0.02 at a proximal end, tHi
+ * its smallest t − 0.02 at a distal one), and a band of triangles zips the tube's end ring to that loop: every
  * edge of the ring and of the loop is used once, so a closed input gives a closed output (no gap,
  * no overlap, the loop's vertices shared by both sides). An end with nothing beyond it (an open
  * input) stays open, the tube spanning the part's own vertices (up to half a bone past the joint).

@@ -67,6 +67,11 @@ const int32_t* gcs_classic_parts(const GcsDeformer* deformer) {
   return m && !m->report.empty() ? m->report.data() : nullptr;
 }
 
+const int32_t* gcs_classic_contour_of_vertex(const GcsDeformer* deformer) {
+  const gcs::ClassicModel* m = asClassic(deformer);
+  return m && !m->contourOfVertex.empty() ? m->contourOfVertex.data() : nullptr;
+}
+
 float gcs_classic_detail_loss(const GcsDeformer* deformer, uint32_t which) {
   const gcs::ClassicModel* m = asClassic(deformer);
   return m ? m->detailLoss(which) : std::nanf("");

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <new>
 #include "error.h"
 #include "transform.h"
@@ -15,6 +16,12 @@ constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carri
 constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
 constexpr float kMaxExtension = 0.5f;      // a tube end passes a rigid neighbour's joint by ≤ ½ bone
 constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°
+constexpr float kBranchBehind = 0.25f;     // a root trunk part's branches start before ¼ of its bone
+constexpr float kCutMargin = 0.05f;        // a trunk tube ends ¹⁄₂₀ bone short of its branches
+constexpr float kMinTrunkSpan = 0.25f;     // … and keeps at least ¼ of its bone
+constexpr float kMinTubeSpan = 0.1f;       // a tube between its end loops spans ≥ ⅒ of its bone
+constexpr float kBandWidth = 0.02f;        // a tube ends ¹⁄₅₀ bone inside its loop
+constexpr uint32_t kProbeContours = 9;     // contours cast to decide whether a part resamples
 
 glm::vec3 anyPerpendicular(const glm::vec3& a) {
   glm::vec3 g = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
@@ -54,11 +61,10 @@ glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
 
 // Casts the `k` star rays of one contour plane (origin O, normal n, frame u, w) against a triangle
 // list: each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle
-// lies in the segment's angular span are tested. radius[r] = outermost hit distance, or −1.
-void castContour(const Rig& rig, const uint32_t* tris, uint32_t triCount, const glm::vec3& O,
-                 const glm::vec3& n, const glm::vec3& u, const glm::vec3& w, uint32_t k,
-                 const float* cosT, const float* sinT, float* radius) {
-  for (uint32_t r = 0; r < k; ++r) radius[r] = -1.0f;
+// lies in the segment's angular span are tested. radius[r] = the outermost hit distance so far
+// (−1 before any hit; the caller resets it, so several triangle lists can be cast in turn).
+void castContour(const Rig& rig, const uint32_t* tris, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
+                 const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius) {
   const float step = 2.0f * kPi / float(k);
   for (uint32_t i = 0; i < triCount; ++i) {
     const uint32_t* t = &rig.indices[size_t(tris[i]) * 3];
@@ -204,6 +210,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // 1. Parts by dominant weight (welded), parent part = nearest ancestor that owns vertices.
     std::vector<uint32_t> representative;
     std::vector<uint32_t> group = weldByPosition(rig, representative);
+    const uint32_t G = uint32_t(representative.size());
     std::vector<uint32_t> partOf(rig.vertexCount);
     m.parts.assign(J, ClassicPart());
     for (uint32_t j = 0; j < J; ++j) m.parts[j].joint = j;
@@ -242,13 +249,12 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // 3. Directions of every part (for bends), candidates (chain parts long enough), their axes.
     std::vector<glm::vec3> centroid(J, glm::vec3(0.0f));
     std::vector<uint32_t> ownCount(J, 0);
-    for (uint32_t g = 0; g < representative.size(); ++g) {
+    for (uint32_t g = 0; g < G; ++g) {
       uint32_t v = representative[g];
       centroid[partOf[v]] += rig.positions[v];
       ++ownCount[partOf[v]];
     }
     const float minBone = kMinBoneFraction * m.height;
-    float longest = 0.0f;
     for (uint32_t j = 0; j < J; ++j) {
       ClassicPart& P = m.parts[j];
       if (!P.isPart) continue;
@@ -274,10 +280,61 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         } else {
           P.candidate = P.resampled = true;
           P.axis = bone / P.length;
-          longest = std::max(longest, P.length);
         }
       }
     }
+    // Trunk parts that branch (pelvis, chest): resampled along the child that continues the trunk,
+    // on the side away from the other children (the branches), whose region stays carried.
+    // The continuing child: after a resampled-candidate parent, the one child whose own direction
+    // turns by at most 45° from the parent's bone (a chest's neck, not its shoulders); with no such
+    // parent, the one child whose siblings' joints lie behind a quarter of the bone to it and whose
+    // siblings' own directions all point away from its own (a pelvis's spine, the thighs below).
+    // branchOf[j][x]: for a split part j, the child of j whose subtree holds part x (−1: none or
+    // the continuing child's).
+    std::vector<std::vector<int32_t>> branchOf(J);
+    for (uint32_t j = 0; j < J; ++j) {
+      ClassicPart& P = m.parts[j];
+      if (!P.isPart || childParts[j].size() < 2) continue;
+      const glm::vec3 cj = rig.jointCentres[j];
+      const bool afterTube = P.parent >= 0 && m.parts[P.parent].candidate && !m.parts[P.parent].split;
+      int32_t chosen = -1, matches = 0;
+      for (uint32_t c : childParts[j]) {
+        glm::vec3 bone = rig.jointCentres[c] - cj;
+        float len = glm::length(bone);
+        if (!(len >= minBone)) continue;
+        // The child's own direction (its bone onward): a shoulder's points along the arm.
+        const glm::vec3 a = bone / len, own = m.parts[c].direction;
+        bool ok;
+        if (afterTube) {
+          ok = glm::dot(own, m.parts[P.parent].axis) >= kMaxBendCos;
+        } else {
+          ok = true;
+          for (uint32_t o : childParts[j])
+            if (o != c && (glm::dot(rig.jointCentres[o] - cj, a) > kBranchBehind * len ||
+                           glm::dot(m.parts[o].direction, own) >= 0.0f))
+              ok = false;
+        }
+        if (ok) chosen = int32_t(c), ++matches;
+      }
+      if (matches != 1) continue;
+      branchOf[j].assign(J, -1);
+      for (uint32_t x = 0; x < J; ++x) {
+        if (!m.parts[x].isPart) continue;
+        int32_t y = int32_t(x);
+        while (y >= 0 && m.parts[y].parent != int32_t(j)) y = m.parts[y].parent;
+        if (y >= 0 && y != chosen) branchOf[j][x] = y;
+      }
+      glm::vec3 bone = rig.jointCentres[chosen] - cj;
+      P.split = afterTube ? 2 : 1;
+      P.child = chosen;
+      P.length = glm::length(bone);
+      P.axis = bone / P.length;
+      P.candidate = P.resampled = true;
+      P.reason = CLASSIC_TRUNK;
+    }
+    float longest = 0.0f;
+    for (uint32_t j = 0; j < J; ++j)
+      if (m.parts[j].candidate) longest = std::max(longest, m.parts[j].length);
     // Reference directions: parallel-transported down each chain of candidates, so that the
     // contour frames agree at shared contours; a chain starts from +Z (or +Y) projected.
     {
@@ -315,22 +372,110 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       P.contourCount = std::min(P.contourCount, contourSetting);
     }
 
-    // Extent of each candidate's own vertices along its bone (for tube ends at rigid neighbours).
-    for (uint32_t j = 0; j < J; ++j) m.parts[j].ownTMin = 0.0f, m.parts[j].ownTMax = 1.0f;
-    for (uint32_t g = 0; g < representative.size(); ++g) {
-      uint32_t v = representative[g];
-      ClassicPart& P = m.parts[partOf[v]];
-      if (!P.candidate) continue;
-      float t = glm::dot(rig.positions[v] - rig.jointCentres[P.joint], P.axis) / P.length;
-      P.ownTMin = std::max(-kMaxExtension, std::min(P.ownTMin, t));
-      P.ownTMax = std::min(1.0f + kMaxExtension, std::max(P.ownTMax, t));
+    // Which welded vertices the tubes replace. A split trunk part's tube side: its vertices short
+    // of its cut, and those of its carried direct branch children (a shoulder's skin down the
+    // flank) short of it too; the rest of it is carried. Its cut: 1/20 bone short of the nearest of
+    // its (and those children's) vertices that share a triangle with the rest of its branches.
+    std::vector<uint32_t> gPart(G);
+    for (uint32_t g = 0; g < G; ++g) gPart[g] = partOf[representative[g]];
+    auto tOn = [&](const ClassicPart& P, uint32_t v) {
+      return glm::dot(rig.positions[v] - rig.jointCentres[P.joint], P.axis) / P.length;
+    };
+    auto member = [&](uint32_t j, uint32_t x) {  // x is j, or a carried direct branch child of j
+      return x == j || (branchOf[j][x] == int32_t(x) && !m.parts[x].resampled);
+    };
+    auto beforeCut = [&](const ClassicPart& P, uint32_t v) {
+      float t = tOn(P, v);
+      return P.split == 1 ? t > P.cut : t < P.cut;
+    };
+    // The part whose tube replaces welded vertex g, or −1 if it is carried (before islands).
+    auto baseOwner = [&](uint32_t g) -> int32_t {
+      const uint32_t x = gPart[g], v = representative[g];
+      const ClassicPart& X = m.parts[x];
+      if (X.resampled) return !X.split || beforeCut(X, v) ? int32_t(x) : -1;
+      const int32_t p = X.parent;
+      if (p >= 0 && m.parts[p].split && m.parts[p].resampled && member(uint32_t(p), x) && beforeCut(m.parts[p], v)) return p;
+      return -1;
+    };
+    auto updateCut = [&](uint32_t j) {  // false: less than kMinTrunkSpan of the bone is left
+      ClassicPart& P = m.parts[j];
+      float lo = INFINITY, hi = -INFINITY;
+      for (uint32_t x = 0; x < J; ++x) {
+        if (!m.parts[x].isPart || !member(j, x)) continue;
+        for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i) {
+          const uint32_t* t = &rig.indices[size_t(triList[i]) * 3];
+          bool touches = false;
+          for (int e = 0; e < 3; ++e) touches = touches || (branchOf[j][partOf[t[e]]] >= 0 && !member(j, partOf[t[e]]));
+          if (!touches) continue;
+          for (int e = 0; e < 3; ++e)
+            if (member(j, partOf[t[e]])) {
+              float tv = tOn(P, t[e]);
+              lo = std::min(lo, tv), hi = std::max(hi, tv);
+            }
+        }
+      }
+      // (a chest's tube ends by its continuing child's joint; a pelvis's starts at most half a
+      // bone before its joint: beyond, its branches are not around it but along it)
+      if (P.split == 2) P.cut = std::isfinite(lo) ? std::min(1.0f, lo - kCutMargin) : 1.0f;
+      else P.cut = std::isfinite(hi) ? hi + kCutMargin : 0.0f;
+      return P.split == 2 ? P.cut >= kMinTrunkSpan : P.cut <= 1.0f - kMinTrunkSpan && P.cut >= -kMaxExtension;
+    };
+    // Extent of each candidate's tube-side vertices along its bone (for open tube ends).
+    auto updateExtents = [&]() {
+      for (uint32_t j = 0; j < J; ++j) m.parts[j].ownTMin = 0.0f, m.parts[j].ownTMax = 1.0f;
+      for (uint32_t g = 0; g < G; ++g) {
+        int32_t o = baseOwner(g);
+        if (o < 0) continue;
+        ClassicPart& P = m.parts[o];
+        float t = tOn(P, representative[g]);
+        P.ownTMin = std::max(-kMaxExtension, std::min(P.ownTMin, t));
+        P.ownTMax = std::min(1.0f + kMaxExtension, std::max(P.ownTMax, t));
+      }
+      for (uint32_t j = 0; j < J; ++j) {
+        ClassicPart& P = m.parts[j];
+        if (P.split == 1) P.ownTMin = P.cut;
+        if (P.split == 2) P.ownTMax = P.cut;
+      }
+    };
+
+    // Triangles over welded vertices, and their edges sorted by (smaller, larger) welded vertex:
+    // what the boundary loops between tubes and the carried mesh are traced on.
+    struct WeldedEdge {
+      uint32_t lo, hi, from, tri;
+    };
+    // Edges grouped by their smaller welded vertex (a counting sort: linear), each group by the larger.
+    std::vector<WeldedEdge> edges;
+    {
+      std::vector<uint32_t> first(G + 1, 0);
+      auto forEdges = [&](auto&& fn) {
+        for (uint32_t t = 0; t < T; ++t) {
+          uint32_t g[3] = {group[rig.indices[3 * t]], group[rig.indices[3 * t + 1]], group[rig.indices[3 * t + 2]]};
+          if (g[0] == g[1] || g[1] == g[2] || g[0] == g[2]) continue;
+          for (int e = 0; e < 3; ++e) {
+            uint32_t a = g[e], b = g[(e + 1) % 3];
+            fn(WeldedEdge{std::min(a, b), std::max(a, b), a, t});
+          }
+        }
+      };
+      forEdges([&](const WeldedEdge& e) { ++first[e.lo + 1]; });
+      for (uint32_t g = 0; g < G; ++g) first[g + 1] += first[g];
+      edges.resize(first[G]);
+      forEdges([&](const WeldedEdge& e) { edges[first[e.lo]++] = e; });
+      for (uint32_t g = G; g > 0; --g) first[g] = first[g - 1];
+      first[0] = 0;
+      for (uint32_t g = 0; g < G; ++g)  // a vertex has a handful of edges: insertion sort
+        for (uint32_t i = first[g] + 1; i < first[g + 1]; ++i)
+          for (uint32_t j = i; j > first[g] && edges[j - 1].hi > edges[j].hi; --j) std::swap(edges[j - 1], edges[j]);
     }
 
-    // 4. Cast rays per candidate part; parts with too many misses fall back to rigid, which changes
-    // their neighbours' end normals, so those are recast (only parts are ever removed: it ends).
+    // 4. Which parts are resampled, and where their tubes end. Rays decide (too many misses:
+    // carried); then the boundary between the tubes and the carried triangles (those with a
+    // carried vertex) is traced: each loop must be one ring around one tube's unshared end, or the
+    // part is carried (CLASSIC_SEAM); that end's contours start at the loop's innermost point.
+    // Parts are only ever removed, so this ends.
     std::vector<std::vector<float>> hits(J);
     std::vector<uint8_t> dirty(J, 0);
-    for (uint32_t j = 0; j < J; ++j) dirty[j] = m.parts[j].candidate;
+    for (uint32_t j = 0; j < J; ++j) dirty[j] = m.parts[j].candidate && !m.parts[j].split;  // trunk parts: once cut
     std::vector<float> scratch;
     scratch.reserve(k);
     auto endNormals = [&](const ClassicPart& P, glm::vec3& nProx, glm::vec3& nDist) {
@@ -344,58 +489,323 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       n = glm::normalize((1.0f - tc) * nProx + tc * nDist);
       u = orthonormal(minRotate(P.axis, n, P.u), n);
     };
-    for (int pass = 0; pass < 64; ++pass) {
-      bool any = false;
+    // Casts `count` contours of part j evenly over [tLo, tHi] into out (count × k radii): its own
+    // triangles; a trunk part's also its continuing child's and its carried branch children's (its
+    // tube runs through their skin). Counts the hits left after outliers, and those between joints.
+    std::vector<float> probe;
+    auto castPart = [&](uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist,
+                        std::vector<float>& out, uint32_t& hitCount, uint32_t& inRangeHits, uint32_t& inRangeRays) {
+      const ClassicPart& P = m.parts[j];
+      out.assign(size_t(count) * k, -1.0f);  // no hit yet
+      for (uint32_t i = 0; i < count; ++i) {
+        float t = P.tLo + (P.tHi - P.tLo) * float(i) / float(count - 1);
+        glm::vec3 O, n, u;
+        contourFrame(P, t, nProx, nDist, O, n, u);
+        float* rad = &out[size_t(i) * k];
+        for (uint32_t x = 0; x < J; ++x) {
+          if (x != j && !(P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) continue;
+          castContour(rig, &triList[triFirst[x]], triFirst[x + 1] - triFirst[x], O, n, u, glm::cross(n, u), k,
+                      m.cosTable.data(), m.sinTable.data(), rad);
+        }
+        uint32_t h = rejectOutliers(rad, k, scratch);
+        hitCount += h;
+        if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
+      }
+    };
+    auto shares = [&](const ClassicPart& P) {  // P's distal joint contour is shared with its child
+      if (!P.resampled || P.child < 0 || P.split == 2) return false;
+      const ClassicPart& C = m.parts[P.child];
+      return C.resampled && C.split != 1;
+    };
+    auto carry = [&](uint32_t j, uint8_t reason) {
+      ClassicPart& P = m.parts[j];
+      P.resampled = false;
+      P.reason = reason;
+      if (P.parent >= 0 && m.parts[P.parent].resampled) dirty[P.parent] = 1;
+      if (P.child >= 0 && m.parts[P.child].resampled) dirty[P.child] = 1;
+    };
+    // Boundary loops: welded vertices in order, the part whose end they close, which end.
+    struct Loop {
+      std::vector<uint32_t> groups;
+      uint32_t part = 0;
+      bool distal = false;
+    };
+    std::vector<Loop> loops;
+    std::vector<uint8_t> gCarried(G, 0), triCarried(T, 0);
+    // Islands (real meshes: a strap or a pouch weighted to another bone, a few vertices of a part
+    // inside its neighbour's skin): a tube region cut off from the main region of its part is
+    // carried; a carried patch that touches one tube only, lies along its bone and is no bigger
+    // than its tube-side skin is replaced by that tube. Either would leave a loop that is no ring
+    // around a tube end (a side loop): a gap or an overlap.
+    std::vector<int32_t> gOwner(G, -1);
+    std::vector<uint32_t> root(G);
+    auto find = [&](uint32_t x) {
+      while (root[x] != x) x = root[x] = root[root[x]];
+      return x;
+    };
+    auto unite = [&](uint32_t a, uint32_t b) {
+      a = find(a), b = find(b);
+      if (a != b) root[std::max(a, b)] = std::min(a, b);
+    };
+    auto owner = [&](uint32_t g) { return gOwner[g]; };
+    auto computeOwners = [&]() {
+      for (uint32_t g = 0; g < G; ++g) gOwner[g] = baseOwner(g);
+      // Skin where two tubes that share no ring touch (a crotch between the thighs) is carried:
+      // no tube surface would cover it.
+      auto joined = [&](int32_t a, int32_t b) {
+        return a == b || (m.parts[a].child == b && m.parts[a].distShared) || (m.parts[b].child == a && m.parts[b].distShared);
+      };
+      std::vector<uint8_t> apart(G, 0);
+      for (uint32_t t = 0; t < T; ++t) {
+        uint32_t v[3] = {group[rig.indices[3 * t]], group[rig.indices[3 * t + 1]], group[rig.indices[3 * t + 2]]};
+        for (int e = 0; e < 3; ++e) {
+          int32_t a = gOwner[v[e]], b = gOwner[v[(e + 1) % 3]];
+          if (a >= 0 && b >= 0 && !joined(a, b)) apart[v[e]] = apart[v[(e + 1) % 3]] = 1;
+        }
+      }
+      for (uint32_t g = 0; g < G; ++g)
+        if (apart[g]) gOwner[g] = -1;
+      // Tube regions: welded vertices joined by triangles of three tube-side vertices.
+      for (uint32_t g = 0; g < G; ++g) root[g] = g;
+      for (uint32_t t = 0; t < T; ++t) {
+        uint32_t a = group[rig.indices[3 * t]], b = group[rig.indices[3 * t + 1]], c = group[rig.indices[3 * t + 2]];
+        if (gOwner[a] >= 0 && gOwner[b] >= 0 && gOwner[c] >= 0) unite(a, b), unite(b, c);
+      }
+      std::vector<std::pair<uint32_t, uint32_t>> partRoot;  // (owner, region) per tube vertex
+      for (uint32_t g = 0; g < G; ++g)
+        if (gOwner[g] >= 0) partRoot.push_back({uint32_t(gOwner[g]), find(g)});
+      std::sort(partRoot.begin(), partRoot.end());
+      std::vector<uint32_t> mainRegion(J, UINT32_MAX), mainSize(J, 0), tubeSize(J, 0);
+      for (size_t i = 0; i < partRoot.size();) {
+        size_t e = i;
+        while (e < partRoot.size() && partRoot[e] == partRoot[i]) ++e;
+        uint32_t part = partRoot[i].first;
+        tubeSize[part] += uint32_t(e - i);
+        if (e - i > mainSize[part]) mainSize[part] = uint32_t(e - i), mainRegion[part] = partRoot[i].second;
+        i = e;
+      }
+      for (uint32_t g = 0; g < G; ++g)
+        if (gOwner[g] >= 0 && find(g) != mainRegion[gOwner[g]]) gOwner[g] = -1;
+      // Carried patches: carried welded vertices joined by triangles; the tubes each one touches.
+      for (uint32_t g = 0; g < G; ++g) root[g] = g;
+      for (uint32_t t = 0; t < T; ++t) {
+        uint32_t v[3] = {group[rig.indices[3 * t]], group[rig.indices[3 * t + 1]], group[rig.indices[3 * t + 2]]};
+        for (int e = 0; e < 3; ++e)
+          if (gOwner[v[e]] < 0 && gOwner[v[(e + 1) % 3]] < 0) unite(v[e], v[(e + 1) % 3]);
+      }
+      std::vector<int32_t> touches(G, -2);  // per patch: −2 none yet, a part, or −1 several
+      for (uint32_t t = 0; t < T; ++t) {
+        uint32_t v[3] = {group[rig.indices[3 * t]], group[rig.indices[3 * t + 1]], group[rig.indices[3 * t + 2]]};
+        for (int e = 0; e < 3; ++e) {
+          if (gOwner[v[e]] >= 0) continue;
+          for (int f = 0; f < 3; ++f) {
+            if (gOwner[v[f]] < 0) continue;
+            int32_t& tt = touches[find(v[e])];
+            tt = tt == -2 || tt == gOwner[v[f]] ? gOwner[v[f]] : -1;
+          }
+        }
+      }
+      std::vector<uint32_t> patchSize(G, 0);
+      std::vector<float> patchT(G, 0.0f);
+      for (uint32_t g = 0; g < G; ++g) {
+        if (gOwner[g] >= 0) continue;
+        uint32_t r = find(g);
+        if (touches[r] < 0) continue;
+        ++patchSize[r];
+        patchT[r] += tOn(m.parts[touches[r]], representative[g]);
+      }
+      for (uint32_t g = 0; g < G; ++g) {
+        if (gOwner[g] >= 0) continue;
+        uint32_t r = find(g);
+        if (touches[r] < 0) continue;
+        float t = patchT[r] / float(patchSize[r]);
+        if (patchSize[r] <= tubeSize[touches[r]] && t > 0.0f && t < 1.0f) gOwner[g] = touches[r];
+      }
+    };
+    for (int round = 0; round < 64; ++round) {
+      updateExtents();
+      for (int pass = 0; pass < 64; ++pass) {
+        bool any = false;
+        for (uint32_t j = 0; j < J; ++j) {
+          ClassicPart& P = m.parts[j];
+          if (!P.resampled || !dirty[j]) continue;
+          dirty[j] = 0;
+          P.proxShared = P.parent >= 0 && m.parts[P.parent].child == int32_t(j) && shares(m.parts[P.parent]);
+          P.distShared = shares(P);
+          P.tLo = P.proxShared ? 0.0f : P.proxLoop >= 0 ? P.loopTLo : P.ownTMin;
+          P.tHi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
+          glm::vec3 nProx, nDist;
+          endNormals(P, nProx, nDist);
+          // The decision looks at up to kProbeContours contours (the full set is cast once, at the end).
+          const uint32_t mm = std::min(P.contourCount, kProbeContours);
+          uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
+          castPart(j, mm, nProx, nDist, probe, hitCount, inRangeHits, inRangeRays);
+          // The miss rule looks at the contours between the joints (past a joint, skin of the
+          // carried neighbour is expected to be missing); all contours if none lies between them.
+          float miss = inRangeRays ? 1.0f - float(inRangeHits) / float(inRangeRays)
+                                   : 1.0f - float(hitCount) / float(mm * k);
+          if (hitCount == 0 || miss > kMaxMissShare) carry(j, CLASSIC_RAYS_MISS), any = true;
+        }
+        if (any) continue;
+        // Once the ray tests have settled: a part whose bone turns by more than 45° from its
+        // resampled parent's bone is not a continuation of that limb (a foot on a shank): carried.
+        for (uint32_t j = 0; j < J; ++j) {
+          ClassicPart& P = m.parts[j];
+          // (only where it continues its parent's tube: a pelvis's thighs are branches)
+          if (!P.resampled || P.parent < 0 || !m.parts[P.parent].resampled || P.split ||
+              m.parts[P.parent].child != int32_t(j))
+            continue;
+          if (glm::dot(P.axis, m.parts[P.parent].axis) >= kMaxBendCos) continue;
+          carry(j, CLASSIC_BENT);
+          any = true;
+        }
+        if (!any) break;
+      }
+
+      // Trunk cuts, once the parts around them have settled (a shoulder found carried lets the
+      // chest's tube run down its flank); a part whose cut moved is cast again.
+      bool recast = false;
       for (uint32_t j = 0; j < J; ++j) {
         ClassicPart& P = m.parts[j];
-        if (!P.resampled || !dirty[j]) continue;
-        dirty[j] = 0;
-        P.proxShared = P.parent >= 0 && m.parts[P.parent].resampled;
-        P.distShared = m.parts[P.child].resampled;
-        P.tLo = P.proxShared ? 0.0f : P.ownTMin;
-        P.tHi = P.distShared ? 1.0f : P.ownTMax;
-        glm::vec3 nProx, nDist;
-        endNormals(P, nProx, nDist);
-        const uint32_t mm = P.contourCount;
-        hits[j].assign(size_t(mm) * k, -1.0f);
-        uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
-        for (uint32_t i = 0; i < mm; ++i) {
-          float t = P.tLo + (P.tHi - P.tLo) * float(i) / float(mm - 1);
-          glm::vec3 O, n, u;
-          contourFrame(P, t, nProx, nDist, O, n, u);
-          float* rad = &hits[j][size_t(i) * k];
-          castContour(rig, &triList[triFirst[j]], triFirst[j + 1] - triFirst[j], O, n, u, glm::cross(n, u), k,
-                      m.cosTable.data(), m.sinTable.data(), rad);
-          uint32_t h = rejectOutliers(rad, k, scratch);
-          hitCount += h;
-          if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
+        if (!P.resampled || !P.split) continue;
+        float before = P.cut;
+        if (!updateCut(j)) carry(j, CLASSIC_BRANCHING), recast = true;
+        else if (P.cut != before || round == 0) dirty[j] = 1, recast = true;
+      }
+      if (recast) continue;
+
+      // The carried mesh and its boundary loops with the tubes.
+      computeOwners();
+      for (uint32_t g = 0; g < G; ++g) gCarried[g] = owner(g) < 0;
+      for (uint32_t t = 0; t < T; ++t)
+        triCarried[t] = gCarried[group[rig.indices[3 * t]]] || gCarried[group[rig.indices[3 * t + 1]]] ||
+                        gCarried[group[rig.indices[3 * t + 2]]];
+      // Loop edges: an edge of a carried triangle shared with a tube triangle, directed as in the
+      // carried triangle (an edge of the input's own border stays open).
+      std::vector<std::pair<uint32_t, uint32_t>> loopEdges;
+      for (size_t e0 = 0; e0 < edges.size();) {
+        size_t e1 = e0;
+        int carriedAt = -1;
+        bool tube = false;
+        while (e1 < edges.size() && edges[e1].lo == edges[e0].lo && edges[e1].hi == edges[e0].hi) {
+          if (triCarried[edges[e1].tri]) { if (carriedAt < 0) carriedAt = int(e1); }
+          else tube = true;
+          ++e1;
         }
-        // The miss rule looks at the contours between the joints (past a joint, skin of the
-        // rigid neighbour is expected to be missing); all contours if none lies between them.
-        float miss = inRangeRays ? 1.0f - float(inRangeHits) / float(inRangeRays)
-                                 : 1.0f - float(hitCount) / float(mm * k);
-        if (hitCount == 0 || miss > kMaxMissShare) {
-          P.resampled = false;
-          P.reason = CLASSIC_RAYS_MISS;
-          any = true;
-          if (P.parent >= 0 && m.parts[P.parent].resampled) dirty[P.parent] = 1;
-          if (m.parts[P.child].resampled) dirty[P.child] = 1;
+        if (carriedAt >= 0 && tube) {
+          const WeldedEdge& e = edges[size_t(carriedAt)];
+          loopEdges.push_back({e.from, e.from == e.lo ? e.hi : e.lo});
         }
+        e0 = e1;
+      }
+      std::sort(loopEdges.begin(), loopEdges.end());
+      std::vector<uint8_t> used(loopEdges.size(), 0);
+      loops.clear();
+      std::vector<uint8_t> failed(J, 0);
+      for (size_t s = 0; s < loopEdges.size(); ++s) {
+        if (used[s]) continue;
+        Loop L;
+        size_t e = s;
+        bool closed = false;
+        while (true) {
+          used[e] = 1;
+          L.groups.push_back(loopEdges[e].first);
+          uint32_t next = loopEdges[e].second;
+          if (next == loopEdges[s].first) { closed = true; break; }
+          auto it = std::lower_bound(loopEdges.begin(), loopEdges.end(), std::make_pair(next, 0u));
+          size_t f = size_t(it - loopEdges.begin());
+          while (f < loopEdges.size() && loopEdges[f].first == next && used[f]) ++f;
+          if (f >= loopEdges.size() || loopEdges[f].first != next) break;
+          e = f;
+        }
+        // The part it closes: most of its vertices'.
+        uint32_t best = uint32_t(owner(L.groups[0])), bestCount = 0;
+        for (uint32_t g : L.groups) {
+          uint32_t c = 0;
+          for (uint32_t h : L.groups) c += owner(h) == owner(g);
+          if (c > bestCount) best = uint32_t(owner(g)), bestCount = c;
+          if (bestCount * 2 > L.groups.size()) break;
+        }
+        L.part = best;
+        ClassicPart& P = m.parts[best];
+        if (!closed || !P.resampled) {  // an open chain (it runs into the input's own border)
+          if (P.resampled) failed[best] = 1;
+          continue;
+        }
+        const glm::vec3 cj = rig.jointCentres[P.joint];
+        float mean = 0.0f;
+        for (uint32_t g : L.groups) mean += glm::dot(rig.positions[representative[g]] - cj, P.axis) / P.length;
+        mean /= float(L.groups.size());
+        L.distal = mean > 0.5f * (P.ownTMin + P.ownTMax);
+        // One turn around the bone, seen along it.
+        const glm::vec3 w = glm::cross(P.axis, P.u);
+        double turn = 0.0;
+        float prev = 0.0f;
+        for (size_t i = 0; i <= L.groups.size(); ++i) {
+          glm::vec3 d = rig.positions[representative[L.groups[i % L.groups.size()]]] - cj;
+          float a = std::atan2(glm::dot(d, w), glm::dot(d, P.u));
+          if (i) {
+            float da = a - prev;
+            if (da > kPi) da -= 2.0f * kPi;
+            if (da < -kPi) da += 2.0f * kPi;
+            turn += da;
+          }
+          prev = a;
+        }
+        bool ring = std::fabs(std::fabs(turn) - 2.0 * 3.14159265358979) < 3.14159265358979;
+        bool shared = L.distal ? shares(P) : P.proxShared;
+        bool taken = false;
+        for (const Loop& other : loops)
+          if (other.part == best && other.distal == L.distal) taken = true;
+        if (!ring || shared || taken) { failed[best] = 1; continue; }
+        loops.push_back(std::move(L));
+      }
+      // A tube that replaces no triangle (every one of its part's triangles has a carried vertex:
+      // a coarse part one triangle long) would only be laid over the kept skin: carried.
+      std::vector<uint32_t> replaced(J, 0);
+      for (uint32_t t = 0; t < T; ++t)
+        if (!triCarried[t]) ++replaced[uint32_t(owner(group[rig.indices[3 * t]]))];
+      bool any = false;
+      for (uint32_t j = 0; j < J; ++j)
+        if (failed[j] || (m.parts[j].resampled && replaced[j] == 0)) carry(j, CLASSIC_SEAM), any = true;
+      if (any) continue;
+      // Tube ends from the loops: just inside the innermost point of each loop (a flat loop
+      // would otherwise leave a band of zero width).
+      for (uint32_t j = 0; j < J; ++j) m.parts[j].proxLoop = m.parts[j].distLoop = -1;
+      for (size_t l = 0; l < loops.size(); ++l) {
+        ClassicPart& P = m.parts[loops[l].part];
+        float lo = INFINITY, hi = -INFINITY;
+        for (uint32_t g : loops[l].groups) {
+          float t = glm::dot(rig.positions[representative[g]] - rig.jointCentres[P.joint], P.axis) / P.length;
+          lo = std::min(lo, t), hi = std::max(hi, t);
+        }
+        if (loops[l].distal) P.distLoop = int32_t(l), P.loopTHi = lo - kBandWidth;
+        else P.proxLoop = int32_t(l), P.loopTLo = hi + kBandWidth;
+      }
+      for (uint32_t j = 0; j < J; ++j) {
+        ClassicPart& P = m.parts[j];
+        if (!P.resampled) continue;
+        float lo = P.proxShared ? 0.0f : P.proxLoop >= 0 ? P.loopTLo : P.ownTMin;
+        float hi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
+        // (the ray test is not run again on the final span: the loops only trim the ends of a
+        // tube whose rays already hit, and the contours are cast below)
+        if (!(hi - lo >= kMinTubeSpan)) carry(j, CLASSIC_SEAM), any = true;
+        else P.tLo = lo, P.tHi = hi;
       }
       if (any) continue;
-      // Once the ray tests have settled: a part whose bone turns by more than 45° from its
-      // resampled parent's bone is not a continuation of that limb (a foot on a shank): rigid.
-      for (uint32_t j = 0; j < J; ++j) {
-        ClassicPart& P = m.parts[j];
-        if (!P.resampled || P.parent < 0 || !m.parts[P.parent].resampled) continue;
-        if (glm::dot(P.axis, m.parts[P.parent].axis) >= kMaxBendCos) continue;
-        P.resampled = false;
-        P.reason = CLASSIC_BENT;
-        any = true;
-        dirty[P.parent] = 1;
-        if (m.parts[P.child].resampled) dirty[P.child] = 1;
-      }
-      if (!any) break;
+      bool pending = false;
+      for (uint32_t j = 0; j < J; ++j) pending = pending || (m.parts[j].resampled && dirty[j]);
+      if (!pending) break;
+    }
+
+    // The contours of the parts that stay resampled, cast once at their final span.
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.resampled) continue;
+      glm::vec3 nProx, nDist;
+      endNormals(P, nProx, nDist);
+      uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
+      castPart(j, P.contourCount, nProx, nDist, hits[j], hitCount, inRangeHits, inRangeRays);
     }
 
     // 5. Contours. Chains of resampled parts are laid out root → leaf, so that a part's rings are
@@ -403,9 +813,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     uint32_t vertex = 0;
     for (uint32_t j0 = 0; j0 < J; ++j0) {
       ClassicPart& head = m.parts[j0];
-      if (!head.resampled || (head.parent >= 0 && m.parts[head.parent].resampled)) continue;
-      for (int32_t j = int32_t(j0); j >= 0 && m.parts[j].resampled;
-           j = m.parts[j].distShared ? m.parts[j].child : -1) {
+      if (!head.resampled || head.proxShared) continue;
+      for (int32_t j = int32_t(j0); j >= 0 && m.parts[j].resampled; j = m.parts[j].distShared ? m.parts[j].child : -1) {
         ClassicPart& P = m.parts[j];
         glm::vec3 nProx, nDist;
         endNormals(P, nProx, nDist);
@@ -467,30 +876,37 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     for (size_t c = 0; c < m.contours.size(); ++c)
       if (empty[c]) std::fill(m.radii.begin() + m.contours[c].radii, m.radii.begin() + m.contours[c].radii + k, 0.0f);
 
-    // 6. Caps where a tube meets a rigid part (or nothing).
+    // Caps: a tube end that meets neither a resampled neighbour nor the carried mesh is closed by a
+    // flat fan when the part's input skin has no border (a robot's finger plate); an open input
+    // (a sleeve) stays open.
+    std::vector<uint8_t> bordered(J, 0);
+    for (size_t e0 = 0; e0 < edges.size();) {
+      size_t e1 = e0;
+      while (e1 < edges.size() && edges[e1].lo == edges[e0].lo && edges[e1].hi == edges[e0].hi) ++e1;
+      if (e1 - e0 == 1)
+        for (uint32_t g : {edges[e0].lo, edges[e0].hi})
+          if (owner(g) >= 0) bordered[owner(g)] = 1;
+      e0 = e1;
+    }
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
-      if (!P.resampled) continue;
-      if (!P.proxShared) {
+      if (!P.resampled || bordered[j]) continue;
+      if (!P.proxShared && P.proxLoop < 0) {
         m.caps.push_back({P.contours.front(), vertex, -1.0f});
         vertex += k + 1;
       }
-      if (!P.distShared) {
+      if (!P.distShared && P.distLoop < 0) {
         m.caps.push_back({P.contours.back(), vertex, 1.0f});
         vertex += k + 1;
       }
     }
 
-    // 7. Carried triangles: those with a vertex in a rigid part. Their vertices are copied and move
+    // 6. Carried triangles (those with a carried vertex): their vertices are copied and move
     // rigidly with their own part's S_j; the copies are grouped by part (one transform run each).
-    std::vector<uint8_t> carriedTri(T, 0);
     std::vector<int64_t> outputOf(rig.vertexCount, -1);
-    for (uint32_t t = 0; t < T; ++t) {
-      for (int e = 0; e < 3; ++e)
-        if (!m.parts[partOf[rig.indices[3 * t + e]]].resampled) carriedTri[t] = 1;
-      if (carriedTri[t])
+    for (uint32_t t = 0; t < T; ++t)
+      if (triCarried[t])
         for (int e = 0; e < 3; ++e) outputOf[rig.indices[3 * t + e]] = 0;
-    }
     std::vector<uint32_t> runCount(J, 0);
     for (uint32_t v = 0; v < rig.vertexCount; ++v)
       if (outputOf[v] == 0) ++runCount[partOf[v]];
@@ -500,11 +916,12 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       m.parts[j].runCount = runCount[j];
       vertex += runCount[j];
     }
+    std::vector<int64_t> groupOutput(G, -1);
     {
       std::vector<uint32_t> cursor(J);
       for (uint32_t j = 0; j < J; ++j) cursor[j] = m.parts[j].runFirst;
       for (uint32_t v = 0; v < rig.vertexCount; ++v)
-        if (outputOf[v] == 0) outputOf[v] = cursor[partOf[v]]++;
+        if (outputOf[v] == 0) groupOutput[group[v]] = outputOf[v] = cursor[partOf[v]]++;
     }
     m.allocateOutput(vertex);
     const uint32_t carried = vertex - m.carriedFirst;
@@ -519,8 +936,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       }
     }
 
-    // 8. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
-    // about the contour normal, which points distally), then caps, then the carried triangles.
+    // 7. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
+    // about the contour normal, which points distally), then the bands, then the carried triangles.
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
       if (!P.resampled) continue;
@@ -533,39 +950,110 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       }
     }
     m.tubeIndexCount = uint32_t(m.indices.size());
+    // A band zips an end ring (traversed against the tube's use of its edges: decreasing angle at
+    // a proximal end, increasing at a distal one) to its loop (traversed as the carried triangles
+    // use its edges, which turns the same way on an outward-wound mesh), always advancing on the
+    // side whose next vertex comes first by angle: ring + loop vertices triangles, every edge of
+    // both used once, so the seam is closed whatever the two sides' vertex counts.
+    std::vector<float> beta;
+    std::vector<uint32_t> loopOut;
+    for (const Loop& L : loops) {
+      const ClassicPart& P = m.parts[L.part];
+      const ClassicContour& c = m.contours[L.distal ? P.contours.back() : P.contours.front()];
+      const float d = L.distal ? 1.0f : -1.0f;
+      const glm::vec3 w = glm::cross(c.normal, c.u);
+      const size_t n = L.groups.size();
+      auto angleOf = [&](uint32_t g) {
+        glm::vec3 x = rig.positions[representative[g]] - c.centre;
+        return d * std::atan2(glm::dot(x, w), glm::dot(x, c.u));
+      };
+      auto wrap = [](float a) {
+        while (a > kPi) a -= 2.0f * kPi;
+        while (a <= -kPi) a += 2.0f * kPi;
+        return a;
+      };
+      float total = 0.0f;
+      for (size_t i = 0; i < n; ++i) total += wrap(angleOf(L.groups[(i + 1) % n]) - angleOf(L.groups[i]));
+      loopOut.resize(n);
+      for (size_t i = 0; i < n; ++i)  // against the ring's turn (an inward-wound input): walk it backwards
+        loopOut[i] = uint32_t(groupOutput[L.groups[total >= 0.0f ? i : n - 1 - i]]);
+      size_t start = 0;
+      float nearest = INFINITY;
+      for (size_t i = 0; i < n; ++i) {
+        float a = std::fabs(wrap(angleOf(L.groups[total >= 0.0f ? i : n - 1 - i])));
+        if (a < nearest) nearest = a, start = i;
+      }
+      std::rotate(loopOut.begin(), loopOut.begin() + ptrdiff_t(start), loopOut.end());
+      beta.resize(n + 1);
+      {
+        auto groupAt = [&](size_t i) { size_t s = (start + i) % n; return L.groups[total >= 0.0f ? s : n - 1 - s]; };
+        beta[0] = wrap(angleOf(groupAt(0)));
+        for (size_t i = 1; i <= n; ++i) beta[i] = beta[i - 1] + wrap(angleOf(groupAt(i % n)) - angleOf(groupAt(i - 1)));
+      }
+      auto ringAt = [&](uint32_t i) { return c.first + (L.distal ? i % k : (k - i % k) % k); };
+      ClassicBand band;
+      band.part = L.part;
+      band.firstIndex = uint32_t(m.indices.size());
+      uint32_t i = 0;
+      size_t jj = 0;
+      const float step = 2.0f * kPi / float(k);
+      while (i < k || jj < n) {
+        bool ringStep = jj == n || (i < k && float(i + 1) * step <= beta[jj + 1]);
+        if (ringStep) {
+          m.indices.insert(m.indices.end(), {ringAt(i), ringAt(i + 1), loopOut[jj % n]});
+          ++i;
+        } else {
+          m.indices.insert(m.indices.end(), {ringAt(i), loopOut[(jj + 1) % n], loopOut[jj % n]});
+          ++jj;
+        }
+      }
+      band.indexCount = uint32_t(m.indices.size()) - band.firstIndex;
+      m.bands.push_back(band);
+    }
     for (const ClassicCap& cap : m.caps) {
+      ClassicBand fan;
+      fan.part = uint32_t(m.contours[cap.contour].part);
+      fan.firstIndex = uint32_t(m.indices.size());
       uint32_t centre = cap.first + k;
       for (uint32_t r = 0; r < k; ++r) {
         uint32_t r1 = (r + 1) % k;
         if (cap.sign > 0.0f) m.indices.insert(m.indices.end(), {centre, cap.first + r, cap.first + r1});
         else m.indices.insert(m.indices.end(), {centre, cap.first + r1, cap.first + r});
       }
+      fan.indexCount = uint32_t(m.indices.size()) - fan.firstIndex;
+      m.bands.push_back(fan);
     }
+    m.bandIndexCount = uint32_t(m.indices.size()) - m.tubeIndexCount;
     for (uint32_t t = 0; t < T; ++t) {
-      if (!carriedTri[t]) continue;
+      if (!triCarried[t]) continue;
       for (int e = 0; e < 3; ++e) m.indices.push_back(uint32_t(outputOf[rig.indices[3 * t + e]]));
     }
 
-    // 9. The report (parts in joint order) and the detail-loss inputs.
+    // 8. The report (parts in joint order), contours per vertex, and the detail-loss inputs: the
+    // input vertices the tubes and bands replace.
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
       if (!P.isPart) continue;
       m.reportJoints.push_back(j);
-      m.report.insert(m.report.end(), {int32_t(j), P.resampled ? 1 : 0,
-                                       int32_t(P.resampled ? P.first : P.runFirst),
-                                       int32_t(P.resampled ? P.count : P.runCount)});
+      m.report.insert(m.report.end(), {int32_t(j), P.resampled ? 1 : 0, int32_t(P.resampled ? P.first : P.runFirst),
+                                       int32_t(P.resampled ? P.count : P.runCount), int32_t(P.reason)});
     }
-    for (uint32_t v = 0; v < rig.vertexCount; ++v)
-      if (m.parts[partOf[v]].resampled) {
-        m.lossPoints.push_back(rig.positions[v]);
-        m.lossParts.push_back(partOf[v]);
+    m.contourOfVertex.assign(m.vertexCount, -1);
+    for (uint32_t c = 0; c < m.contours.size(); ++c)
+      for (uint32_t r = 0; r < k; ++r) m.contourOfVertex[m.contours[c].first + r] = int32_t(c);
+    for (const ClassicCap& cap : m.caps)
+      for (uint32_t r = 0; r <= k; ++r) m.contourOfVertex[cap.first + r] = int32_t(cap.contour);
+    for (uint32_t g = 0; g < G; ++g)
+      if (groupOutput[g] < 0 && owner(g) >= 0) {
+        m.lossPoints.push_back(rig.positions[representative[g]]);
+        m.lossParts.push_back(uint32_t(owner(g)));
       }
 
-    // 10. The bind pose as the initial output (and the bind tube for the detail loss).
+    // 9. The bind pose as the initial output (and the bind surface for the detail loss).
     std::vector<glm::mat4> identity(J, glm::mat4(1.0f));
     m.deform(identity.data());
-    m.bindPositions.resize(m.carriedFirst);
-    for (uint32_t o = 0; o < m.carriedFirst; ++o)
+    m.bindPositions.resize(m.vertexCount);
+    for (uint32_t o = 0; o < m.vertexCount; ++o)
       m.bindPositions[o] = glm::vec3(m.positions[3 * o], m.positions[3 * o + 1], m.positions[3 * o + 2]);
   } catch (const std::bad_alloc&) {
     delete model;
@@ -624,7 +1112,8 @@ void ClassicModel::deform(const glm::mat4* skin) {
       float len = glm::length(n);
       n = len > 1e-6f ? n / len : P.posedDir;
       u = orthonormal(minRotate(P.posedDir, n, P.posedU), n);
-      scale = P.scale * (1.0f + bulge * P.flex * std::sin(kPi * tc));
+      // Muscle bulge on the limbs; a trunk part's tube does not swell when its neck turns.
+      scale = P.scale * (1.0f + (P.split ? 0.0f : bulge) * P.flex * std::sin(kPi * tc));
     }
     glm::vec3 w = glm::cross(n, u);
     const float* rad = &radii[c.radii];
@@ -635,45 +1124,12 @@ void ClassicModel::deform(const glm::mat4* skin) {
       out[3 * r] = p.x, out[3 * r + 1] = p.y, out[3 * r + 2] = p.z;
     }
   }
-  // Tube normals: area-weighted from the deformed tube triangles. Edges are divided by the tube's
-  // extent first: the cross products of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.
-  float extent = 0.0f;
-  if (tubeVertexCount) {
-    glm::vec3 lo(positions[0], positions[1], positions[2]), hi = lo;
-    for (uint32_t v = 1; v < tubeVertexCount; ++v) {
-      glm::vec3 p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-      lo = glm::min(lo, p), hi = glm::max(hi, p);
-    }
-    glm::vec3 e = hi - lo;
-    extent = std::fmax(e.x, std::fmax(e.y, e.z));
-  }
-  if (!(extent > 0.0f)) extent = 1.0f;
-  std::memset(normals.data(), 0, size_t(tubeVertexCount) * 3 * sizeof(float));
-  for (uint32_t i = 0; i < tubeIndexCount; i += 3) {
-    uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
-    glm::vec3 pa(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
-    glm::vec3 pb(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
-    glm::vec3 pc(positions[3 * c], positions[3 * c + 1], positions[3 * c + 2]);
-    glm::vec3 f = glm::cross((pb - pa) / extent, (pc - pa) / extent);
-    for (uint32_t v : {a, b, c}) {
-      normals[3 * v] += f.x;
-      normals[3 * v + 1] += f.y;
-      normals[3 * v + 2] += f.z;
-    }
-  }
-  for (uint32_t v = 0; v < tubeVertexCount; ++v) {
-    float* nn = &normals[3 * size_t(v)];
-    // unitOr scales before squaring: a tiny sum was left unnormalised (its square underflowed to 0).
-    glm::vec3 n = unitOr(glm::vec3(nn[0], nn[1], nn[2]), glm::vec3(0.0f, 1.0f, 0.0f));
-    nn[0] = n.x, nn[1] = n.y, nn[2] = n.z;
-  }
   // Caps: rim copies and the centre, normal along the contour normal (outward).
   for (const ClassicCap& cap : caps) {
     const ClassicContour& c = contours[cap.contour];
     const ClassicPart& P = parts[c.part];
     float tc = glm::clamp(c.t, 0.0f, 1.0f);
-    glm::vec3 n = (1.0f - tc) * P.nProx + tc * P.nDist;
-    n = cap.sign * glm::normalize(n);
+    glm::vec3 n = cap.sign * unitOr((1.0f - tc) * P.nProx + tc * P.nDist, P.posedDir);
     glm::vec3 centre = P.posedA + c.t * (P.posedB - P.posedA);
     std::memcpy(&positions[size_t(cap.first) * 3], &positions[size_t(c.first) * 3], size_t(k) * 3 * sizeof(float));
     for (uint32_t r = 0; r <= k; ++r) {
@@ -694,15 +1150,51 @@ void ClassicModel::deform(const glm::mat4* skin) {
     transformRun(skin[j], pose.normal, pose.renormalise, &restPositions[o], &restNormals[o], &positions[size_t(P.runFirst) * 3],
                  &normals[size_t(P.runFirst) * 3], P.runCount);
   }
+  // Tube normals: area-weighted from the deformed tube and band triangles (the bands after the
+  // carried vertices have moved). Edges are divided by the tube's extent first: the cross products
+  // of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.
+  float extent = 0.0f;
+  if (tubeVertexCount) {
+    glm::vec3 lo(positions[0], positions[1], positions[2]), hi = lo;
+    for (uint32_t v = 1; v < tubeVertexCount; ++v) {
+      glm::vec3 p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+      lo = glm::min(lo, p), hi = glm::max(hi, p);
+    }
+    glm::vec3 e = hi - lo;
+    extent = std::fmax(e.x, std::fmax(e.y, e.z));
+  }
+  if (!(extent > 0.0f)) extent = 1.0f;
+  const uint32_t rings = tubeVertexCount;  // ring vertices (caps follow them)
+  std::memset(normals.data(), 0, size_t(rings) * 3 * sizeof(float));
+  const uint32_t end = tubeIndexCount + bandIndexCount;
+  for (uint32_t i = 0; i < end; i += 3) {
+    uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+    glm::vec3 pa(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
+    glm::vec3 pb(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
+    glm::vec3 pc(positions[3 * c], positions[3 * c + 1], positions[3 * c + 2]);
+    glm::vec3 f = glm::cross((pb - pa) / extent, (pc - pa) / extent);
+    for (uint32_t v : {a, b, c}) {
+      if (v >= rings) continue;  // a band's carried vertex (or a cap's) keeps its own normal
+      normals[3 * v] += f.x;
+      normals[3 * v + 1] += f.y;
+      normals[3 * v + 2] += f.z;
+    }
+  }
+  for (uint32_t v = 0; v < rings; ++v) {
+    float* nn = &normals[3 * size_t(v)];
+    // unitOr scales before squaring: a tiny sum was left unnormalised (its square underflowed to 0).
+    glm::vec3 n = unitOr(glm::vec3(nn[0], nn[1], nn[2]), glm::vec3(0.0f, 1.0f, 0.0f));
+    nn[0] = n.x, nn[1] = n.y, nn[2] = n.z;
+  }
 }
 
 float ClassicModel::detailLoss(uint32_t which) const {
   if (which > 1) return std::nanf("");
   if (!lossDone) {
-    // For each original vertex of a resampled part, the nearest bind-pose tube triangle among the
-    // cells around its own (contour interval ±2, ray sector ±2, following shared contours into the
-    // neighbouring part) and the part's caps; a vertex farther than 0.5 % of the height from all of
-    // those is tested against every tube and cap triangle of the model.
+    // For each input vertex the tubes and bands replace, the nearest bind-pose tube triangle among
+    // the cells around its own (contour interval ±2, ray sector ±2, following shared contours into
+    // the neighbouring part) and its part's band triangles; a vertex farther than 0.5 % of the
+    // height from all of those is tested against every tube and band triangle of the model.
     const uint32_t k = rays;
     const float step = 2.0f * kPi / float(k);
     double sum = 0.0;
@@ -728,6 +1220,11 @@ float ClassicModel::detailLoss(uint32_t which) const {
       best = std::min(best, pointTriangleDistance(x, bindPositions[a + r], bindPositions[a + r1], bindPositions[b + r1]));
       best = std::min(best, pointTriangleDistance(x, bindPositions[a + r], bindPositions[b + r1], bindPositions[b + r]));
     };
+    auto testTriangles = [&](uint32_t first, uint32_t count, float& best, const glm::vec3& x) {
+      for (uint32_t t = first; t < first + count; t += 3)
+        best = std::min(best, pointTriangleDistance(x, bindPositions[indices[t]], bindPositions[indices[t + 1]],
+                                                    bindPositions[indices[t + 2]]));
+    };
     for (size_t i = 0; i < lossPoints.size(); ++i) {
       const glm::vec3& x = lossPoints[i];
       const ClassicPart& P = parts[lossParts[i]];
@@ -742,23 +1239,14 @@ float ClassicModel::detailLoss(uint32_t which) const {
       float best = INFINITY;
       for (int di = -2; di <= 2; ++di)
         for (int dr = -2; dr <= 2; ++dr) testCell(P, interval + di, sector + dr, best, x);
-      for (const ClassicCap& cap : caps) {
-        if (contours[cap.contour].part != int32_t(P.joint)) continue;
-        glm::vec3 centre = bindPositions[cap.first + k];
-        for (uint32_t r = 0; r < k; ++r)
-          best = std::min(best, pointTriangleDistance(x, centre, bindPositions[cap.first + r],
-                                                      bindPositions[cap.first + (r + 1) % k]));
-      }
+      for (const ClassicBand& band : bands)
+        if (band.part == P.joint) testTriangles(band.firstIndex, band.indexCount, best, x);
       if (!std::isfinite(best)) {  // beyond a tube end with no neighbour: the cells at that end
-        int end = std::max(0, std::min(n - 2, interval));
+        int last = std::max(0, std::min(n - 2, interval));
         for (int di = -2; di <= 2; ++di)
-          for (int dr = -2; dr <= 2; ++dr) testCell(P, end + di, sector + dr, best, x);
+          for (int dr = -2; dr <= 2; ++dr) testCell(P, last + di, sector + dr, best, x);
       }
-      if (best > 5e-3f * height) {  // far from the cells around it: every tube and cap triangle
-        for (uint32_t t = 0; t < uint32_t(indices.size()) && indices[t] < carriedFirst; t += 3)
-          best = std::min(best, pointTriangleDistance(x, bindPositions[indices[t]], bindPositions[indices[t + 1]],
-                                                      bindPositions[indices[t + 2]]));
-      }
+      if (best > 5e-3f * height) testTriangles(0, tubeIndexCount + bandIndexCount, best, x);
       sum += double(best) * double(best);
       worst = std::max(worst, best);
     }

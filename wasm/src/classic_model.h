@@ -20,17 +20,30 @@ struct ClassicContour {
   glm::vec3 centre{0.0f}, normal{0.0f, 1.0f, 0.0f}, u{1.0f, 0.0f, 0.0f};  // bind pose
 };
 
-// A tube end that meets a rigid part: closed by a fan (rim copies + a centre vertex).
+// A tube end that meets the carried mesh: a band of triangles zipping the tube's end ring to the
+// boundary loop of the carried triangles (both sides' own vertices: no gap, no overlap).
+// An end of a tube whose input skin is closed but meets nothing (a robot's finger plate): a flat
+// fan (rim copies of its ring + a centre vertex) in its end contour's plane.
 struct ClassicCap {
   uint32_t contour = 0;
   uint32_t first = 0;        // rays rim vertices, then the centre
   float sign = 1.0f;         // +1: outward = +contour normal (distal end), −1: proximal end
 };
 
+struct ClassicBand {
+  uint32_t part = 0;
+  uint32_t firstIndex = 0, indexCount = 0;  // its triangles in ClassicModel::indices
+};
+
 struct ClassicPart {
   uint32_t joint = 0;
   bool isPart = false;       // the joint owns vertices
-  bool candidate = false;    // cylinder-like by shape (one child part, long enough)
+  bool candidate = false;    // cylinder-like by shape (one child part, long enough; or a trunk part)
+  // A branching part of the trunk (pelvis, chest) resampled along its continuing child's bone on
+  // the side away from its branches; its branch region (crotch, shoulders) is carried rigidly.
+  // 0: not split; 1: vertices with t <= cut carried (pelvis); 2: vertices with t >= cut (chest).
+  uint8_t split = 0;
+  float cut = 0.0f;
   bool resampled = false;    // candidate whose rays hit well enough
   uint8_t reason = 0;        // why not resampled (ClassicRigidReason)
   int32_t parent = -1;       // parent part joint or −1
@@ -40,10 +53,12 @@ struct ClassicPart {
   glm::vec3 u{1.0f, 0.0f, 0.0f};     // bind reference direction ⟂ axis (parallel-transported)
   glm::vec3 direction{0.0f, 1.0f, 0.0f};  // bind direction of any part (for the bend of its joint)
   uint32_t contourCount = 0;         // m_j (including shared end contours)
-  // Contours span t in [tLo, tHi]: [0, 1] between shared joints; past a joint with a rigid
-  // neighbour, the tube extends over the part's own vertices (up to half a bone) so that no skin
-  // of the part is left uncovered between the tube and the rigid part.
+  // Contours span t in [tLo, tHi]: 0 / 1 at a joint shared with a resampled neighbour; at an end
+  // that meets the carried mesh, the innermost point of the boundary loop (the band covers the
+  // rest); at an open end (nothing beyond), the part's own vertices (up to half a bone past).
   float tLo = 0.0f, tHi = 1.0f, ownTMin = 0.0f, ownTMax = 1.0f;
+  float loopTLo = 0.0f, loopTHi = 1.0f;
+  int32_t proxLoop = -1, distLoop = -1;  // boundary loops stitched at each end, or −1
   bool proxShared = false, distShared = false;
   std::vector<uint32_t> contours;    // contour ids, proximal → distal
   uint32_t first = 0, count = 0;     // reported output range
@@ -62,7 +77,9 @@ enum ClassicRigidReason : uint8_t {
   CLASSIC_BRANCHING = 2,     // several child parts (pelvis, chest, a hand with fingers)
   CLASSIC_TOO_SHORT = 3,     // bone shorter than 3 % of the model height (incl. zero length)
   CLASSIC_RAYS_MISS = 4,     // too many rays miss the part's own triangles (or none hits)
-  CLASSIC_BENT = 5           // bone turned > 45° from its resampled parent's bone (a foot on a shank)
+  CLASSIC_BENT = 5,          // bone turned > 45° from its resampled parent's bone (a foot on a shank)
+  CLASSIC_SEAM = 6,          // its boundary with the carried mesh is not one ring around its bone
+  CLASSIC_TRUNK = 7          // resampled along the trunk; its branch region (crotch, shoulders) carried
 };
 
 class ClassicModel final : public Deformer {
@@ -78,19 +95,22 @@ class ClassicModel final : public Deformer {
   std::vector<ClassicPart> parts;          // indexed by joint
   std::vector<glm::vec3> jointCentres;
   std::vector<ClassicContour> contours;
+  std::vector<ClassicBand> bands;         // bands, and caps' fans (their part's "ends")
   std::vector<ClassicCap> caps;
   std::vector<float> radii;                // per contour, `rays` bind radii
   std::vector<float> cosTable, sinTable;   // ray directions in a contour frame
   uint32_t tubeIndexCount = 0;             // tube triangles come first in `indices`
-  uint32_t tubeVertexCount = 0;            // ring vertices come first in the output
+  uint32_t bandIndexCount = 0;             // then the bands' and caps' triangles
+  uint32_t tubeVertexCount = 0;            // ring vertices come first in the output (caps follow)
   uint32_t carriedFirst = 0;               // carried rig vertices: [carriedFirst, vertexCount)
   std::vector<float> restPositions, restNormals;  // carried vertices, interleaved (+1 spare)
-  std::vector<int32_t> report;             // partCount × 4 (see gcs_classic_parts)
+  std::vector<int32_t> report;             // partCount × 5 (see gcs_classic_parts)
+  std::vector<int32_t> contourOfVertex;    // per output vertex: its contour, −1 for carried vertices
   std::vector<uint32_t> reportJoints;      // parts in report order
-  // Detail loss inputs: original vertices of resampled parts (position, part).
+  // Detail loss inputs: original vertices replaced by the tubes and bands (position, part).
   std::vector<glm::vec3> lossPoints;
   std::vector<uint32_t> lossParts;
-  std::vector<glm::vec3> bindPositions;    // tube and cap vertices in the bind pose
+  std::vector<glm::vec3> bindPositions;    // every output vertex in the bind pose
   mutable bool lossDone = false;
   mutable float lossRms = 0.0f, lossMax = 0.0f;
 };

@@ -34,7 +34,7 @@ uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
 }
 uint64_t classicPeakBytes(uint64_t v, uint64_t i, uint64_t parts, uint64_t contours, uint64_t rays) {
   const uint64_t points = parts * (contours + 2) * (rays + 1);
-  return (v * 300 + i * 24 + points * 96) * 3 / 2 + 65536;
+  return (v * 300 + i * 48 + points * 100) * 3 / 2 + 65536;  // i: welded edges (16 bytes × 3 per triangle) and loop edges
 }
 
 }  // namespace gcs

@@ -120,6 +120,32 @@ export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): numbe
 }
 
 /**
+ * The border of a triangle mesh whose coincident vertices are welded (`pairs` from
+ * coincidentPairs): `open` edges used by one triangle, `overused` edges by more than two (a fold
+ * or an overlap glued on). A closed manifold mesh has both 0; a closed input deformed into an
+ * output with a gap or a torn seam has open > 0.
+ */
+export function meshBorder(indices: ArrayLike<number>, vertexCount: number, pairs: Uint32Array): { open: number; overused: number } {
+  const weld = new Uint32Array(vertexCount);
+  for (let v = 0; v < vertexCount; v++) weld[v] = v;
+  for (let i = 0; i < pairs.length; i += 2) weld[pairs[i + 1]] = pairs[i];
+  const uses = new Map<number, number>();
+  for (let t = 0; t + 2 < indices.length; t += 3)
+    for (let e = 0; e < 3; e++) {
+      const a = weld[indices[t + e]], b = weld[indices[t + ((e + 1) % 3)]];
+      if (a === b) continue;
+      const key = a < b ? a * vertexCount + b : b * vertexCount + a;
+      uses.set(key, (uses.get(key) ?? 0) + 1);
+    }
+  let open = 0, overused = 0;
+  for (const n of uses.values()) {
+    if (n === 1) open++;
+    else if (n > 2) overused++;
+  }
+  return { open, overused };
+}
+
+/**
  * The rest positions of a deformer's output vertices: the rig's bind-pose positions of their
  * source vertices where the deformer has them, else the output of a bind-pose deform.
  */
