@@ -4,7 +4,8 @@
 //
 //   node scripts/screenshot-demo.mjs            → docs/demo.png (the default: weights criterion),
 //                                                 docs/demo-sections.png (colour by section, 8 sections),
-//                                                 docs/demo-fox.png (the shipped Fox, all three views)
+//                                                 docs/demo-fox.png (the shipped Fox, all three views),
+//                                                 docs/demo-classic.png (CesiumMan coloured by section / contour)
 //   node scripts/screenshot-demo.mjs --out DIR  → the same files in DIR
 //   node scripts/screenshot-demo.mjs --only demo-fox.png → only that one
 //   EXTRA='?criterion=y&colour=1' node scripts/screenshot-demo.mjs → also extra.png
@@ -46,6 +47,7 @@ try {
     { file: 'demo.png', query: '' },
     { file: 'demo-sections.png', query: '?colour=1&sections=8' },
     { file: 'demo-fox.png', query: '?model=fox&lbs=1' },
+    { file: 'demo-classic.png', query: '?model=cesiumman&colour=1' },
     ...(process.env.EXTRA ? [{ file: 'extra.png', query: process.env.EXTRA }] : []),
   ].filter((s) => !only || s.file === only);
   if (!shots.length) throw new Error(`--only ${only}: no such shot`);

@@ -578,3 +578,57 @@ function maxOf(a: ArrayLike<number>): number {
   for (let i = 0; i < a.length; i++) if (!(a[i] <= m)) m = Number.isNaN(a[i]) ? Infinity : a[i];
   return m;
 }
+
+/** What the classic model makes of a rig at one setting (the paper's Fig. 5 comparison). */
+export interface ClassicFigures {
+  contours: number;
+  rays: number;
+  outputVertices: number;
+  /** Parts resampled (chain parts, and trunk parts along the spine) and carried rigidly. */
+  resampled: number;
+  trunk: number;
+  carried: number;
+  /** Detail loss, % of the mesh's height (ClassicDeformer.detailLoss). */
+  rms: number;
+  max: number;
+  /** Welded border edges of the output at rest (equal to the input's: no gap where tubes meet carried skin). */
+  border: number;
+}
+
+/** Builds the classic model at one setting and measures it (disposes it). */
+export function classicFigures(rig: Rig, contours: number, rays: number): ClassicFigures {
+  const d = rig.buildClassic({ contours, rays });
+  try {
+    const parts = d.parts;
+    const loss = d.detailLoss;
+    return {
+      contours, rays, outputVertices: d.vertexCount, resampled: parts.filter((p) => p.reason === 'resampled').length,
+      trunk: parts.filter((p) => p.reason === 'trunk').length, carried: parts.filter((p) => !p.resampled).length,
+      rms: loss.rms, max: loss.max, border: meshBorder(d.indices, d.vertexCount, coincidentPairs(d.positions.slice())).open,
+    };
+  } finally {
+    d.dispose();
+  }
+}
+
+/**
+ * The classic model at the vertex budget of GCS (which keeps every input vertex): the square
+ * setting (contours = rays = s) whose output vertex count is closest to the rig's, by bisection
+ * over s in [3, 256] (output size grows with s).
+ */
+export function classicAtBudget(rig: Rig): ClassicFigures {
+  let lo = 3, hi = 256;
+  const size = (s: number) => {
+    const d = rig.buildClassic({ contours: s, rays: s });
+    const n = d.vertexCount;
+    d.dispose();
+    return n;
+  };
+  while (hi - lo > 1) {
+    const mid = (lo + hi) >> 1;
+    if (size(mid) <= rig.vertexCount) lo = mid;
+    else hi = mid;
+  }
+  const best = Math.abs(size(lo) - rig.vertexCount) <= Math.abs(size(hi) - rig.vertexCount) ? lo : hi;
+  return classicFigures(rig, best, best);
+}
