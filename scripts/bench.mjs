@@ -10,6 +10,7 @@ import { rootOf, sampleClip } from '../dist/cli/gltf-node.js';
 import { errorInfo, median, timeFrames } from '../dist/measure.js';
 import { JsGcs } from './bench/js-gcs.mjs';
 import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';
+import { crowdBench } from './bench/crowd.mjs';
 
 const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
   const n = Number(x.replace(/k$/i, '000').replace(/m$/i, '000000'));
@@ -24,6 +25,7 @@ try {
     quick: { type: 'flag', default: false },
     sizes: { parse: sizesArg, default: null },
     sections: { parse: (s) => Number(s), default: 6 },
+    crowdOnly: { type: 'flag', default: false },
   });
 } catch (e) {
   console.error(`bench: ${e.message}`);
@@ -34,7 +36,8 @@ if (args.help) {
   --sizes     vertex counts of the scaling table (default 10k,100k,1m; --quick: 10k)
   --quick     shorter timing, small sizes only
   --json      machine-readable results on stdout
-  --markdown  tables as markdown (for docs/benchmarks.md)`);
+  --markdown  tables as markdown (for docs/benchmarks.md)
+  --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)`);
   process.exit(0);
 }
 const quick = args.quick;
@@ -56,7 +59,39 @@ const PAPER = { vertices: 17023, walk: { ms: 24.817, adjusted: 0.4 }, run: { ms:
 const budget = (base) => ({ minSamples: quick ? 60 : 300, minMs: quick ? base / 4 : base, maxMs: quick ? base : 4 * base });
 
 const gcs = await initGcsSkin();
-const results = { machine: machine(), sections, table1: null, comparisons: null, adapter: null, rebuild: null, sizes: [], targets: [] };
+const results = { machine: machine(), sections, table1: null, comparisons: null, adapter: null, rebuild: null, sizes: [], crowd: null, targets: [] };
+
+/** The crowd table: per character and frame, CPU ms and bytes uploaded, CPU vs GPU backend. */
+function printCrowd(crowd) {
+  const kb = (b) => (b === null || b === undefined ? 'n/a' : `${(b / 1024).toFixed(1)} KB`);
+  const r0 = crowd.rows[0];
+  console.log(`\nCrowd: default humans (${r0.vertices} vertices, ${r0.sections} GCS sections each), per character and frame ` +
+    '(CPU ms: skinning in node, posing included, rendering excluded; bytes: uploads counted on WebGL calls in headless Chromium)');
+  const rows = [['characters', 'CPU backend ms', 'CPU backend bytes', 'GPU backend ms', 'GPU backend bytes', 'ms ratio', 'bytes ratio']];
+  for (const r of crowd.rows)
+    rows.push([String(r.characters), ms(r.cpu.msPerCharacter), kb(r.cpu.bytesPerCharacter), ms(r.gpu.msPerCharacter), kb(r.gpu.bytesPerCharacter),
+      `${(r.cpu.msPerCharacter / r.gpu.msPerCharacter).toFixed(1)}×`,
+      r.gpu.bytesPerCharacter ? `${(r.cpu.bytesPerCharacter / r.gpu.bytesPerCharacter).toFixed(0)}×` : 'n/a']);
+  console.log(fmtTable(rows));
+  if (crowd.browser.skipped) console.log(`  ${crowd.browser.skipped}`);
+}
+const crowdTargetRows = (crowd) => crowd.targets.map((t) => [t.name, t.value === null ? 'n/a' : t.unit === 'bytes' ? `${(t.value / 1024).toFixed(1)} KB` : `${ms(t.value)} ms`,
+  t.goal, t.met === null ? `n/a ${t.note}` : t.met ? 'met' : `MISSED (${t.note || 'measured above'})`]);
+
+if (args.crowdOnly) {
+  log('bench: building the default human…');
+  const h = createHuman();
+  results.crowd = await crowdBench(gcs, h, { quick, log });
+  results.targets.push(...results.crowd.targets);
+  if (args.json) {
+    console.log(JSON.stringify(results, null, 2));
+    process.exit(0);
+  }
+  printCrowd(results.crowd);
+  console.log('\nTargets:');
+  console.log(fmtTable([['target', 'value', 'goal', 'result'], ...crowdTargetRows(results.crowd)]));
+  process.exit(0);
+}
 
 /** Frames of a clip at 60 fps (at least 30), as skin-matrix arrays. */
 function framesOf(mesh, clip) {
@@ -294,6 +329,9 @@ for (const size of sizes) {
   log(`bench: ${size}: GCS ${ms(row.methods.gcs?.medianMs)} ms, memcpy ${ms(row.memcpy.medianMs)} ms`);
 }
 
+// ---------------------------------------------------------------- crowds: CPU vs GPU backend
+results.crowd = await crowdBench(gcs, createHuman(), { quick, log });
+
 // ---------------------------------------------------------------- targets
 const g = results.table1.methods.gcs ?? {};
 const gcsMs = g.walk ? Math.max(g.walk.medianMs, g.run.medianMs) : null;
@@ -319,6 +357,8 @@ target('GCS rebuild (section slider, 17 k)', results.rebuild.gcsMs, '≤ 5 ms', 
 target('classic resampling (17 k)', results.rebuild.classicMs, '≤ 30 ms',
   results.rebuild.classicMs === null ? null : results.rebuild.classicMs <= 30,
   results.rebuild.classicError ? `n/a: ${results.rebuild.classicError.code}: ${results.rebuild.classicError.message}` : '');
+
+results.targets.push(...results.crowd.targets);
 
 // ---------------------------------------------------------------- output
 if (args.json) {
@@ -364,10 +404,13 @@ if (results.sizes.length) {
   console.log(fmtTable(rows3));
 }
 
+printCrowd(results.crowd);
+
 console.log('\nTargets:');
 const rows4 = [['target', 'value', 'goal', 'result']];
-for (const t of results.targets) {
+for (const t of results.targets.filter((x) => !results.crowd.targets.includes(x))) {
   const v = t.value === null ? 'n/a' : t.unit === 'ratio' ? `${t.value.toFixed(2)}×` : `${ms(t.value)} ms`;
   rows4.push([t.name, v, t.goal, t.met === null ? `n/a ${t.note}` : t.met ? 'met' : `MISSED ${t.note}`]);
 }
+rows4.push(...crowdTargetRows(results.crowd));
 console.log(fmtTable(rows4));

@@ -23,6 +23,7 @@ import {
 import { SkinDeformer } from '../lib/three.js';
 import { createHumanData, humanFromData, type HumanData } from '../lib/human/index.js';
 import { attributesNeeded, transferAttributes } from './transfer.js';
+import { crowdRequested, startCrowd } from './crowd.js';
 
 // ---------------------------------------------------------------------------------------------
 // State
@@ -1149,9 +1150,12 @@ function render(): void {
 // ---------------------------------------------------------------------------------------------
 // Testing hook
 
-const ready = init()
-  .catch((e) => showMessage(`The demo could not start: ${describeError(e)}`))
-  .then(() => new Promise<void>((resolve) => { const f = frameCount; const wait = () => (frameCount > f + 1 ? resolve() : setTimeout(wait, 16)); wait(); }));
+// ?crowd=N: the crowd mode (web/demo/crowd.ts) instead of the comparison views.
+const ready = crowdRequested()
+  ? startCrowd().catch((e) => showMessage(`The crowd could not start: ${describeError(e)}`))
+  : init()
+    .catch((e) => showMessage(`The demo could not start: ${describeError(e)}`))
+    .then(() => new Promise<void>((resolve) => { const f = frameCount; const wait = () => (frameCount > f + 1 ? resolve() : setTimeout(wait, 16)); wait(); }));
 
 Object.assign(window, {
   __demo: {

@@ -1,0 +1,89 @@
+// The demo's crowd mode (?crowd=N) in headless Chromium: N characters drawn (GPU backend: one
+// instanced mesh, a handful of draw calls; CPU backend: one mesh each), each moving on its own,
+// the readouts on the page, the backend switch, and no page or WebGL error.
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { BrowserContext, Page } from 'playwright-core';
+import { analyse, launchChromium, skipReason, startDemo, type DemoServer } from './harness.js';
+
+const reason = skipReason();
+if (reason) console.log(reason);
+
+interface Measure { characters: number; backend: string; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
+interface CrowdHook {
+  frame(): number; count(): number; backend(): string; drawn(): number; drawCalls(): number; readout(): string;
+  set(n: number, backend?: string): void; measure(frames: number): Promise<Measure>; pause(t?: number): void;
+}
+declare global { interface Window { __crowd: CrowdHook } }
+
+let server: DemoServer | null = null;
+let context: BrowserContext | null = null;
+
+beforeAll(async () => {
+  if (reason) return;
+  server = await startDemo();
+  context = await launchChromium();
+});
+afterAll(async () => {
+  await context?.close();
+  await server?.close();
+});
+
+async function open(query: string, viewport?: { width: number; height: number }): Promise<{ page: Page; errors: string[] }> {
+  const page = await context!.newPage();
+  if (viewport) await page.setViewportSize(viewport); // software rendering: fewer pixels, a faster test
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await page.goto(server!.url + query);
+  await page.waitForFunction(() => window.__demo !== undefined);
+  await page.evaluate(() => window.__demo.ready);
+  const message = await page.evaluate(() => window.__demo.error());
+  expect(message).toBe('');
+  await page.waitForFunction(() => window.__crowd !== undefined && window.__crowd.frame() > 2, null, { timeout: 120000 });
+  return { page, errors };
+}
+
+describe.skipIf(!!reason)('crowd mode', () => {
+  test('?crowd=24 draws 24 walking characters in one instanced draw call, then switches to the CPU backend', async () => {
+    const { page, errors } = await open('?crowd=24');
+    expect(await page.evaluate(() => window.__crowd.count())).toBe(24);
+    expect(await page.evaluate(() => window.__crowd.drawn())).toBe(24);
+    expect(await page.evaluate(() => window.__crowd.backend())).toBe('gpu');
+    // Ground + the crowd's one instanced mesh (no shadows by default).
+    expect(await page.evaluate(() => window.__crowd.drawCalls())).toBeLessThanOrEqual(3);
+    const gpu = await page.evaluate(() => window.__crowd.measure(4));
+    console.log(`GPU backend, 24 characters: ${gpu.msPerFrame.toFixed(3)} ms skinning CPU per frame, ${gpu.bytesPerFrame} bytes uploaded per frame (${gpu.sections} sections)`);
+    // The frame uploads the section texture: 24 × sections × 48 bytes (+ the padding of its last row), nothing per vertex.
+    expect(gpu.bytesPerFrame).toBeGreaterThanOrEqual(24 * gpu.sections * 48);
+    expect(gpu.bytesPerFrame).toBeLessThan(24 * gpu.sections * 48 + 2048 * 16);
+    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/24 characters .*GPU backend.*ms\/frame.*uploaded/);
+    // Every character is on screen and moving: pixels of the skin colour, changing between frames.
+    const region = { x: 0, y: 0, width: 1280 - 300, height: 720 };
+    const a = await page.screenshot();
+    await page.waitForFunction((f) => window.__crowd.frame() > f + 3, await page.evaluate(() => window.__crowd.frame()));
+    const b = await page.screenshot();
+    const [stats] = await analyse(page, b, [region], a);
+    console.log(`crowd pixels: ${(100 * stats.skin).toFixed(1)} % skin colour, ${(100 * stats.changed).toFixed(1)} % changed in 3 frames`);
+    expect(stats.skin).toBeGreaterThan(0.02);
+    expect(stats.changed).toBeGreaterThan(0.005);
+    // The CPU backend: one mesh per character, the vertex buffers uploaded every frame.
+    await page.evaluate(() => window.__crowd.set(6, 'cpu'));
+    await page.waitForFunction(() => window.__crowd.backend() === 'cpu' && window.__crowd.frame() > 0);
+    expect(await page.evaluate(() => window.__crowd.drawn())).toBe(6);
+    const cpu = await page.evaluate(() => window.__crowd.measure(3));
+    console.log(`CPU backend, 6 characters: ${cpu.msPerFrame.toFixed(3)} ms, ${cpu.bytesPerFrame} bytes per frame`);
+    expect(cpu.bytesPerFrame).toBeGreaterThanOrEqual(6 * cpu.vertices * 24); // positions + normals, float32
+    expect(errors).toEqual([]);
+    await page.close();
+  }, 300000);
+
+  // 300 characters of a lighter human (2,000 vertices): software rendering of 300 × 17 k vertices takes minutes.
+  test('?crowd=300&smooth=1&vertices=2000 renders 300 characters with no page error', async () => {
+    const { page, errors } = await open('?crowd=300&smooth=1&vertices=2000', { width: 480, height: 270 });
+    expect(await page.evaluate(() => window.__crowd.drawn())).toBe(300);
+    const m = await page.evaluate(() => window.__crowd.measure(2));
+    expect(m.bytesPerFrame).toBeLessThan(300 * m.sections * 48 + 2048 * 16);
+    expect(errors).toEqual([]);
+    await page.close();
+  }, 300000);
+});
