@@ -6,6 +6,7 @@ import * as THREE from 'three';
 import { basename } from 'node:path';
 import { initGcsSkin, GcsError, type GcsSkin, type RigInput, type ClassicDeformer } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
+import { coincidentPairs, meshBorder, seamGap } from '../../web/lib/measure.js';
 import { createHuman } from '../../web/lib/human/index.js';
 import { loadGlb, sharedModels, skinMatricesAt } from '../helpers/models.js';
 
@@ -20,9 +21,10 @@ interface Tube3 { input: RigInput; radius: number; }
  * A tube of radius r along +Y from 0 to 3 with three bones (joints at y = 0, 1, 2; joint 2 owns the
  * last third, a leaf): parts 0 and 1 are chain parts (resampled), part 2 is a leaf (rigid).
  * `drop` removes the triangles of part 1 whose first vertex has z < 0 (an open half-pipe);
- * `joint2` moves joint 2's centre (its weights stay on y ≥ 2).
+ * `joint2` moves joint 2's centre (its weights stay on y ≥ 2); `closed` closes both ends with a fan;
+ * `patch` binds a small patch on the side of part 1 (y in [1.4, 1.6], a few segments) to joint 2.
  */
-function tube3(o: { radius?: number; segments?: number; rings?: number; drop?: boolean; joint2?: number } = {}): Tube3 {
+function tube3(o: { radius?: number; segments?: number; rings?: number; drop?: boolean; joint2?: number; closed?: boolean; patch?: boolean } = {}): Tube3 {
   const r = o.radius ?? 0.1, segs = o.segments ?? 48, rings = o.rings ?? 121, j2 = o.joint2 ?? 2;
   const positions: number[] = [], joints: number[] = [], weights: number[] = [];
   for (let i = 0; i < rings; i++) {
@@ -30,7 +32,8 @@ function tube3(o: { radius?: number; segments?: number; rings?: number; drop?: b
     for (let k = 0; k < segs; k++) {
       const a = (2 * Math.PI * k) / segs;
       positions.push(r * Math.cos(a), y, r * Math.sin(a));
-      joints.push(y < 1 ? 0 : y < 2 ? 1 : 2, 0, 0, 0);
+      const patched = o.patch && y >= 1.4 && y <= 1.6 && k < 4;
+      joints.push(y < 1 ? 0 : y < 2 && !patched ? 1 : 2, 0, 0, 0);
       weights.push(1, 0, 0, 0);
     }
   }
@@ -42,6 +45,16 @@ function tube3(o: { radius?: number; segments?: number; rings?: number; drop?: b
       if (o.drop && y >= 1 && y < 2 && positions[3 * a + 2] < 0) continue;
       indices.push(a, b + segs, b, a, a + segs, b + segs);
     }
+  if (o.closed) { // a centre vertex at each end, fans wound against the tube's use of the end rings
+    const bottom = rings * segs, top = bottom + 1, last = (rings - 1) * segs;
+    positions.push(0, 0, 0, 0, 3, 0);
+    joints.push(0, 0, 0, 0, 2, 0, 0, 0);
+    weights.push(1, 0, 0, 0, 1, 0, 0, 0);
+    for (let k = 0; k < segs; k++) {
+      const k1 = (k + 1) % segs;
+      indices.push(bottom, k, k1, top, last + k1, last + k);
+    }
+  }
   const ibm = new Float32Array(48);
   [0, 1, j2].forEach((y, j) => ibm.set(new THREE.Matrix4().makeTranslation(0, -y, 0).elements, 16 * j));
   return {
@@ -228,8 +241,48 @@ describe('classic cross-sections on analytic tubes', () => {
     d.deform(bendSkin(1));
     expect(allFinite(d.positions)).toBe(true);
     expect(allFinite(d.normals)).toBe(true);
-    // Part 0 now ends at a rigid neighbour: its tube end is capped (one rim copy + centre).
+    // Part 0 now ends at a carried neighbour: a band zips its end ring to the half-pipe's border.
     expect(d.parts[0].vertexCount).toBe(25 * 40);
+    d.dispose();
+    rig.dispose();
+  });
+
+  test('where tubes meet carried skin nothing opens: a closed tube stays closed, an open one keeps only its two end rims', () => {
+    for (const closed of [true, false]) {
+      const t = tube3({ closed });
+      const rig = gcs.createRig(t.input);
+      const inputBorder = meshBorder(t.input.indices, rig.vertexCount, coincidentPairs(t.input.positions));
+      expect(inputBorder).toEqual({ open: closed ? 0 : 2 * 48, overused: 0 });
+      for (const [contours, rays] of [[25, 40], [4, 3], [60, 64]]) {
+        const d = rig.buildClassic({ contours, rays, bulge: 1 });
+        expect(d.parts.map((p) => p.reason)).toEqual(['resampled', 'resampled', 'leaf']);
+        const pairs = coincidentPairs(d.positions.slice());
+        // Closed: nothing open. Open: the resampled bottom rim (rays edges) and the leaf's own top rim.
+        expect(meshBorder(d.indices, d.vertexCount, pairs)).toEqual({ open: closed ? 0 : rays + 48, overused: 0 });
+        // Part 1's tube ends inside the leaf's border loop, which the band shares with the carried
+        // triangles: bent, the ring, the band and the leaf stay joined (no coincident pair opens).
+        for (const angle of [0.5, Math.PI / 2, 2.5]) {
+          d.deform(bendSkin(angle));
+          expect(seamGap(d.positions, pairs)).toBe(0);
+          expect(allFinite(d.positions) && allFinite(d.normals)).toBe(true);
+        }
+        d.dispose();
+      }
+      rig.dispose();
+    }
+  });
+
+  test('a patch bound to another bone on the side of a tube is absorbed by the tube (no side loop, no overlap)', () => {
+    const t = tube3({ patch: true, closed: true });
+    const rig = gcs.createRig(t.input);
+    const d = rig.buildClassic({ contours: 25, rays: 40, bulge: 0 });
+    expect(d.parts.map((p) => p.reason)).toEqual(['resampled', 'resampled', 'leaf']);
+    expect(meshBorder(d.indices, d.vertexCount, coincidentPairs(d.positions.slice()))).toEqual({ open: 0, overused: 0 });
+    // The patch's vertices are replaced by the tube: the carried leaf keeps only y ≥ ~2 skin.
+    const leaf = d.parts[2];
+    let lowest = Infinity;
+    for (let v = leaf.firstVertex; v < leaf.firstVertex + leaf.vertexCount; v++) lowest = Math.min(lowest, d.positions[3 * v + 1]);
+    expect(lowest).toBeGreaterThan(1.9);
     d.dispose();
     rig.dispose();
   });
