@@ -18,7 +18,7 @@ import Stats from 'three/addons/libs/stats.module.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
 import {
   CLASSIC_LIMITS, GcsError, initGcsSkin,
-  type ClassicDeformer, type ClassicOptions, type Criterion, type GcsDeformer, type GcsOptions, type GcsSkin,
+  type ClassicDeformer, type ClassicOptions, type ClassicReason, type Criterion, type GcsDeformer, type GcsOptions, type GcsSkin,
 } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import { createHumanData, humanFromData, type HumanData } from '../lib/human/index.js';
@@ -72,8 +72,10 @@ interface Character {
   gcs: SkinDeformer[];
   classic: SkinDeformer[];
   classicError: string | null;
-  /** Bones whose parts the classic model carries rigidly (not resampled). */
-  rigidParts: string[];
+  /** Bones whose parts the classic model carries rigidly (not resampled), and why. */
+  rigidParts: { name: string; reason: ClassicReason }[];
+  /** Branching trunk parts resampled along the spine (their branch region carried). */
+  trunkParts: string[];
   mixer: THREE.AnimationMixer;
   clips: THREE.AnimationClip[];
   action: THREE.AnimationAction | null;
@@ -499,16 +501,31 @@ function gcsColours(skin: SkinDeformer): void {
   setSectionColours(skin, colours);
 }
 
-/** The classic model: a colour per resampled part, grey for the parts it carries rigidly. */
+/**
+ * The classic model, coloured like the GCS view: one colour per contour (a hue per part, light and
+ * dark bands alternating along it; a shared joint contour takes the distal part's hue), the carried
+ * skin a pale grey tinted by its part (the untinted grey: skin of a resampled part kept by carried
+ * triangles, e.g. a band's border).
+ */
 function classicColours(skin: SkinDeformer): void {
   const d = skin.deformer as ClassicDeformer;
+  const contourOf = d.contourOfVertex;
+  const hueOf = (joint: number) => (0.22 + ((joint * 0.618034) % 1) * 0.8) % 1;
+  const contourHue = new Float32Array(d.sectionCount);
   const colours = new Float32Array(d.vertexCount * 3);
-  const grey = new THREE.Color().setHSL(0, 0, 0.5);
+  const grey = new THREE.Color().setHSL(0, 0, 0.72);
   for (let v = 0; v < d.vertexCount; v++) grey.toArray(colours, 3 * v);
   for (const p of d.parts) {
-    const c = p.resampled ? new THREE.Color().setHSL((0.22 + ((p.joint * 0.618034) % 1) * 0.8) % 1, 0.6, 0.5) : grey;
     const end = Math.min(d.vertexCount, p.firstVertex + p.vertexCount);
-    for (let v = Math.max(0, p.firstVertex); v < end; v++) c.toArray(colours, 3 * v);
+    if (p.resampled) for (let v = Math.max(0, p.firstVertex); v < end; v++) contourHue[contourOf[v]] = hueOf(p.joint);
+    else {
+      tmpColour.setHSL(hueOf(p.joint), 0.2, 0.72);
+      for (let v = Math.max(0, p.firstVertex); v < end; v++) tmpColour.toArray(colours, 3 * v);
+    }
+  }
+  for (let v = 0; v < d.vertexCount; v++) {
+    const c = contourOf[v];
+    if (c >= 0) tmpColour.setHSL(contourHue[c], 0.6, c % 2 ? 0.36 : 0.56).toArray(colours, 3 * v);
   }
   setSectionColours(skin, colours);
 }
@@ -796,10 +813,10 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     (skeletonHelper.material as THREE.LineBasicMaterial).linewidth = 2;
 
     const next: Character = {
-      name, key: menuKey, credit, holder, sources, gcs: gcsSkins, classic: classicSkins, classicError, rigidParts: [],
+      name, key: menuKey, credit, holder, sources, gcs: gcsSkins, classic: classicSkins, classicError, rigidParts: [], trunkParts: [],
       mixer, clips, action: null, skeletonHelper, sourceVertices: vertices, sourceTriangles: triangles, rigidMeshes,
     };
-    next.rigidParts = rigidParts(next);
+    classicSummary(next);
     for (const s of next.gcs) { s.mesh.castShadow = true; gcsColours(s); }
     for (const s of next.classic) s.mesh.castShadow = true;
 
@@ -846,14 +863,38 @@ function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; er
   }
 }
 
-function rigidParts(ch: Character): string[] {
-  const names: string[] = [];
+/** Which parts the classic model carries rigidly and why, and which trunk parts it resamples. */
+function classicSummary(ch: Character): void {
+  const carried = new Map<string, ClassicReason>(), trunk = new Set<string>();
   ch.classic.forEach((s, i) => {
     const bones = ch.sources[i].skeleton.bones;
-    for (const p of (s.deformer as ClassicDeformer).parts)
-      if (!p.resampled) names.push(bones[p.joint]?.name || `joint ${p.joint}`);
+    for (const p of (s.deformer as ClassicDeformer).parts) {
+      const name = bones[p.joint]?.name || `joint ${p.joint}`;
+      if (p.reason === 'trunk') trunk.add(name);
+      else if (!p.resampled) carried.set(name, p.reason);
+    }
   });
-  return [...new Set(names)];
+  ch.rigidParts = [...carried].map(([name, reason]) => ({ name, reason }));
+  ch.trunkParts = [...trunk];
+}
+
+/** Why the classic model carries a part, as the page groups it. */
+const CARRIED_WHY: Record<Exclude<ClassicReason, 'resampled' | 'trunk'>, string> = {
+  leaf: 'ends', branching: 'branch regions', 'too-short': 'bones too short', 'rays-miss': 'not tube-like (rays miss)',
+  bent: 'bent off their limb', seam: 'no clean ring to the carried skin',
+};
+
+/** "fingers: 30 joints · ends: Head, LeftHand, … · branch regions: Chest": carried parts grouped by reason. */
+function groupCarried(parts: { name: string; reason: ClassicReason }[]): string {
+  const finger = (n: string) => /thumb|index|middle|ring|pinky|finger/i.test(n);
+  const groups: string[] = [];
+  const fingers = parts.filter((p) => finger(p.name));
+  if (fingers.length) groups.push(`fingers: ${fingers.length} joints`);
+  for (const [reason, label] of Object.entries(CARRIED_WHY)) {
+    const names = parts.filter((p) => p.reason === reason && !finger(p.name)).map((p) => p.name);
+    if (names.length) groups.push(`${label}: ${summariseBones(names)}`);
+  }
+  return groups.join(' · ');
 }
 
 function disposeCharacter(ch: Character): void {
@@ -907,7 +948,7 @@ function rebuildClassic(ch: Character): void {
     ch.classicError = error;
     for (const s of skins) { s.mesh.castShadow = true; classicGroup.add(s.mesh); }
   }
-  ch.rigidParts = rigidParts(ch);
+  classicSummary(ch);
   updateLabels();
   updateReadouts();
 }
@@ -966,8 +1007,12 @@ function updateLabels(): void {
       body = '<h2>Classic cross-sections</h2><div class="sub">Shen, Magnenat-Thalmann, Thalmann 1994 · ' +
         `${params.contours} contours × ${params.rays} rays per limb</div>`;
       if (ch?.classicError) body += `<div class="err">Not available: ${esc(ch.classicError)}</div>`;
-      else if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly, not resampled: ${esc(summariseBones(ch.rigidParts))}</div>`;
-      if (params.colourBySection && !ch?.classicError) body += '<div class="sub">colour = resampled part · grey = rigid part</div>';
+      else {
+        if (ch?.trunkParts.length) body += `<div class="sub">trunk resampled along the spine through ${esc(summariseBones(ch.trunkParts))} (crotch and shoulders carried)</div>`;
+        if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly — ${esc(groupCarried(ch.rigidParts))}</div>`;
+      }
+      if (params.colourBySection && !ch?.classicError)
+        body += '<div class="sub">colour = contour (bands alternate along each limb) · grey = carried skin</div>';
     } else {
       body = '<h2>three.js skinning (LBS)</h2><div class="sub">the source SkinnedMesh itself, for reference</div>';
     }
@@ -1192,7 +1237,7 @@ Object.assign(window, {
     criterion: () => builtCriterion,
     gcsBuilds: () => gcsBuilds,
     classicError: () => current?.classicError ?? null,
-    rigidParts: () => current?.rigidParts ?? [],
+    rigidParts: () => current?.rigidParts.map((p) => `${p.name}: ${p.reason}`) ?? [],
     readouts: () => collectReadouts(),
     views: () => viewRects(),
     time: () => current?.mixer.time ?? 0,
