@@ -268,15 +268,15 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       if (glm::length(dir) < 1e-6f * m.height && P.parent >= 0) dir = cj - rig.jointCentres[P.parent];
       P.direction = glm::length(dir) > 1e-6f * m.height ? glm::normalize(dir) : glm::vec3(0, 1, 0);
       if (childParts[j].empty()) {
-        P.reason = CLASSIC_LEAF;
+        P.reason = GCS_CLASSIC_LEAF;
       } else if (childParts[j].size() > 1) {
-        P.reason = CLASSIC_BRANCHING;
+        P.reason = GCS_CLASSIC_BRANCHING;
       } else {
         P.child = int32_t(childParts[j][0]);
         glm::vec3 bone = rig.jointCentres[P.child] - cj;
         P.length = glm::length(bone);
         if (!(P.length >= minBone)) {
-          P.reason = CLASSIC_TOO_SHORT;
+          P.reason = GCS_CLASSIC_TOO_SHORT;
         } else {
           P.candidate = P.resampled = true;
           P.axis = bone / P.length;
@@ -330,7 +330,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       P.length = glm::length(bone);
       P.axis = bone / P.length;
       P.candidate = P.resampled = true;
-      P.reason = CLASSIC_TRUNK;
+      P.reason = GCS_CLASSIC_TRUNK;
     }
     float longest = 0.0f;
     for (uint32_t j = 0; j < J; ++j)
@@ -471,7 +471,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // 4. Which parts are resampled, and where their tubes end. Rays decide (too many misses:
     // carried); then the boundary between the tubes and the carried triangles (those with a
     // carried vertex) is traced: each loop must be one ring around one tube's unshared end, or the
-    // part is carried (CLASSIC_SEAM); that end's contours start at the loop's innermost point.
+    // part is carried (GCS_CLASSIC_SEAM); that end's contours start just inside the loop.
     // Parts are only ever removed, so this ends.
     std::vector<std::vector<float>> hits(J);
     std::vector<uint8_t> dirty(J, 0);
@@ -644,7 +644,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           // carried neighbour is expected to be missing); all contours if none lies between them.
           float miss = inRangeRays ? 1.0f - float(inRangeHits) / float(inRangeRays)
                                    : 1.0f - float(hitCount) / float(mm * k);
-          if (hitCount == 0 || miss > kMaxMissShare) carry(j, CLASSIC_RAYS_MISS), any = true;
+          if (hitCount == 0 || miss > kMaxMissShare) carry(j, GCS_CLASSIC_RAYS_MISS), any = true;
         }
         if (any) continue;
         // Once the ray tests have settled: a part whose bone turns by more than 45° from its
@@ -656,7 +656,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
               m.parts[P.parent].child != int32_t(j))
             continue;
           if (glm::dot(P.axis, m.parts[P.parent].axis) >= kMaxBendCos) continue;
-          carry(j, CLASSIC_BENT);
+          carry(j, GCS_CLASSIC_BENT);
           any = true;
         }
         if (!any) break;
@@ -669,7 +669,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         ClassicPart& P = m.parts[j];
         if (!P.resampled || !P.split) continue;
         float before = P.cut;
-        if (!updateCut(j)) carry(j, CLASSIC_BRANCHING), recast = true;
+        if (!updateCut(j)) carry(j, GCS_CLASSIC_BRANCHING), recast = true;
         else if (P.cut != before || round == 0) dirty[j] = 1, recast = true;
       }
       if (recast) continue;
@@ -767,7 +767,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         if (!triCarried[t]) ++replaced[uint32_t(owner(group[rig.indices[3 * t]]))];
       bool any = false;
       for (uint32_t j = 0; j < J; ++j)
-        if (failed[j] || (m.parts[j].resampled && replaced[j] == 0)) carry(j, CLASSIC_SEAM), any = true;
+        if (failed[j] || (m.parts[j].resampled && replaced[j] == 0)) carry(j, GCS_CLASSIC_SEAM), any = true;
       if (any) continue;
       // Tube ends from the loops: just inside the innermost point of each loop (a flat loop
       // would otherwise leave a band of zero width).
@@ -789,7 +789,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         float hi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
         // (the ray test is not run again on the final span: the loops only trim the ends of a
         // tube whose rays already hit, and the contours are cast below)
-        if (!(hi - lo >= kMinTubeSpan)) carry(j, CLASSIC_SEAM), any = true;
+        if (!(hi - lo >= kMinTubeSpan)) carry(j, GCS_CLASSIC_SEAM), any = true;
         else P.tLo = lo, P.tHi = hi;
       }
       if (any) continue;

@@ -45,7 +45,7 @@ struct ClassicPart {
   uint8_t split = 0;
   float cut = 0.0f;
   bool resampled = false;    // candidate whose rays hit well enough
-  uint8_t reason = 0;        // why not resampled (ClassicRigidReason)
+  uint8_t reason = 0;        // why it is (not) resampled: a GcsClassicReason
   int32_t parent = -1;       // parent part joint or −1
   int32_t child = -1;        // the single child part joint (chain parts), or −1
   float length = 0.0f;
@@ -71,16 +71,6 @@ struct ClassicPart {
   float scale = 1.0f;        // uniform scale of S_joint (mesh-node transforms), applied to radii
 };
 
-enum ClassicRigidReason : uint8_t {
-  CLASSIC_RESAMPLED = 0,
-  CLASSIC_LEAF = 1,          // no child part (head, hands, feet, finger tips)
-  CLASSIC_BRANCHING = 2,     // several child parts (pelvis, chest, a hand with fingers)
-  CLASSIC_TOO_SHORT = 3,     // bone shorter than 3 % of the model height (incl. zero length)
-  CLASSIC_RAYS_MISS = 4,     // too many rays miss the part's own triangles (or none hits)
-  CLASSIC_BENT = 5,          // bone turned > 45° from its resampled parent's bone (a foot on a shank)
-  CLASSIC_SEAM = 6,          // its boundary with the carried mesh is not one ring around its bone
-  CLASSIC_TRUNK = 7          // resampled along the trunk; its branch region (crotch, shoulders) carried
-};
 
 class ClassicModel final : public Deformer {
  public:
