@@ -5,6 +5,7 @@
 //   node scripts/screenshot-demo.mjs            → docs/demo.png (the default: weights criterion),
 //                                                 docs/demo-sections.png (colour by section, 8 sections),
 //                                                 docs/demo-fox.png (the shipped Fox, all three views),
+//                                                 docs/demo-crowd.png (crowd mode: 64 humans, GPU backend),
 //                                                 docs/demo-classic.png (CesiumMan coloured by section / contour)
 //   node scripts/screenshot-demo.mjs --out DIR  → the same files in DIR
 //   node scripts/screenshot-demo.mjs --only demo-fox.png → only that one
@@ -47,6 +48,7 @@ try {
     { file: 'demo.png', query: '' },
     { file: 'demo-sections.png', query: '?colour=1&sections=8' },
     { file: 'demo-fox.png', query: '?model=fox&lbs=1' },
+    { file: 'demo-crowd.png', query: '?crowd=64&shadows=1', crowd: true },
     { file: 'demo-classic.png', query: '?model=cesiumman&colour=1' },
     ...(process.env.EXTRA ? [{ file: 'extra.png', query: process.env.EXTRA }] : []),
   ].filter((s) => !only || s.file === only);
@@ -61,6 +63,16 @@ try {
     await page.evaluate(() => window.__demo.idle());
     const message = await page.evaluate(() => window.__demo.error());
     if (message) throw new Error(`${shot.file}: the page says: ${message}`);
+    if (shot.crowd) {
+      // Crowd mode: let every character take a few steps, then hold the pose; the readout refreshes every 10 frames.
+      await page.waitForFunction(() => window.__crowd.frame() > 12, null, { timeout: 600000 });
+      await page.evaluate(() => window.__crowd.pause());
+      if (errors.length) throw new Error(`${shot.file}: page errors: ${errors.join('; ')}`);
+      await page.screenshot({ path: join(outDir, shot.file), timeout: 600000 }); // software rendering of the whole crowd
+      console.log('wrote', join(outDir, shot.file));
+      await page.close();
+      continue;
+    }
     // A stride of the walk with legs apart, then hold it so every view shows the same pose.
     await page.waitForFunction(() => window.__demo.time() > 0.9, null, { timeout: 60000 });
     await page.evaluate(() => window.__demo.pause(0.32));

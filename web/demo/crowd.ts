@@ -260,7 +260,7 @@ export async function startCrowd(): Promise<void> {
 
   const samples: { ms: number; bytes: number }[] = [];
   let frame = 0;
-  let smoothedMs = NaN, smoothedBytes = NaN;
+  let smoothedMs = NaN, smoothedBytes = NaN; // the readout's figures
   const waiters: { frames: number; resolve: (r: CrowdMeasure) => void; start: number }[] = [];
   const fmtBytes = (b: number) => (b >= 1e6 ? `${(b / 1e6).toFixed(2)} MB` : b >= 1e3 ? `${(b / 1e3).toFixed(1)} KB` : `${b.toFixed(0)} B`);
   const clock = new THREE.Timer();
@@ -296,8 +296,6 @@ export async function startCrowd(): Promise<void> {
     frame++;
     samples.push({ ms, bytes });
     if (samples.length > 240) samples.shift();
-    smoothedMs = Number.isNaN(smoothedMs) ? ms : 0.9 * smoothedMs + 0.1 * ms;
-    smoothedBytes = Number.isNaN(smoothedBytes) ? bytes : 0.9 * smoothedBytes + 0.1 * bytes;
     for (let k = waiters.length - 1; k >= 0; k--) {
       const w = waiters[k];
       if (frame - w.start >= w.frames) {
@@ -306,9 +304,13 @@ export async function startCrowd(): Promise<void> {
       }
     }
     if (frame % 10 === 1) {
-      const vertices = source.geometry.getAttribute('position').count;
+      // Medians of the last frames since the crowd was built (start-up uploads do not linger).
+      const m = measureLast(Math.min(samples.length, 60));
+      smoothedMs = m.msPerFrame;
+      smoothedBytes = m.bytesPerFrame;
+      const vertices = m.vertices;
       readout.innerHTML = `<b>${count}</b> characters × ${vertices.toLocaleString('en')} vertices · <b>${backend.toUpperCase()}</b> backend` +
-        `${params.smooth ? ' (smooth)' : ''}<br>skinning CPU <b>${smoothedMs.toFixed(2)} ms</b>/frame (${(smoothedMs / count * 1000).toFixed(1)} µs per character)` +
+        `${params.smooth ? ' (smooth)' : ''}<br>skinning CPU <b>${smoothedMs.toFixed(2)} ms</b>/frame (median) (${(smoothedMs / count * 1000).toFixed(1)} µs per character)` +
         ` · uploaded <b>${fmtBytes(smoothedBytes)}</b>/frame (${fmtBytes(smoothedBytes / count)} per character)` +
         `${note ? `<br><span class="criterion">${note}</span>` : ''}`;
     }
