@@ -63,12 +63,14 @@ glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
 // list: each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle
 // lies in the segment's angular span are tested. radius[r] = the outermost hit distance so far
 // (−1 before any hit; the caller resets it, so several triangle lists can be cast in turn).
-void castContour(const Rig& rig, const uint32_t* tris, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
+// corners: 3 positions per triangle, contiguous (gathered once per part: the rig's vertices are
+// scattered, and every contour of the part reads every triangle).
+void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
                  const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius) {
   const float step = 2.0f * kPi / float(k);
   for (uint32_t i = 0; i < triCount; ++i) {
-    const uint32_t* t = &rig.indices[size_t(tris[i]) * 3];
-    glm::vec3 p[3] = {rig.positions[t[0]] - O, rig.positions[t[1]] - O, rig.positions[t[2]] - O};
+    const glm::vec3* c = &corners[size_t(i) * 3];
+    glm::vec3 p[3] = {c[0] - O, c[1] - O, c[2] - O};
     float h[3] = {glm::dot(p[0], n), glm::dot(p[1], n), glm::dot(p[2], n)};
     bool neg0 = h[0] < 0.0f, neg1 = h[1] < 0.0f, neg2 = h[2] < 0.0f;
     if (neg0 == neg1 && neg1 == neg2) continue;
@@ -493,20 +495,24 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // triangles; a trunk part's also its continuing child's and its carried branch children's (its
     // tube runs through their skin). Counts the hits left after outliers, and those between joints.
     std::vector<float> probe;
+    std::vector<glm::vec3> corners;
     auto castPart = [&](uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist,
                         std::vector<float>& out, uint32_t& hitCount, uint32_t& inRangeHits, uint32_t& inRangeRays) {
       const ClassicPart& P = m.parts[j];
       out.assign(size_t(count) * k, -1.0f);  // no hit yet
+      corners.clear();
+      for (uint32_t x = 0; x < J; ++x) {
+        if (x != j && !(P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) continue;
+        for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i)
+          for (int e = 0; e < 3; ++e) corners.push_back(rig.positions[rig.indices[size_t(triList[i]) * 3 + e]]);
+      }
+      const uint32_t triCount = uint32_t(corners.size() / 3);
       for (uint32_t i = 0; i < count; ++i) {
         float t = P.tLo + (P.tHi - P.tLo) * float(i) / float(count - 1);
         glm::vec3 O, n, u;
         contourFrame(P, t, nProx, nDist, O, n, u);
         float* rad = &out[size_t(i) * k];
-        for (uint32_t x = 0; x < J; ++x) {
-          if (x != j && !(P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) continue;
-          castContour(rig, &triList[triFirst[x]], triFirst[x + 1] - triFirst[x], O, n, u, glm::cross(n, u), k,
-                      m.cosTable.data(), m.sinTable.data(), rad);
-        }
+        castContour(corners.data(), triCount, O, n, u, glm::cross(n, u), k, m.cosTable.data(), m.sinTable.data(), rad);
         uint32_t h = rejectOutliers(rad, k, scratch);
         hitCount += h;
         if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
