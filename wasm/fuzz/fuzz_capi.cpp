@@ -696,7 +696,8 @@ void checkStructure(Built& b, const RigInput& in) {
     for (uint32_t i = 0; i < I; ++i)
       CHECK(src[idx[i]] == in.indices[i], "output triangle index %u: rig vertex %u, the rig's triangle has %u", i,
             src[idx[i]], in.indices[i]);
-    CHECK(gcs_classic_part_count(d) == 0 && gcs_classic_parts(d) == nullptr && !gcs_classic_contour_of_vertex(d), "classic report on a non-classic deformer");
+    CHECK(gcs_classic_part_count(d) == 0 && gcs_classic_parts(d) == nullptr && !gcs_classic_contour_of_vertex(d) &&
+              !gcs_classic_source_of_vertex(d), "classic report on a non-classic deformer");
     CHECK(std::isnan(gcs_classic_detail_loss(d, 0)), "classic detail loss on a non-classic deformer");
     CHECK(gcs_classic_set_bulge(d, 1.0f) == 0, "set_bulge accepted on a non-classic deformer");
     checkRejected("set_bulge on a non-classic deformer", [](int c) { return c == GCS_ERR_INVALID_ARGUMENT; });
@@ -763,10 +764,15 @@ void checkStructure(Built& b, const RigInput& in) {
             p, e[2], e[3], N);
     }
     const int32_t* contourOf = gcs_classic_contour_of_vertex(d);
-    CHECK(contourOf != nullptr || N == 0, "classic contour of vertex is null");
-    for (uint32_t o = 0; contourOf && o < N; ++o)
+    const int32_t* sourceOf = gcs_classic_source_of_vertex(d);
+    CHECK((contourOf != nullptr && sourceOf != nullptr) || N == 0, "classic contour / source of vertex is null");
+    for (uint32_t o = 0; contourOf && sourceOf && o < N; ++o) {
       CHECK(contourOf[o] >= -1 && float(contourOf[o]) < statSections, "output vertex %u on contour %d of %g", o,
             contourOf[o], double(statSections));
+      // A vertex is resampled (on a contour) or a copy of a rig vertex, never both.
+      CHECK((contourOf[o] >= 0) == (sourceOf[o] < 0) && sourceOf[o] < int32_t(in.vertexCount),
+            "output vertex %u: contour %d, source %d", o, contourOf[o], sourceOf[o]);
+    }
     for (uint32_t which = 0; which < 3; ++which) {
       const float a = gcs_classic_detail_loss(d, which), again = gcs_classic_detail_loss(d, which);
       if (which == 2) {

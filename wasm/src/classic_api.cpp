@@ -72,6 +72,11 @@ const int32_t* gcs_classic_contour_of_vertex(const GcsDeformer* deformer) {
   return m && !m->contourOfVertex.empty() ? m->contourOfVertex.data() : nullptr;
 }
 
+const int32_t* gcs_classic_source_of_vertex(const GcsDeformer* deformer) {
+  const gcs::ClassicModel* m = asClassic(deformer);
+  return m && !m->sourceOfVertex.empty() ? m->sourceOfVertex.data() : nullptr;
+}
+
 float gcs_classic_detail_loss(const GcsDeformer* deformer, uint32_t which) {
   const gcs::ClassicModel* m = asClassic(deformer);
   return m ? m->detailLoss(which) : std::nanf("");

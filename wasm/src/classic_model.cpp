@@ -1049,6 +1049,9 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       for (uint32_t r = 0; r < k; ++r) m.contourOfVertex[m.contours[c].first + r] = int32_t(c);
     for (const ClassicCap& cap : m.caps)
       for (uint32_t r = 0; r <= k; ++r) m.contourOfVertex[cap.first + r] = int32_t(cap.contour);
+    m.sourceOfVertex.assign(m.vertexCount, -1);
+    for (uint32_t v = 0; v < rig.vertexCount; ++v)
+      if (outputOf[v] >= 0) m.sourceOfVertex[size_t(outputOf[v])] = int32_t(v);
     for (uint32_t g = 0; g < G; ++g)
       if (groupOutput[g] < 0 && owner(g) >= 0) {
         m.lossPoints.push_back(rig.positions[representative[g]]);

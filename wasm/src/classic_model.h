@@ -96,6 +96,7 @@ class ClassicModel final : public Deformer {
   std::vector<float> restPositions, restNormals;  // carried vertices, interleaved (+1 spare)
   std::vector<int32_t> report;             // partCount × 5 (see gcs_classic_parts)
   std::vector<int32_t> contourOfVertex;    // per output vertex: its contour, −1 for carried vertices
+  std::vector<int32_t> sourceOfVertex;     // per output vertex: the rig vertex it copies, −1 if resampled
   std::vector<uint32_t> reportJoints;      // parts in report order
   // Detail loss inputs: original vertices replaced by the tubes and bands (position, part).
   std::vector<glm::vec3> lossPoints;

@@ -567,7 +567,8 @@ function carrySurfaceAttributes(skin: SkinDeformer): void {
   const identity = new Float32Array(16 * d.jointCount);
   for (let j = 0; j < d.jointCount; j++) identity.set([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1], 16 * j);
   d.deform(identity); // the bind pose; the next update() poses it again
-  transferAttributes(skin.source.geometry, skin.mesh.geometry, d.positions.slice(), names);
+  const sourceOf = skin.currentMethod === 'classic' ? (d as ClassicDeformer).sourceOfVertex : undefined;
+  transferAttributes(skin.source.geometry, skin.mesh.geometry, d.positions.slice(), names, sourceOf);
 }
 
 function applyMaterials(): void {

@@ -24,11 +24,12 @@ export function attributesNeeded(material: THREE.Material | THREE.Material[]): s
 
 /**
  * Adds to `target` (restPositions: its vertices in the source's bind-pose mesh space) the
- * attributes `names` of `source`, each resampled vertex taking the values at the closest point
- * of the source's triangles. Attributes the source lacks, or the target has, are skipped.
- * Returns the names added.
+ * attributes `names` of `source`: a vertex that copies a source vertex (`sourceOf[o] >= 0`: the
+ * classic model's carried skin) takes that vertex's values, so its texture seams stay sharp; each
+ * resampled vertex takes the values at the closest point of the source's triangles. Attributes the
+ * source lacks, or the target has, are skipped. Returns the names added.
  */
-export function transferAttributes(source: THREE.BufferGeometry, target: THREE.BufferGeometry, restPositions: ArrayLike<number>, names: string[]): string[] {
+export function transferAttributes(source: THREE.BufferGeometry, target: THREE.BufferGeometry, restPositions: ArrayLike<number>, names: string[], sourceOf?: ArrayLike<number>): string[] {
   const attrs = names
     .filter((n) => source.getAttribute(n) && !target.getAttribute(n))
     .map((n) => ({ name: n, attr: source.getAttribute(n) as AnyAttribute }))
@@ -47,6 +48,11 @@ export function transferAttributes(source: THREE.BufferGeometry, target: THREE.B
   const outs = attrs.map((a) => ({ ...a, out: new Float32Array(n * a.attr.itemSize) }));
   const hit = { tri: -1, u: 0, v: 0, w: 0 };
   for (let o = 0; o < n; o++) {
+    const copy = sourceOf ? sourceOf[o] : -1;
+    if (copy >= 0) {
+      for (const { attr, out } of outs) for (let k = 0; k < attr.itemSize; k++) out[o * attr.itemSize + k] = attr.getComponent(copy, k);
+      continue;
+    }
     grid.closest(restPositions[3 * o], restPositions[3 * o + 1], restPositions[3 * o + 2], hit);
     if (hit.tri < 0) continue;
     const a = T[3 * hit.tri], b = T[3 * hit.tri + 1], c = T[3 * hit.tri + 2];

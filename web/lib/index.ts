@@ -594,6 +594,15 @@ export class ClassicDeformer extends Deformer {
     const ptr = this.gcs.core.gcs_classic_contour_of_vertex(h);
     return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
   }
+  /**
+   * For each output vertex, the rig vertex a carried vertex copies (take its texture coordinates
+   * and colours from there), or −1 for a resampled vertex. A copy (valid until the next rebuild).
+   */
+  get sourceOfVertex(): Int32Array {
+    const h = this.live();
+    const ptr = this.gcs.core.gcs_classic_source_of_vertex(h);
+    return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
+  }
   /** Resampling detail loss, % of model height: RMS and max distance of original vertices to the resampled surface. */
   get detailLoss(): { rms: number; max: number } {
     const h = this.live();

@@ -44,6 +44,7 @@ export interface CoreExports {
   gcs_classic_part_count(d: number): number;
   gcs_classic_parts(d: number): number;
   gcs_classic_contour_of_vertex(d: number): number;
+  gcs_classic_source_of_vertex(d: number): number;
   gcs_classic_detail_loss(d: number, which: number): number;
 }
 
@@ -96,7 +97,7 @@ const UNSIGNED_RESULTS = [
   'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
   'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
   'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
-  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex',
+  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
 ] as const;
 
 function unsignedResults(raw: CoreExports): CoreExports {
