@@ -557,8 +557,9 @@ function applyColourMode(skin: SkinDeformer): void {
 }
 
 /**
- * The classic model resamples the skin: its vertices get the source's texture coordinates (and
- * vertex colours) from the closest point of the source surface in the bind pose (transfer.ts).
+ * The classic model resamples the skin: its resampled vertices get the source's texture
+ * coordinates (and vertex colours) from the closest point of the source surface in the bind pose,
+ * its carried vertices their own source vertex's (transfer.ts).
  */
 function carrySurfaceAttributes(skin: SkinDeformer): void {
   const names = attributesNeeded(skin.source.material);
