@@ -4,12 +4,12 @@
 // criterion and the paper's (Y, axial), plain and smooth, on the default human's walk and run,
 // under a non-uniform scale too, and for every instance of a crowd at once. Bad input is a GcsError.
 import { beforeAll, describe, expect, test } from 'vitest';
-import * as THREE from 'three';
 import { GcsError, initGcsSkin, SectionTransforms, GPU_TEXELS_PER_SECTION, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
 import { sampleClip } from '../../web/lib/cli/gltf-node.js';
 import { identitySkin } from '../../web/lib/measure.js';
+import { maxDistance, scaledSkin as scaled } from '../helpers/skins.js';
 
 let gcs: GcsSkin;
 let human: Human;
@@ -75,25 +75,6 @@ function normalMatrix(m: Float64Array, smooth: boolean): Float64Array {
     const det = a(0, 0) * out[0] + a(0, 1) * out[1] + a(0, 2) * out[2];
     if (Math.abs(det) > 1e-30) { const k = Math.pow(Math.abs(det), 2 / 3); for (let i = 0; i < 9; i++) out[i] /= k; }
   }
-  return out;
-}
-
-function maxDistance(a: ArrayLike<number>, b: ArrayLike<number>, normalise = false): number {
-  let worst = 0;
-  for (let v = 0; v < a.length / 3; v++) {
-    let lb = 1;
-    if (normalise) lb = Math.hypot(b[3 * v], b[3 * v + 1], b[3 * v + 2]) || 1;
-    const d = Math.hypot(a[3 * v] - b[3 * v] / lb, a[3 * v + 1] - b[3 * v + 1] / lb, a[3 * v + 2] - b[3 * v + 2] / lb);
-    if (!(d <= worst)) worst = Number.isNaN(d) ? Infinity : d;
-  }
-  return worst;
-}
-
-/** Scales every skin matrix of a frame by a non-uniform scale about the origin (a scaled character node). */
-function scaled(skin: Float32Array, sx: number, sy: number, sz: number): Float32Array {
-  const out = new Float32Array(skin.length);
-  const s = new THREE.Matrix4().makeScale(sx, sy, sz), m = new THREE.Matrix4();
-  for (let j = 0; j < skin.length / 16; j++) out.set(m.fromArray(skin, 16 * j).premultiply(s).elements, 16 * j);
   return out;
 }
 

@@ -706,7 +706,8 @@ void checkStructure(Built& b, const RigInput& in) {
     CHECK(statSections == 0.0f && statParts == 0.0f && gcs_deformer_stat(d, GCS_STAT_ADJUSTED_SHARE) == 0.0f &&
               gcs_deformer_stat(d, GCS_STAT_ADJUSTED_SECTIONS) == 0.0f,
           "LBS/DQS stats %g %g", double(statSections), double(statParts));
-    CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d),
+    CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d) &&
+              !gcs_gcs_section_influences(d),
           "GCS introspection on LBS/DQS");
   }
   if (b.kind == GCS_KIND_GCS) {
@@ -738,7 +739,8 @@ void checkStructure(Built& b, const RigInput& in) {
   }
   if (b.kind == GCS_KIND_CLASSIC) {
     CHECK(src == nullptr, "classic source vertices not null");
-    CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d),
+    CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d) &&
+              !gcs_gcs_section_influences(d),
           "GCS introspection on classic");
     const uint32_t P = gcs_classic_part_count(d);
     const int32_t* parts = gcs_classic_parts(d);
@@ -876,6 +878,70 @@ struct Snapshot {
   }
 };
 
+// The joint-level GPU path (weights criterion): the static table names each section's joints (in
+// range, -1 past the last), weights ≥ 0 summing to 1, one joint exactly for a rigid core; the joint
+// poses of two instances are the rows of their S_j bit for bit and a finite unit quaternion; a
+// rejected call (0 instances, a wrong joint count, NaN in the last joint of the second instance)
+// writes nothing. Y / axial: no table, and compute_joint_poses is refused. `skins` holds two
+// instances, the second's last joint already NaN.
+void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skins) {
+  GcsDeformer* d = b.d;
+  const uint32_t S = b.sections, J = in.jointCount;
+  const float* table = gcs_gcs_section_influences(d);
+  std::vector<float> out(size_t(J) * 32, -7.0f);
+  if (b.c != GCS_CRITERION_WEIGHTS) {
+    CHECK(!table, "criterion %u has a joint-level table", b.c);
+    CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 1, out.data()) == 0, "compute_joint_poses took criterion %u", b.c);
+    checkRejected("compute_joint_poses(criterion)", [](int c) { return c == GCS_ERR_INVALID_ARGUMENT; });
+    return;
+  }
+  CHECK(table != nullptr, "no joint-level table for the weights criterion");
+  const float* info = gcs_gcs_section_info(d);
+  for (uint32_t s = 0; s < S; ++s) {
+    const float* e = &table[8 * size_t(s)];
+    uint32_t n = 0;
+    while (n < 4 && e[n] >= 0.0f) ++n;
+    CHECK(n >= 1, "section %u has no joint", s);
+    double sum = 0.0;
+    for (uint32_t k = 0; k < 4; ++k) {
+      if (k < n) {
+        CHECK(e[k] < float(J) && e[k] == std::floor(e[k]), "section %u joint %u is %g", s, k, double(e[k]));
+        CHECK(std::isfinite(e[4 + k]) && e[4 + k] >= 0.0f, "section %u weight %u is %g", s, k, double(e[4 + k]));
+        sum += e[4 + k];
+      } else {
+        CHECK(e[k] == -1.0f && e[4 + k] == 0.0f, "section %u slot %u past the last joint: (%g, %g)", s, k, double(e[k]),
+              double(e[4 + k]));
+      }
+    }
+    CHECK(std::fabs(sum - 1.0) < 1e-4, "section %u weights sum to %g", s, sum);
+    CHECK((n == 1) == (info[8 * size_t(s) + 4] == 2.0f), "section %u: %u joints, kind %g", s, n, double(info[8 * size_t(s) + 4]));
+  }
+  const size_t last = size_t(J) * 16 + 16 * size_t(J - 1) + 3;
+  const float broken = skins[last];
+  skins[last] = skins[3];  // both instances valid again
+  CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 2, out.data()) == 1, "compute_joint_poses rejected a valid frame");
+  checkOk("compute_joint_poses");
+  for (uint32_t k = 0; k < 2 * J; ++k) {
+    const float* o = &out[16 * size_t(k)];
+    const float* m = &skins[16 * size_t(k)];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        CHECK(std::memcmp(&o[4 * r + c], &m[4 * c + r], 4) == 0, "joint pose %u row %d col %d: %g, S has %g", k, r, c,
+              double(o[4 * r + c]), double(m[4 * c + r]));
+    const double len = std::sqrt(double(o[12]) * o[12] + double(o[13]) * o[13] + double(o[14]) * o[14] + double(o[15]) * o[15]);
+    CHECK(std::fabs(len - 1.0) < 1e-5, "joint pose %u quaternion length %g", k, len);
+  }
+  std::vector<float> kept(out);
+  CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 0, out.data()) == 0, "compute_joint_poses took 0 instances");
+  checkRejected("compute_joint_poses(0 instances)", [](int c) { return c == GCS_ERR_OUT_OF_RANGE; });
+  CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J + 1, 1, out.data()) == 0, "compute_joint_poses took a wrong joint count");
+  checkRejected("compute_joint_poses(joint count)", [](int c) { return c == GCS_ERR_LENGTH_MISMATCH; });
+  skins[last] = broken;
+  CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 2, out.data()) == 0, "compute_joint_poses took NaN");
+  checkRejected("compute_joint_poses(NaN)", [](int c) { return c == GCS_ERR_NON_FINITE; });
+  CHECK(std::memcmp(kept.data(), out.data(), out.size() * 4) == 0, "a rejected compute_joint_poses wrote its output");
+}
+
 // The GPU path (gcs_gcs_compute_sections): for two instances posed by this frame, the packed rows
 // are the section matrices gcs_deformer_deform just used, bit for bit; the output mesh is not
 // touched; a rejected call (no instances, a non-finite matrix in the second instance) writes
@@ -909,6 +975,7 @@ void checkGpuSections(const Built& b, const RigInput& in, const Frame& fr) {
   CHECK(gcs_gcs_compute_sections(d, skins.data(), J, 2, out.data()) == 0, "compute_sections took NaN");
   checkRejected("compute_sections(NaN)", [](int c) { return c == GCS_ERR_NON_FINITE; });
   CHECK(std::memcmp(kept.data(), out.data(), out.size() * 4) == 0, "a rejected compute_sections wrote its output");
+  checkJointPoses(b, in, skins);
   const uint32_t* other = gcs_gcs_blend_other(d);
   const float* factor = gcs_gcs_blend_factor(d);
   CHECK((other != nullptr) == (b.smooth != 0) && (factor != nullptr) == (b.smooth != 0), "blend data present %d, smooth %d",

@@ -280,6 +280,45 @@ const float* gcs_gcs_blend_factor(const GcsDeformer* deformer);
 int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
                              uint32_t instanceCount, float* out);
 
+/*
+ * The joint-level GPU path (weights criterion only; docs/gpu.md). Under the weights criterion a
+ * section's transform depends only on its joints' poses: a rigid core is exactly S_j; every other
+ * section is the dual-quaternion blend of its (at most 4) joints at its members' mean weights, the
+ * scale parts K_j = R_jᵀ·S_j blended linearly and applied first. So per frame only the joint poses
+ * change (J per instance), and the vertex shader blends each vertex's section from them and from a
+ * static per-section table (below), uploaded once.
+ *
+ * gcs_gcs_section_influences: sectionCount × 8 floats, the static table, two RGBA32F texels per
+ *   section: [joint 0, joint 1, joint 2, joint 3] (ids as floats, -1 past the last), then
+ *   [weight 0, weight 1, weight 2, weight 3] — the blend gcs_deformer_deform computes, in its order
+ *   (the first joint is the blend's hemisphere pivot). One joint (weight 1): a rigid core, moved by
+ *   S_j itself. Null for a GCS deformer built with the Y or axial criterion (their transforms
+ *   involve per-section fractions of parent/child motions: use gcs_gcs_compute_sections), and for
+ *   other deformers.
+ */
+#define GCS_GPU_TEXELS_PER_JOINT 4
+const float* gcs_gcs_section_influences(const GcsDeformer* deformer);
+/*
+ * Joint poses only, for instanceCount poses of the same model, packed for an RGBA32F texture; O(J)
+ * per instance, no per-section and no per-vertex work.
+ *   deformer       a GCS deformer built with the weights criterion (plain or smooth); else
+ *                  GCS_ERR_INVALID_ARGUMENT.
+ *   skinMatrices   instanceCount × jointCount × 16 floats, as gcs_gcs_compute_sections takes them; finite.
+ *   jointCount     must equal the rig's joint count.
+ *   instanceCount  1 .. GCS_MAX_INSTANCES; instanceCount · jointCount · 64 bytes must fit in 4 GiB
+ *                  (else GCS_ERR_OUT_OF_RANGE).
+ *   out            instanceCount × jointCount × GCS_GPU_TEXELS_PER_JOINT × 4 floats: joint j of instance
+ *                  k starts at texel (k · jointCount + j) · 4; texels 0, 1, 2 are the rows r of S_j
+ *                  (m[0][r], m[1][r], m[2][r], m[3][r]), copied bit for bit; texel 3 is the rotation R_j
+ *                  of S_j as a unit quaternion (x, y, z, w), the one gcs_deformer_deform splits S_j
+ *                  with (S_j = [R_j·K_j | t_j]; robust to uniform, non-uniform, mirrored and collapsed
+ *                  scales).
+ * The deformer's state is not changed. Nothing is allocated.
+ * Returns 1, or 0 with the error recorded (then nothing was written: every matrix is checked first).
+ */
+int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                                uint32_t instanceCount, float* out);
+
 
 /* ---------------------------------------------------------------- classic cross-sections */
 

@@ -239,6 +239,27 @@ const float* gcs_gcs_blend_factor(const GcsDeformer* d) {
   return g && g->settings.smooth ? g->blendF.data() : nullptr;
 }
 
+// The checks both GPU-path calls make before writing anything: pointers, counts, sizes (the input
+// and `outBytesPerInstance` per instance within 4 GiB) and every skin matrix finite.
+static bool validGpuInput(const gcs::GcsDeformerImpl& g, const float* skinMatrices, uint32_t jointCount,
+                          uint32_t instanceCount, const float* out, uint64_t outBytesPerInstance, uint32_t units,
+                          const char* unitName) {
+  if (!skinMatrices) return fail(GCS_ERR_INVALID_ARGUMENT, "the skin matrices are null");
+  if (!out) return fail(GCS_ERR_INVALID_ARGUMENT, "the output buffer is null");
+  if (jointCount != g.jointCount)
+    return fail(GCS_ERR_LENGTH_MISMATCH, "got %u skin matrices per instance, but the rig has %u joints", jointCount, g.jointCount);
+  if (instanceCount < 1 || instanceCount > GCS_MAX_INSTANCES)
+    return fail(GCS_ERR_OUT_OF_RANGE, "the instance count must be from 1 to %d; got %u", GCS_MAX_INSTANCES, instanceCount);
+  const uint64_t inFloats = uint64_t(instanceCount) * jointCount * 16;
+  if (uint64_t(instanceCount) * outBytesPerInstance > 0xffffffffull || inFloats * 4 > 0xffffffffull)
+    return fail(GCS_ERR_OUT_OF_RANGE, "%u instances of %u %s do not fit in 4 GiB of memory", instanceCount, units, unitName);
+  for (uint64_t i = 0; i < inFloats; ++i)
+    if (!std::isfinite(skinMatrices[i]))
+      return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u of instance %u contains NaN or infinity",
+                  uint32_t((i / 16) % jointCount), uint32_t(i / 16 / jointCount));
+  return true;
+}
+
 int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
                              uint32_t instanceCount, float* out) {
   gcs::clearError();
@@ -246,27 +267,43 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
   if (deformer->impl->kind() != GCS_KIND_GCS)
     return fail(GCS_ERR_INVALID_ARGUMENT, "section transforms exist only for GCS deformers");
   gcs::GcsDeformerImpl& g = *static_cast<gcs::GcsDeformerImpl*>(deformer->impl);
-  if (!skinMatrices) return fail(GCS_ERR_INVALID_ARGUMENT, "the skin matrices are null");
-  if (!out) return fail(GCS_ERR_INVALID_ARGUMENT, "the output buffer is null");
-  if (jointCount != g.jointCount)
-    return fail(GCS_ERR_LENGTH_MISMATCH, "got %u skin matrices per instance, but the rig has %u joints", jointCount, g.jointCount);
-  if (instanceCount < 1 || instanceCount > GCS_MAX_INSTANCES)
-    return fail(GCS_ERR_OUT_OF_RANGE, "the instance count must be from 1 to %d; got %u", GCS_MAX_INSTANCES, instanceCount);
-  const uint64_t S = g.sections.size();
-  const uint64_t outFloats = uint64_t(instanceCount) * S * 4 * GCS_GPU_TEXELS_PER_SECTION;
-  const uint64_t inFloats = uint64_t(instanceCount) * jointCount * 16;
-  if (outFloats * 4 > 0xffffffffull || inFloats * 4 > 0xffffffffull)
-    return fail(GCS_ERR_OUT_OF_RANGE, "%u instances of %u sections do not fit in 4 GiB of memory", instanceCount, uint32_t(S));
-  for (uint64_t i = 0; i < inFloats; ++i)
-    if (!std::isfinite(skinMatrices[i]))
-      return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u of instance %u contains NaN or infinity",
-                  uint32_t((i / 16) % jointCount), uint32_t(i / 16 / jointCount));
+  const uint32_t S = uint32_t(g.sections.size());
+  if (!validGpuInput(g, skinMatrices, jointCount, instanceCount, out, uint64_t(S) * 16 * GCS_GPU_TEXELS_PER_SECTION, S, "sections"))
+    return 0;
   const glm::mat4* skins = reinterpret_cast<const glm::mat4*>(skinMatrices);
   float* o = out;
   for (uint32_t k = 0; k < instanceCount; ++k) {
     g.computeSections(skins + size_t(k) * jointCount);
     for (const glm::mat4& m : g.sectionMatrices)
       for (int r = 0; r < 3; ++r, o += 4) o[0] = m[0][r], o[1] = m[1][r], o[2] = m[2][r], o[3] = m[3][r];
+  }
+  return 1;
+}
+
+const float* gcs_gcs_section_influences(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g && !g->influenceTable.empty() ? g->influenceTable.data() : nullptr;
+}
+
+int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                                uint32_t instanceCount, float* out) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  const gcs::GcsDeformerImpl* g = asGcs(deformer);
+  if (!g) return fail(GCS_ERR_INVALID_ARGUMENT, "joint poses are for GCS deformers (weights criterion) only");
+  if (g->settings.criterion != GCS_CRITERION_WEIGHTS)
+    return fail(GCS_ERR_INVALID_ARGUMENT,
+                "joint poses drive the weights criterion only; the Y and axial criteria need gcs_gcs_compute_sections");
+  if (!validGpuInput(*g, skinMatrices, jointCount, instanceCount, out, uint64_t(jointCount) * 16 * GCS_GPU_TEXELS_PER_JOINT,
+                     jointCount, "joints"))
+    return 0;
+  const glm::mat4* skins = reinterpret_cast<const glm::mat4*>(skinMatrices);
+  float* o = out;
+  for (uint64_t k = 0; k < uint64_t(instanceCount) * jointCount; ++k, o += 16) {
+    const glm::mat4 m = skins[k];
+    const glm::quat q = gcs::rotationOf(m);
+    for (int r = 0; r < 3; ++r) o[4 * r] = m[0][r], o[4 * r + 1] = m[1][r], o[4 * r + 2] = m[2][r], o[4 * r + 3] = m[3][r];
+    o[12] = q.x, o[13] = q.y, o[14] = q.z, o[15] = q.w;
   }
   return 1;
 }

@@ -129,6 +129,18 @@ void finishModel(GcsDeformerImpl& m) {
     info[6] = sec.alpha;
     info[7] = sec.beta;
   }
+  if (m.settings.criterion == GCS_CRITERION_WEIGHTS) {
+    m.influenceTable.assign(size_t(S) * 8, 0.0f);
+    for (uint32_t i = 0; i < S; ++i) {
+      const Section& sec = m.sections[i];
+      float* row = &m.influenceTable[size_t(i) * 8];
+      for (uint32_t k = 0; k < 4; ++k) {
+        const bool used = k < sec.influenceCount;
+        row[k] = used ? float(m.influences[sec.influenceFirst + k].joint) : -1.0f;
+        row[4 + k] = used ? m.influences[sec.influenceFirst + k].weight : 0.0f;
+      }
+    }
+  }
   m.poses.resize(m.jointCount);
   m.lastSkin.assign(m.jointCount, glm::mat4(1.0f));
   m.sectionMatrices.assign(S, glm::mat4(1.0f));

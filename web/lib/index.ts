@@ -561,10 +561,36 @@ export class GcsDeformer extends Deformer {
     if (!this.gcs.core.gcs_gcs_compute_sections(h, skinPtr, this.jointCount, instanceCount, outPtr))
       this.gcs.raise('computing the section transforms failed');
   }
+  /**
+   * Weights criterion: each section's blend, 8 floats per section (two RGBA32F texels: its joints,
+   * -1 past the last, then their weights; one joint = a rigid core), a copy; null for the Y and
+   * axial criteria. The static table of the joint-level GPU path (gcs_gcs_section_influences).
+   */
+  sectionInfluences(): Float32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_section_influences(this.live());
+    return ptr ? this.gcs.viewF32(ptr, this.sectionCount * 8).slice() : null;
+  }
+  /** True when the joint-level GPU path can drive this deformer (the weights criterion). */
+  get jointLevel(): boolean {
+    return this.gcs.core.gcs_gcs_section_influences(this.live()) !== 0;
+  }
+  /**
+   * The joint-level GPU path's per-frame work (weights criterion): joint poses only, for
+   * `instanceCount` poses at once, GPU_TEXELS_PER_JOINT RGBA32F texels per joint (the rows of S_j,
+   * then its rotation quaternion) at byte offset `outPtr`; `skinPtr` holds instanceCount × J × 16
+   * floats. No allocation.
+   */
+  computeJointPosesAt(skinPtr: number, instanceCount: number, outPtr: number): void {
+    const h = this.live();
+    if (!this.gcs.core.gcs_gcs_compute_joint_poses(h, skinPtr, this.jointCount, instanceCount, outPtr))
+      this.gcs.raise('computing the joint poses failed');
+  }
 }
 
 /** RGBA32F texels per GCS section in the GPU path's buffer (the rows of its affine 3×4 transform). */
 export const GPU_TEXELS_PER_SECTION = 3;
+/** RGBA32F texels per joint in the joint-level GPU path's buffer (the rows of S_j, its rotation quaternion). */
+export const GPU_TEXELS_PER_JOINT = 4;
 /** Most instances one computeSectionsAt call takes. */
 export const MAX_INSTANCES = 65536;
 
@@ -619,19 +645,19 @@ export class ClassicDeformer extends Deformer {
 
 /**
  * The GPU path's per-frame buffers for one GCS model and `instanceCount` poses of it (a crowd),
- * both in wasm memory: the skin matrices in (instanceCount × J × 16 floats) and the packed section
- * transforms out, `width × height` RGBA32F texels (section s of instance k at texel
- * (k·S + s)·3, rows of its affine 3×4; the tail past the last section is padding). A float texture
- * views `texels` as it is: nothing is copied. `compute()` is one wasm call for every instance.
- * Views are re-created when wasm memory grew (check `texels.buffer` against `gcs.memory.buffer`,
- * or just read the getters each frame). The deformer stays the caller's; `dispose()` frees only
- * these buffers.
+ * both in wasm memory: the skin matrices in (instanceCount × J × 16 floats) and the packed texels
+ * out, `width × height` RGBA32F texels, `texelsPerInstance` per instance (the tail past the last
+ * instance is padding). A float texture views `texels` as it is: nothing is copied. `compute()` is
+ * one wasm call for every instance. Views are re-created when wasm memory grew (check
+ * `texels.buffer` against `gcs.memory.buffer`, or just read the getters each frame). The deformer
+ * stays the caller's; `dispose()` frees only these buffers. See SectionTransforms and JointPoses.
  */
-export class SectionTransforms {
+export abstract class PoseTexels {
   readonly instanceCount: number;
-  readonly sectionCount: number;
   readonly jointCount: number;
-  /** Texture size in texels: width × height ≥ instanceCount × sectionCount × 3. */
+  /** RGBA32F texels per instance. */
+  readonly texelsPerInstance: number;
+  /** Texture size in texels: width × height ≥ instanceCount × texelsPerInstance. */
   readonly width: number;
   readonly height: number;
   private skinPtr: number;
@@ -639,18 +665,18 @@ export class SectionTransforms {
   private skinView: Float32Array;
   private texelView: Float32Array;
 
-  /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). */
-  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
+  /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). `unit`: texels per section or joint. */
+  protected constructor(readonly deformer: GcsDeformer, instanceCount: number, maxWidth: number, perInstance: () => number, unit: number) {
     if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
-    if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms need a GCS deformer (rig.buildGcs)');
+    if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms and joint poses need a GCS deformer (rig.buildGcs)');
     if (!Number.isInteger(instanceCount) || instanceCount < 1 || instanceCount > MAX_INSTANCES)
       throw new GcsError('OUT_OF_RANGE', `the instance count must be a whole number from 1 to ${MAX_INSTANCES}; got ${instanceCount}`);
-    if (!Number.isInteger(maxWidth) || maxWidth < GPU_TEXELS_PER_SECTION)
-      throw new GcsError('OUT_OF_RANGE', `maxWidth must be a whole number ≥ ${GPU_TEXELS_PER_SECTION}; got ${maxWidth}`);
+    if (!Number.isInteger(maxWidth) || maxWidth < unit)
+      throw new GcsError('OUT_OF_RANGE', `maxWidth must be a whole number ≥ ${unit}; got ${maxWidth}`);
     this.instanceCount = instanceCount;
-    this.sectionCount = deformer.sectionCount;
     this.jointCount = deformer.jointCount;
-    const texels = instanceCount * this.sectionCount * GPU_TEXELS_PER_SECTION;
+    this.texelsPerInstance = perInstance();
+    const texels = instanceCount * this.texelsPerInstance;
     this.width = Math.min(maxWidth, texels);
     this.height = Math.ceil(texels / this.width);
     const gcs = deformer.gcs;
@@ -661,7 +687,7 @@ export class SectionTransforms {
     this.texelPtr = gcs.core.gcs_alloc(texelBytes);
     if (!this.texelPtr) {
       gcs.core.gcs_free(this.skinPtr);
-      gcs.raise('out of memory for the section transforms');
+      gcs.raise('out of memory for the GPU texels');
     }
     this.skinView = gcs.viewF32(this.skinPtr, instanceCount * this.jointCount * 16);
     this.texelView = gcs.viewF32(this.texelPtr, this.width * this.height * 4);
@@ -670,11 +696,10 @@ export class SectionTransforms {
     this.skinView.fill(0);
     for (let k = 0; k < instanceCount * this.jointCount; k++)
       for (let c = 0; c < 4; c++) this.skinView[16 * k + 5 * c] = 1;
-    this.compute();
   }
 
   private live(): void {
-    if (!this.skinPtr) throw new GcsError('DISPOSED', 'these section transforms have been disposed');
+    if (!this.skinPtr) throw new GcsError('DISPOSED', 'these GPU texels have been disposed');
   }
 
   /** Every instance's skin matrices (instanceCount × J × 16 floats), a view on wasm memory: write them, then compute(). */
@@ -693,19 +718,22 @@ export class SectionTransforms {
     return this.texelView;
   }
 
-  /** Bytes of texels that hold section transforms of `instances` instances (what an upload of them moves). */
+  /** Bytes of texels that hold `instances` instances' data (what an upload of them moves). */
   bytesFor(instances = this.instanceCount): number {
-    return instances * this.sectionCount * GPU_TEXELS_PER_SECTION * 16;
+    return instances * this.texelsPerInstance * 16;
   }
 
-  /** Section transforms of the first `count` instances from their skins (default: all). No allocation. */
+  /** The texels of the first `count` instances from their skins (default: all). No allocation. */
   compute(count = this.instanceCount): void {
     this.live();
     if (!Number.isInteger(count) || count < 0 || count > this.instanceCount)
       throw new GcsError('OUT_OF_RANGE', `compute(count): count must be a whole number from 0 to ${this.instanceCount}; got ${count}`);
     if (count === 0) return;
-    this.deformer.computeSectionsAt(this.skinPtr, count, this.texelPtr);
+    this.run(this.skinPtr, count, this.texelPtr);
   }
+
+  /** @internal The wasm call. */
+  protected abstract run(skinPtr: number, count: number, outPtr: number): void;
 
   /** Frees the two buffers (not the deformer). Safe to call twice. */
   dispose(): void {
@@ -718,5 +746,43 @@ export class SectionTransforms {
 
   get disposed(): boolean {
     return this.skinPtr === 0;
+  }
+}
+
+/**
+ * The section-level GPU path's buffers (any criterion): section s of instance k at texel
+ * (k·S + s)·3, the rows of its affine 3×4 (gcs_gcs_compute_sections). See PoseTexels.
+ */
+export class SectionTransforms extends PoseTexels {
+  readonly sectionCount: number;
+
+  /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). */
+  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
+    super(deformer, instanceCount, maxWidth, () => deformer.sectionCount * GPU_TEXELS_PER_SECTION, GPU_TEXELS_PER_SECTION);
+    this.sectionCount = deformer.sectionCount;
+    this.compute();
+  }
+
+  protected run(skinPtr: number, count: number, outPtr: number): void {
+    this.deformer.computeSectionsAt(skinPtr, count, outPtr);
+  }
+}
+
+/**
+ * The joint-level GPU path's buffers (weights criterion only, else GcsError 'INVALID_ARGUMENT'):
+ * joint j of instance k at texel (k·J + j)·4, the rows of S_j then its rotation quaternion
+ * (gcs_gcs_compute_joint_poses); O(joints) per instance per frame. See PoseTexels.
+ */
+export class JointPoses extends PoseTexels {
+  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
+    super(deformer, instanceCount, maxWidth, () => {
+      if (!deformer.jointLevel) throw new GcsError('INVALID_ARGUMENT', 'joint poses drive the weights criterion only; the Y and axial criteria need SectionTransforms');
+      return deformer.jointCount * GPU_TEXELS_PER_JOINT;
+    }, GPU_TEXELS_PER_JOINT);
+    this.compute();
+  }
+
+  protected run(skinPtr: number, count: number, outPtr: number): void {
+    this.deformer.computeJointPosesAt(skinPtr, count, outPtr);
   }
 }
