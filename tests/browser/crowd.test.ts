@@ -1,6 +1,7 @@
 // The demo's crowd mode (?crowd=N) in headless Chromium: N characters drawn (GPU backend: one
 // instanced mesh, a handful of draw calls; CPU backend: one mesh each), each moving on its own,
-// the readouts on the page, the backend switch, and no page or WebGL error.
+// the readouts on the page, the bytes each GPU path uploads (joint poses by default, section
+// transforms on request), the backend switch, and no page or WebGL error.
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
 import { analyse, launchChromium, skipReason, startDemo, type DemoServer } from './harness.js';
@@ -8,10 +9,10 @@ import { analyse, launchChromium, skipReason, startDemo, type DemoServer } from 
 const reason = skipReason();
 if (reason) console.log(reason);
 
-interface Measure { characters: number; backend: string; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
+interface Measure { characters: number; backend: string; path: string | null; joints: number; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
 interface CrowdHook {
   frame(): number; count(): number; backend(): string; drawn(): number; drawCalls(): number; readout(): string;
-  set(n: number, backend?: string): void; measure(frames: number): Promise<Measure>; pause(t?: number): void;
+  set(n: number, backend?: string, path?: string): void; measure(frames: number): Promise<Measure>; pause(t?: number): void;
 }
 declare global { interface Window { __crowd: CrowdHook } }
 
@@ -52,11 +53,13 @@ describe.skipIf(!!reason)('crowd mode', () => {
     // Ground + the crowd's one instanced mesh (no shadows by default).
     expect(await page.evaluate(() => window.__crowd.drawCalls())).toBeLessThanOrEqual(3);
     const gpu = await page.evaluate(() => window.__crowd.measure(4));
-    console.log(`GPU backend, 24 characters: ${gpu.msPerFrame.toFixed(3)} ms skinning CPU per frame, ${gpu.bytesPerFrame} bytes uploaded per frame (${gpu.sections} sections)`);
-    // The frame uploads the section texture: 24 × sections × 48 bytes (+ the padding of its last row), nothing per vertex.
-    expect(gpu.bytesPerFrame).toBeGreaterThanOrEqual(24 * gpu.sections * 48);
-    expect(gpu.bytesPerFrame).toBeLessThan(24 * gpu.sections * 48 + 2048 * 16);
-    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/24 characters .*GPU backend.*ms\/frame.*uploaded/);
+    console.log(`GPU backend (joint poses), 24 characters: ${gpu.msPerFrame.toFixed(3)} ms skinning CPU per frame, ${gpu.bytesPerFrame} bytes uploaded per frame (${gpu.joints} joints, ${gpu.sections} sections)`);
+    expect(gpu.path).toBe('joints');
+    // The frame uploads the joint poses: 24 × joints × 64 bytes (+ the padding of its last row), nothing per section or vertex.
+    expect(gpu.bytesPerFrame).toBeGreaterThanOrEqual(24 * gpu.joints * 64);
+    expect(gpu.bytesPerFrame).toBeLessThan(24 * gpu.joints * 64 + 2048 * 16);
+    expect(gpu.bytesPerFrame / 24).toBeLessThanOrEqual(8 * 1024); // the issue's target
+    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/24 characters .*GPU backend \(joint poses\).*ms\/frame.*uploaded/);
     // Every character is on screen and moving: pixels of the skin colour, changing between frames.
     const region = { x: 0, y: 0, width: 1280 - 300, height: 720 };
     const a = await page.screenshot();
@@ -66,6 +69,15 @@ describe.skipIf(!!reason)('crowd mode', () => {
     console.log(`crowd pixels: ${(100 * stats.skin).toFixed(1)} % skin colour, ${(100 * stats.changed).toFixed(1)} % changed in 3 frames`);
     expect(stats.skin).toBeGreaterThan(0.02);
     expect(stats.changed).toBeGreaterThan(0.005);
+    // The section-level path: the section texture, 24 × sections × 48 bytes (+ padding).
+    await page.evaluate(() => window.__crowd.set(24, 'gpu', 'sections'));
+    await page.waitForFunction(() => window.__crowd.frame() > 1);
+    const sections = await page.evaluate(() => window.__crowd.measure(3));
+    console.log(`GPU backend (section transforms), 24 characters: ${sections.msPerFrame.toFixed(3)} ms, ${sections.bytesPerFrame} bytes per frame`);
+    expect(sections.path).toBe('sections');
+    expect(sections.bytesPerFrame).toBeGreaterThanOrEqual(24 * sections.sections * 48);
+    expect(sections.bytesPerFrame).toBeLessThan(24 * sections.sections * 48 + 2048 * 16);
+    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/GPU backend \(section transforms\)/);
     // The CPU backend: one mesh per character, the vertex buffers uploaded every frame.
     await page.evaluate(() => window.__crowd.set(6, 'cpu'));
     await page.waitForFunction(() => window.__crowd.backend() === 'cpu' && window.__crowd.frame() > 0);
@@ -82,7 +94,8 @@ describe.skipIf(!!reason)('crowd mode', () => {
     const { page, errors } = await open('?crowd=300&smooth=1&vertices=2000', { width: 480, height: 270 });
     expect(await page.evaluate(() => window.__crowd.drawn())).toBe(300);
     const m = await page.evaluate(() => window.__crowd.measure(2));
-    expect(m.bytesPerFrame).toBeLessThan(300 * m.sections * 48 + 2048 * 16);
+    expect(m.path).toBe('joints');
+    expect(m.bytesPerFrame).toBeLessThan(300 * m.joints * 64 + 2048 * 16);
     expect(errors).toEqual([]);
     await page.close();
   }, 300000);

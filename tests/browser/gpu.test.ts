@@ -2,8 +2,10 @@
 // read back from an RGBA32F render target (tests/browser/gpu-fixture), equals the CPU backend's
 // positions within 1e-5 of the character's height on the same frames — the default criterion,
 // plain and smooth, on the default human and on CesiumMan and Soldier from ../shared/models (skipped
-// with the reason printed when absent) — and the character drawn by its own patched material
-// looks the same as on the CPU backend.
+// with the reason printed when absent), on both GPU paths: 'joints' (the default for this
+// criterion: the shader blends every section from the joint poses) and 'sections' (section
+// transforms computed in wasm) — and the character drawn by its own patched material looks the
+// same as on the CPU backend.
 import { existsSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
@@ -54,20 +56,23 @@ afterAll(async () => {
 });
 
 interface Result {
-  skins: number; backends: string[]; notes: string[]; height: number; positionError: number; normalError: number;
+  skins: number; backends: string[]; paths: string[]; notes: string[]; height: number; positionError: number; normalError: number;
   motion: number; vertices: number; frames: number; pixelDiff: number[]; coverage: number; pixelMotion: number; extColorBufferFloat: boolean;
 }
 
-async function check(model: string, smooth: boolean, times: number[], clip?: string): Promise<Result> {
-  return page!.evaluate(([m, s, t, c]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string): Promise<Result> } })
-    .__gpu.check(m as string, { smooth: s }, t as number[], c as string | undefined), [model, smooth, times, clip] as const);
+type Path = 'joints' | 'sections';
+
+async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path): Promise<Result> {
+  return page!.evaluate(([m, s, t, c, p]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string): Promise<Result> } })
+    .__gpu.check(m as string, { smooth: s }, t as number[], c as string | undefined, p as string), [model, smooth, times, clip, path] as const);
 }
 
-function expectEqual(r: Result, label: string): void {
+function expectEqual(r: Result, label: string, path: Path): void {
   console.log(`${label}: ${r.skins} skin(s), ${r.vertices} vertices, ${r.frames} frames; GPU − CPU positions ≤ ${r.positionError.toExponential(2)} of the height ` +
     `(the frames move the skin up to ${r.motion.toFixed(3)} of it), normals ≤ ${r.normalError.toExponential(2)}; pixels differing ${r.pixelDiff.map((x) => (100 * x).toFixed(3) + ' %').join(', ')} (character covers ${(100 * r.coverage).toFixed(1)} %; ${(100 * r.pixelMotion).toFixed(1)} % change between frames)`);
   expect(r.extColorBufferFloat).toBe(true);
   expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+  expect(r.paths.every((p) => p === path)).toBe(true);
   expect(r.motion).toBeGreaterThan(0.05); // the frames bend the character: a comparison in the bind pose would prove nothing
   expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
   expect(r.normalError).toBeLessThan(NORMAL_TOLERANCE);
@@ -83,17 +88,20 @@ const SHARED = [
 ];
 
 describe.skipIf(!!reason)('GPU backend = CPU backend (headless Chromium)', () => {
-  for (const smooth of [false, true]) {
-    test(`default human, weights criterion, ${smooth ? 'smooth' : 'plain'}`, async () => {
-      expectEqual(await check('human', smooth, [0.15, 0.45, 0.8], 'run'), `human ${smooth ? 'smooth' : 'plain'}`);
-    });
-    for (const m of SHARED) {
-      const path = join(MODELS_DIR, m.file);
-      const missing = existsSync(path) ? '' : `skipped: ${path} is absent (the shared test models are not on this machine)`;
-      if (missing) console.log(missing);
-      test.skipIf(!!missing)(`${m.file}, weights criterion, ${smooth ? 'smooth' : 'plain'}`, async () => {
-        expectEqual(await check(`/@fs${path}`, smooth, m.times, m.clip), `${m.file} ${smooth ? 'smooth' : 'plain'}`);
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    for (const smooth of [false, true]) {
+      const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
+      test(`default human, weights criterion, ${mode}`, async () => {
+        expectEqual(await check('human', smooth, [0.15, 0.45, 0.8], 'run', gpuPath), `human ${mode}`, gpuPath);
       });
+      for (const m of SHARED) {
+        const path = join(MODELS_DIR, m.file);
+        const missing = existsSync(path) ? '' : `skipped: ${path} is absent (the shared test models are not on this machine)`;
+        if (missing) console.log(missing);
+        test.skipIf(!!missing)(`${m.file}, weights criterion, ${mode}`, async () => {
+          expectEqual(await check(`/@fs${path}`, smooth, m.times, m.clip, gpuPath), `${m.file} ${mode}`, gpuPath);
+        });
+      }
     }
   }
 });

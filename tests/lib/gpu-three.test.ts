@@ -1,6 +1,7 @@
 // The GPU backend of the three.js adapter, in node (no WebGL here: what the shader computes is
 // checked in headless Chromium, tests/browser/gpu.test.ts): the geometry is the bind pose plus the
-// static section data, uploaded once; update() computes only the section texture; materials are
+// static section data, uploaded once; update() computes only the per-frame texture (the joint
+// poses on the default 'joints' path, the section transforms on the 'sections' path); materials are
 // patched clones (shadows too); unsupported methods and materials fall back to the CPU and say
 // why; raycasts hit the deformed skin; rebuilds switch backends; dispose frees.
 import { beforeAll, describe, expect, test } from 'vitest';
@@ -11,7 +12,7 @@ import { GcsCharacter, SkinDeformer } from '../../web/lib/three.js';
 import { gpuMaterialSupport, patchVertexShader } from '../../web/lib/gpu.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
 import { bakeClip, GcsCrowd } from '../../web/lib/crowd.js';
-import { SectionTransforms } from '../../web/lib/index.js';
+import { JointPoses, SectionTransforms } from '../../web/lib/index.js';
 
 let gcs: GcsSkin;
 let human: Human;
@@ -37,23 +38,28 @@ describe('GPU backend (three.js adapter)', () => {
     for (const name of ['standard', 'physical', 'lambert', 'phong', 'basic', 'toon', 'matcap', 'normal', 'depth', 'distance'] as const) {
       const src = THREE.ShaderLib[name].vertexShader;
       for (const smooth of [false, true]) {
-        const out = patchVertexShader(src, smooth);
-        expect(out).not.toContain('#include <skinning_vertex>');
-        expect(out).not.toContain('#include <skinbase_vertex>');
-        expect(out).toContain('gcsRows');
-        expect(out.startsWith('#define GCS_SMOOTH')).toBe(smooth);
+        for (const path of ['sections', 'joints'] as const) {
+          const out = patchVertexShader(src, smooth, path);
+          expect(out).not.toContain('#include <skinning_vertex>');
+          expect(out).not.toContain('#include <skinbase_vertex>');
+          expect(out).toContain(path === 'joints' ? 'gcsSectionBlend' : 'gcsRows');
+          expect(out).not.toContain(path === 'joints' ? 'gcsRows' : 'gcsSectionBlend');
+          expect(out.startsWith('#define GCS_SMOOTH')).toBe(smooth);
+        }
       }
     }
     expect(() => patchVertexShader('void main() { gl_Position = vec4(0.0); }', false)).toThrow(GcsError);
+    expect(() => patchVertexShader(THREE.ShaderLib.standard.vertexShader, false, 'vertices' as 'joints')).toThrow(GcsError);
     expect(gpuMaterialSupport(new THREE.MeshStandardMaterial())).toBeNull();
     expect(gpuMaterialSupport(new THREE.ShaderMaterial())).toMatch(/custom shader/);
   });
 
-  test('the bind pose and section data are uploaded once; a frame moves only the section texture', () => {
+  test('the bind pose and section data are uploaded once; a frame moves only the joint poses (default path)', () => {
     const { mesh, group, mixer } = walking(0.3);
     const character = new GcsCharacter(gcs, group, { backend: 'gpu' });
     expect(character.backend).toBe('gpu');
     const skin = character.skins[0];
+    expect(skin.gpuPath).toBe('joints');
     expect(skin.backendNote).toBe('');
     const g = skin.mesh.geometry;
     const position = g.getAttribute('position') as THREE.BufferAttribute;
@@ -67,24 +73,60 @@ describe('GPU backend (three.js adapter)', () => {
     // The material is a patched clone of the source's; shadows have patched depth materials.
     expect(skin.mesh.material).not.toBe(mesh.material);
     expect((skin.mesh.material as THREE.Material).type).toBe((mesh.material as THREE.Material).type);
-    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-plain');
-    expect(skin.mesh.customDepthMaterial?.customProgramCacheKey()).toContain('gcs-plain');
-    expect(skin.mesh.customDistanceMaterial?.customProgramCacheKey()).toContain('gcs-plain');
+    for (const m of [skin.mesh.material as THREE.Material, skin.mesh.customDepthMaterial!, skin.mesh.customDistanceMaterial!])
+      expect(m.customProgramCacheKey()).toContain('gcs-plain-joints');
     const sections = skin.gpuSections!;
-    const S = skin.deformer.sectionCount;
-    expect(skin.bytesPerFrame).toBe(sections.transforms.width * sections.transforms.height * 16);
-    expect(skin.bytesPerFrame).toBeLessThan(S * 48 + 2048 * 16);
-    const positionVersion = position.version, textureVersion = sections.texture.version;
+    const J = skin.deformer.jointCount;
+    expect(sections.path).toBe('joints');
+    // One row of J × 4 texels: 64 bytes per joint (19 joints: 1,216 bytes), whatever the section count.
+    expect(skin.bytesPerFrame).toBe(J * 64);
+    expect(sections.uniforms.gcsJoints!.value).toBe(sections.texture);
+    expect(sections.uniforms.gcsTable!.value).toBe(sections.table);
+    const table = sections.table!.image.data as Float32Array;
+    expect(Array.from(table.subarray(0, skin.deformer.sectionCount * 8))).toEqual(Array.from((skin.deformer as import('../../web/lib/index.js').GcsDeformer).sectionInfluences()!));
+    const positionVersion = position.version, textureVersion = sections.texture.version, tableVersion = sections.table!.version;
     mixer.setTime(0.6);
     character.update();
     expect(position.version).toBe(positionVersion);
     expect(sections.texture.version).toBe(textureVersion + 1);
-    // The texture views wasm memory (no copy) and holds this frame's section transforms.
+    expect(sections.table!.version).toBe(tableVersion); // static
+    // The texture views wasm memory (no copy) and holds this frame's joint poses: the rows of S_j.
+    const data = sections.texture.image.data as Float32Array;
+    expect(data.buffer).toBe(gcs.memory.buffer);
+    const S = (skin as unknown as { skin: Float32Array }).skin; // this frame's S_j
+    for (let j = 0; j < J; j++) for (let r = 0; r < 3; r++) for (let c = 0; c < 4; c++) expect(data[16 * j + 4 * r + c]).toBe(S[16 * j + 4 * c + r]);
+    character.dispose();
+  });
+
+  test('the section-level path on request and for the paper criteria: a frame moves only the section texture', () => {
+    const { group, mixer } = walking(0.3);
+    const character = new GcsCharacter(gcs, group, { backend: 'gpu', gpuPath: 'sections' });
+    const skin = character.skins[0];
+    expect(skin.gpuPath).toBe('sections');
+    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-plain-sections');
+    const sections = skin.gpuSections!;
+    expect(sections.table).toBeNull();
+    const S = skin.deformer.sectionCount;
+    expect(skin.bytesPerFrame).toBe(sections.transforms.width * sections.transforms.height * 16);
+    expect(skin.bytesPerFrame).toBeGreaterThanOrEqual(S * 48);
+    expect(skin.bytesPerFrame).toBeLessThan(S * 48 + 2048 * 16);
+    const textureVersion = sections.texture.version;
+    mixer.setTime(0.6);
+    character.update();
+    expect(sections.texture.version).toBe(textureVersion + 1);
     const data = sections.texture.image.data as Float32Array;
     expect(data.buffer).toBe(gcs.memory.buffer);
     skin.deformer.deform((skin as unknown as { skin: Float32Array }).skin); // this frame's S_j, on the CPU
     const m = (skin.deformer as import('../../web/lib/index.js').GcsDeformer).sectionMatrices();
     for (let s = 0; s < S; s += 7) for (let r = 0; r < 3; r++) for (let c = 0; c < 4; c++) expect(data[12 * s + 4 * r + c]).toBe(m[16 * s + 4 * c + r]);
+    // Back to 'auto': the joint-level path; the paper's criteria have only the section-level one.
+    character.rebuild('gcs', { gpuPath: 'auto' });
+    expect(skin.gpuPath).toBe('joints');
+    character.rebuild('gcs', { gcs: { criterion: 'y' } });
+    expect(skin.gpuPath).toBe('sections');
+    expect(() => character.rebuild('gcs', { gpuPath: 'joints' })).toThrow(GcsError); // 'y' has no joint-level path
+    expect(skin.gpuPath).toBe('sections'); // unchanged
+    expect(() => character.rebuild('gcs', { gpuPath: 'vertices' as 'joints' })).toThrow(GcsError);
     character.dispose();
   });
 
@@ -149,39 +191,51 @@ describe('GPU backend (three.js adapter)', () => {
     character.dispose();
   });
 
-  test('a crowd: one instanced mesh, every instance its own pose, one wasm call and one texture per frame', () => {
-    const { mesh } = walking(0);
-    const N = 5;
-    const crowd = new GcsCrowd(gcs, mesh, N, { gcs: { smooth: true } });
-    expect(crowd.mesh).toBeInstanceOf(THREE.InstancedMesh);
-    expect(crowd.mesh.count).toBe(N);
-    expect((crowd.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-smooth');
-    const S = crowd.deformer.sectionCount;
-    expect(crowd.bytesPerFrame).toBe(crowd.sections.transforms.width * crowd.sections.transforms.height * 16);
-    expect(crowd.bytesPerFrame).toBeLessThan(N * S * 48 + 2048 * 16);
-    const walk = bakeClip(mesh, human.clips.find((c) => c.name === 'walk')!, 30);
-    expect(walk.frames).toBe(Math.round(walk.duration * 30));
-    const times = [0, 0.21, 0.5, -0.3, 7.9];
-    times.forEach((t, i) => crowd.setBakedPose(i, walk, t));
-    const version = crowd.sections.texture.version;
-    crowd.update();
-    expect(crowd.sections.texture.version).toBe(version + 1);
-    // Instance i's texels are the section transforms of its own pose (the baked frame at its time).
-    const one = new SectionTransforms(crowd.deformer, 1);
-    const J = crowd.jointCount, S12 = S * 12;
-    const all = crowd.sections.transforms.texels;
-    times.forEach((t, i) => {
-      let f = Math.floor(t * walk.fps) % walk.frames;
-      if (f < 0) f += walk.frames;
-      one.skins.set(walk.data.subarray(f * J * 16, (f + 1) * J * 16));
-      one.compute();
-      expect(Array.from(all.subarray(i * S12, (i + 1) * S12))).toEqual(Array.from(one.texels.subarray(0, S12)));
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    test(`a crowd (${gpuPath} path): one instanced mesh, every instance its own pose, one wasm call and one texture per frame`, () => {
+      const { mesh } = walking(0);
+      const N = 5;
+      const crowd = new GcsCrowd(gcs, mesh, N, { gcs: { smooth: true }, gpuPath: gpuPath === 'joints' ? undefined : gpuPath });
+      expect(crowd.sections.path).toBe(gpuPath);
+      expect(crowd.mesh).toBeInstanceOf(THREE.InstancedMesh);
+      expect(crowd.mesh.count).toBe(N);
+      expect((crowd.mesh.material as THREE.Material).customProgramCacheKey()).toContain(`gcs-smooth-${gpuPath}`);
+      const S = crowd.deformer.sectionCount, J = crowd.jointCount;
+      const perInstance = gpuPath === 'joints' ? J * 16 : S * 12; // floats
+      expect(crowd.sections.transforms.texelsPerInstance * 4).toBe(perInstance);
+      expect(crowd.bytesPerFrame).toBe(crowd.sections.transforms.width * crowd.sections.transforms.height * 16);
+      expect(crowd.bytesPerFrame).toBeLessThan(N * perInstance * 4 + 2048 * 16);
+      const walk = bakeClip(mesh, human.clips.find((c) => c.name === 'walk')!, 30);
+      expect(walk.frames).toBe(Math.round(walk.duration * 30));
+      const times = [0, 0.21, 0.5, -0.3, 7.9];
+      times.forEach((t, i) => crowd.setBakedPose(i, walk, t));
+      const version = crowd.sections.texture.version;
+      crowd.update();
+      expect(crowd.sections.texture.version).toBe(version + 1);
+      // Instance i's texels are those of its own pose (the baked frame at its time).
+      const one = gpuPath === 'joints' ? new JointPoses(crowd.deformer, 1) : new SectionTransforms(crowd.deformer, 1);
+      const all = crowd.sections.transforms.texels;
+      times.forEach((t, i) => {
+        let f = Math.floor(t * walk.fps) % walk.frames;
+        if (f < 0) f += walk.frames;
+        one.skins.set(walk.data.subarray(f * J * 16, (f + 1) * J * 16));
+        one.compute();
+        expect(Array.from(all.subarray(i * perInstance, (i + 1) * perInstance))).toEqual(Array.from(one.texels.subarray(0, perInstance)));
+      });
+      expect(Array.from(all.subarray(0, perInstance))).not.toEqual(Array.from(all.subarray(perInstance, 2 * perInstance)));
+      one.dispose();
+      expect(() => crowd.offsetOf(N)).toThrow(GcsError);
+      expect(() => new GcsCrowd(gcs, mesh, 0)).toThrow(GcsError);
+      crowd.dispose();
+      expect(() => crowd.update()).toThrow(GcsError);
     });
-    expect(Array.from(all.subarray(0, S12))).not.toEqual(Array.from(all.subarray(S12, 2 * S12)));
-    one.dispose();
-    expect(() => crowd.offsetOf(N)).toThrow(GcsError);
-    expect(() => new GcsCrowd(gcs, mesh, 0)).toThrow(GcsError);
+  }
+
+  test('a crowd of a paper criterion runs the section-level path; asking it for joints is a GcsError', () => {
+    const { mesh } = walking(0);
+    const crowd = new GcsCrowd(gcs, mesh, 2, { gcs: { criterion: 'axial' } });
+    expect(crowd.sections.path).toBe('sections');
     crowd.dispose();
-    expect(() => crowd.update()).toThrow(GcsError);
+    expect(() => new GcsCrowd(gcs, mesh, 2, { gcs: { criterion: 'y' }, gpuPath: 'joints' })).toThrow(GcsError);
   });
 });

@@ -1,11 +1,12 @@
 // The demo's crowd mode (?crowd=N): N copies of the default human (17 k vertices), each walking or
 // running at its own phase, deformed by GCS on the GPU backend (one GcsCrowd: one instanced draw,
-// one section texture) or on the CPU backend (one wasm deformer and one mesh per character, as
-// GcsCharacter does), switchable. On screen: the CPU time of a frame's skinning (posing every
+// one per-frame texture: the joint poses, or on the section-level path the section transforms) or
+// on the CPU backend (one wasm deformer and one mesh per character, as GcsCharacter does), switchable. On screen: the CPU time of a frame's skinning (posing every
 // character + section transforms or vertex deformation; rendering excluded) and the bytes the
 // frame uploads to the GPU, counted on the WebGL calls themselves.
 //
-// URL: ?crowd=N (1 … 500; default 100) &backend=gpu|cpu &smooth=1 &shadows=1 &paused=1
+// URL: ?crowd=N (1 … 500; default 100) &backend=gpu|cpu &path=joints|sections (the GPU path)
+//      &smooth=1 &shadows=1 &paused=1
 //      &vertices=V (the human's vertex count, default 17,023)
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -22,6 +23,8 @@ export const MAX_CPU_CROWD = 200;
 const SPACING = 1.1;
 
 type Backend = 'gpu' | 'cpu';
+type Path = 'joints' | 'sections';
+const PATH_NAMES: Record<Path, string> = { joints: 'joint poses', sections: 'section transforms' };
 const query = new URLSearchParams(location.search);
 
 /** True when the page was opened with ?crowd. */
@@ -141,6 +144,7 @@ export async function startCrowd(): Promise<void> {
   const params = {
     characters: clampCount(Number(query.get('crowd') || 100)),
     backend: (query.get('backend') === 'cpu' ? 'cpu' : 'gpu') as Backend,
+    path: (query.get('path') === 'sections' ? 'sections' : 'joints') as Path,
     smooth: query.get('smooth') === '1',
     shadows: query.get('shadows') === '1',
     paused: query.get('paused') === '1',
@@ -217,7 +221,7 @@ export async function startCrowd(): Promise<void> {
     walkers = Array.from({ length: count }, (_, i) => ({ clip: i % 3 === 2 ? 1 : 0, phase: random() * 4, speed: 0.85 + 0.3 * random() }));
     const p = new THREE.Vector3();
     if (backend === 'gpu') {
-      gpuCrowd = new GcsCrowd(gcs, source, count, { gcs: { smooth: params.smooth } });
+      gpuCrowd = new GcsCrowd(gcs, source, count, { gcs: { smooth: params.smooth }, gpuPath: params.path });
       gpuCrowd.mesh.castShadow = true;
       for (let i = 0; i < count; i++) gpuCrowd.mesh.setMatrixAt(i, placement.makeTranslation(positionOf(i, count, p)));
       gpuCrowd.mesh.instanceMatrix.needsUpdate = true;
@@ -268,7 +272,8 @@ export async function startCrowd(): Promise<void> {
 
   const gui = new GUI({ title: 'Crowd' });
   gui.add(params, 'characters', 1, MAX_CROWD, 1).name('characters').onFinishChange(() => build());
-  gui.add(params, 'backend', { 'GPU (section transforms in the shader)': 'gpu', 'CPU (wasm deforms every vertex)': 'cpu' }).name('backend').onChange(() => build());
+  gui.add(params, 'backend', { 'GPU (the vertex shader skins)': 'gpu', 'CPU (wasm deforms every vertex)': 'cpu' }).name('backend').onChange(() => build());
+  gui.add(params, 'path', { 'joint poses (shader blends the sections)': 'joints', 'section transforms (from wasm)': 'sections' }).name('GPU path').onChange(() => build());
   gui.add(params, 'smooth').name('smooth mode').onChange(() => build());
   gui.add(params, 'shadows').onChange(() => { renderer.shadowMap.enabled = params.shadows; });
   gui.add(params, 'paused');
@@ -310,6 +315,7 @@ export async function startCrowd(): Promise<void> {
       smoothedBytes = m.bytesPerFrame;
       const vertices = m.vertices;
       readout.innerHTML = `<b>${count}</b> characters × ${vertices.toLocaleString('en')} vertices · <b>${backend.toUpperCase()}</b> backend` +
+        `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}` +
         `${params.smooth ? ' (smooth)' : ''}<br>skinning CPU <b>${smoothedMs.toFixed(2)} ms</b>/frame (median) (${(smoothedMs / count * 1000).toFixed(1)} µs per character)` +
         ` · uploaded <b>${fmtBytes(smoothedBytes)}</b>/frame (${fmtBytes(smoothedBytes / count)} per character)` +
         `${note ? `<br><span class="criterion">${note}</span>` : ''}`;
@@ -321,7 +327,7 @@ export async function startCrowd(): Promise<void> {
   const measureLast = (frames: number): CrowdMeasure => {
     const last = samples.slice(-frames);
     const ms = median(last.map((s) => s.ms)), bytes = median(last.map((s) => s.bytes));
-    return { characters: count, backend, frames: last.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
+    return { characters: count, backend, path: gpuCrowd?.sections.path ?? null, joints: rig.jointCount, frames: last.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
       vertices: source.geometry.getAttribute('position').count, sections: gpuCrowd?.deformer.sectionCount ?? cpuCrowd?.deformers[0]?.sectionCount ?? 0 };
   };
 
@@ -334,7 +340,7 @@ export async function startCrowd(): Promise<void> {
       drawn: () => (gpuCrowd ? gpuCrowd.mesh.count : cpuCrowd ? cpuCrowd.group.children.length : 0),
       drawCalls: () => renderer.info.render.calls,
       readout: () => readout.textContent ?? '',
-      set: (n: number, b: Backend = params.backend) => { params.characters = clampCount(n); params.backend = b; gui.controllersRecursive().forEach((c) => c.updateDisplay()); build(); },
+      set: (n: number, b: Backend = params.backend, path: Path = params.path) => { params.characters = clampCount(n); params.backend = b; params.path = path; gui.controllersRecursive().forEach((c) => c.updateDisplay()); build(); },
       /** Medians over the next `frames` frames: skinning CPU ms and bytes uploaded, per frame and per character. */
       measure: (frames: number) => new Promise<CrowdMeasure>((resolve) => waiters.push({ frames, resolve, start: frame })),
       pause: (t?: number) => { params.paused = true; if (t !== undefined) time = t; },
@@ -346,6 +352,9 @@ export async function startCrowd(): Promise<void> {
 export interface CrowdMeasure {
   characters: number;
   backend: Backend;
+  /** GPU backend: its path; null on the CPU backend. */
+  path: Path | null;
+  joints: number;
   frames: number;
   msPerFrame: number;
   bytesPerFrame: number;

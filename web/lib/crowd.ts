@@ -10,13 +10,15 @@
  *   // each frame: crowd.setBakedPose(i, walk, t_i) (or writeSkinMatrices(mesh_i, crowd.skins, crowd.offsetOf(i)))
  *   //             crowd.update(); renderer.render(scene, camera);
  *
- * Per frame the CPU does O(instances × sections): one wasm call computes every instance's section
- * transforms into the texture's memory, and three.js uploads it (instances × sections × 48 bytes).
+ * Per frame one wasm call writes every instance's joint poses (the weights criterion, the default:
+ * O(instances × joints), 64 bytes per joint) or section transforms ('y' / 'axial', or
+ * `gpuPath: 'sections'`: O(instances × sections), 48 bytes per section) into the texture's memory,
+ * and three.js uploads it.
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import type { GcsDeformer, GcsOptions, GcsSkin, Rig } from './index.js';
-import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes } from './gpu.js';
+import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes, type GpuPath } from './gpu.js';
 import { remapAttribute, rigInputFromSkinnedMesh, SKINNING_ATTRIBUTES, writeSkinMatrices } from './three.js';
 
 export { writeSkinMatrices } from './three.js';
@@ -65,8 +67,10 @@ export interface GcsCrowdOptions {
   gcs?: GcsOptions;
   /** Drawn with a patched clone of this material. Default: the source's own. */
   material?: THREE.Material | THREE.Material[];
-  /** The widest row of the section texture (default 2048, what WebGL2 guarantees). */
+  /** The widest row of the per-frame texture (default 2048, what WebGL2 guarantees). */
   maxTextureWidth?: number;
+  /** See SkinDeformerOptions.gpuPath: 'auto' (default: 'joints' for the weights criterion), 'joints' or 'sections'. */
+  gpuPath?: GpuPath | 'auto';
 }
 
 /**
@@ -98,7 +102,8 @@ export class GcsCrowd {
     let deformer: GcsDeformer | null = null, sections: GpuSections | null = null;
     try {
       deformer = this.rig.buildGcs(options.gcs ?? {});
-      sections = new GpuSections(deformer, count, options.maxTextureWidth ?? 2048);
+      const path = options.gpuPath ?? 'auto';
+      sections = new GpuSections(deformer, count, options.maxTextureWidth ?? 2048, path === 'auto' ? undefined : path);
     } catch (e) {
       deformer?.dispose();
       this.rig.dispose();
@@ -122,10 +127,11 @@ export class GcsCrowd {
     for (const [key, attr] of Object.entries(source.geometry.attributes))
       if (!SKINNING_ATTRIBUTES.has(key) || key === 'tangent') geometry.setAttribute(key, remapAttribute(attr, sourceVertex));
     for (const g of source.geometry.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
-    const { uniforms, smooth } = sections;
-    const patched = Array.isArray(material) ? material.map((m) => gcsMaterial(m, uniforms, smooth)) : gcsMaterial(material, uniforms, smooth);
+    const { uniforms, smooth, path } = sections;
+    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path);
+    const patched = Array.isArray(material) ? material.map(patch) : patch(material);
     this.mesh = new THREE.InstancedMesh(geometry, patched, count);
-    const shadow = gcsShadowMaterials(Array.isArray(material) ? material[0] : material, uniforms, smooth);
+    const shadow = gcsShadowMaterials(Array.isArray(material) ? material[0] : material, uniforms, smooth, path);
     this.mesh.customDepthMaterial = shadow.depth;
     this.mesh.customDistanceMaterial = shadow.distance;
     this.mesh.castShadow = source.castShadow;
@@ -162,13 +168,13 @@ export class GcsCrowd {
     for (let k = 0; k < n; k++) dst[o + k] = src[s + k];
   }
 
-  /** Once per frame after posing: every instance's section transforms (one wasm call); the texture uploads at the next render. */
+  /** Once per frame after posing: every instance's joint poses or section transforms (one wasm call); the texture uploads at the next render. */
   update(): void {
     this.live();
     this.sections.update();
   }
 
-  /** Bytes uploaded per update(): the section texture. */
+  /** Bytes uploaded per update(): the per-frame texture (joint poses or section transforms). */
   get bytesPerFrame(): number {
     return this.sections.bytesPerUpdate;
   }

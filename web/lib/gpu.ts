@@ -2,11 +2,18 @@
  * gcs-skin/gpu: generalized cross-sections on the GPU (design.md §6, docs/gpu.md).
  *
  * The mesh stays in GPU memory in the bind pose, section by section; per vertex its section id
- * (smooth mode: also the other section and the factor towards it) is a static attribute. Each
- * frame wasm computes only the section transforms (3 RGBA32F texels per section) into a buffer
- * that a float DataTexture views with no JavaScript copy, and the vertex shader of the source's
- * own material (three.js's built-in materials, patched through onBeforeCompile; shadows through
- * matching depth and distance materials) applies them to positions, normals and tangents.
+ * (smooth mode: also the other section and the factor towards it) is a static attribute. Two paths:
+ *   'joints' (the default for the weights criterion): each frame wasm writes only the joint poses
+ *     (4 RGBA32F texels per joint: the rows of S_j and its rotation quaternion); the vertex shader
+ *     blends each vertex's section from them and a static per-section table (its joints and mean
+ *     weights, uploaded once), exactly as the CPU does (dual quaternions, scale blended linearly
+ *     and applied first, the CPU's normal matrix and smooth-mode length fix).
+ *   'sections' (any criterion; the only one for 'y' and 'axial'): each frame wasm computes the
+ *     section transforms (3 RGBA32F texels per section) and the shader applies them.
+ * Either way the per-frame texels live in wasm memory that a float DataTexture views with no
+ * JavaScript copy, and the vertex shader of the source's own material (three.js's built-in
+ * materials, patched through onBeforeCompile; shadows through matching depth and distance
+ * materials) moves positions, normals and tangents.
  *
  * Most users never touch this module: `new GcsCharacter(gcs, scene, { backend: 'gpu' })`
  * (gcs-skin/three) uses it. `GcsCrowd` draws many characters sharing one mesh and one section
@@ -14,15 +21,21 @@
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
-import { GPU_TEXELS_PER_SECTION, SectionTransforms, type GcsDeformer } from './index.js';
+import { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from './index.js';
 
-export { GPU_TEXELS_PER_SECTION, SectionTransforms } from './index.js';
+export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JointPoses, SectionTransforms } from './index.js';
+
+/**
+ * What the GPU gets per frame: 'joints' (joint poses, O(joints); weights criterion only) or
+ * 'sections' (section transforms, O(sections); any criterion).
+ */
+export type GpuPath = 'joints' | 'sections';
 
 // ---------------------------------------------------------------------------------- shader
 
 /** Declarations: the texture of section transforms and the static per-vertex section data. */
-const PARS = /* glsl */ `
-uniform highp sampler2D gcsSections;
+/** Both paths: where instance 0's texels start, texels per instance, the static per-vertex section data. */
+const COMMON_PARS = /* glsl */ `
 uniform int gcsBase;
 uniform int gcsStride;
 #ifdef GCS_SMOOTH
@@ -30,6 +43,10 @@ attribute vec3 gcsBlend;
 #else
 attribute float gcsSection;
 #endif
+`;
+
+const PARS = /* glsl */ `
+uniform highp sampler2D gcsSections;${COMMON_PARS}
 void gcsRows( const in int section, out vec4 r0, out vec4 r1, out vec4 r2 ) {
 	int i = gcsBase + section * ${GPU_TEXELS_PER_SECTION};
 	#ifdef USE_INSTANCING
@@ -84,12 +101,15 @@ const BASE = /* glsl */ `
 	}
 `;
 
-const NORMAL = /* glsl */ `
-	objectNormal = gcsTurn( objectNormal, gcsN0, gcsN1, gcsN2 );
+/** Normals and tangents, each turned by `turn` (the GLSL call on that vector). */
+const turned = (turn: (v: string) => string) => /* glsl */ `
+	objectNormal = ${turn('objectNormal')};
 	#ifdef USE_TANGENT
-	objectTangent = gcsTurn( objectTangent, gcsN0, gcsN1, gcsN2 );
+	objectTangent = ${turn('objectTangent')};
 	#endif
 `;
+
+const NORMAL = turned((v) => `gcsTurn( ${v}, gcsN0, gcsN1, gcsN2 )`);
 
 const POSITION = /* glsl */ `
 	{
@@ -98,24 +118,151 @@ const POSITION = /* glsl */ `
 	}
 `;
 
+// ------------------------------------------------------------ the joint-level path (weights criterion)
+// Matrices are GLSL's (column-major); the math is GcsDeformerImpl::sectionTransformsWeights,
+// blendPoses and normalMatrix (wasm/src), step for step.
+
+/** Declarations: joint poses (per frame), the section table (static), the per-section blend. */
+const JOINT_PARS = /* glsl */ `
+uniform highp sampler2D gcsJoints;
+uniform highp sampler2D gcsTable;${COMMON_PARS}
+vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
+	int w = textureSize( t, 0 ).x;
+	return texelFetch( t, ivec2( i % w, i / w ), 0 );
+}
+// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+void gcsJoint( const in int j, out mat3 s, out vec3 t, out vec4 q ) {
+	int i = gcsBase + j * ${GPU_TEXELS_PER_JOINT};
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	vec4 r0 = gcsTexel( gcsJoints, i ), r1 = gcsTexel( gcsJoints, i + 1 ), r2 = gcsTexel( gcsJoints, i + 2 );
+	q = gcsTexel( gcsJoints, i + 3 );
+	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	t = vec3( r0.w, r1.w, r2.w );
+}
+// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
+mat3 gcsRotation( const in vec4 q, const in float k2 ) {
+	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
+		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
+		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
+}
+// The CPU's normalMatrix: r when k is a positive uniform scale (up to 1e-4), else r · cof(k) scaled
+// to entries ≤ 1 (renormalise), r alone when k has collapsed.
+mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	bool uniformScale = s > 0.0;
+	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
+		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > 1e-4 * s ) uniformScale = false;
+	renorm = ! uniformScale;
+	if ( uniformScale ) return r;
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	if ( ! ( kbig > 1e-30 ) ) return r;
+	mat3 a = k / kbig;
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	if ( ! ( big > 1e-30 ) ) return r;
+	return r * ( c / big );
+}
+// Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
+// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first.
+void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+	vec4 joints = gcsTexel( gcsTable, 2 * s ), weights = gcsTexel( gcsTable, 2 * s + 1 );
+	mat3 S; vec3 t; vec4 q;
+	gcsJoint( int( joints.x ), S, t, q );
+	if ( joints.y < 0.0 ) {
+		M = S; T = t;
+		mat3 r = gcsRotation( q, 2.0 );
+		N = gcsNormalMatrix( r, transpose( r ) * S, renorm );
+		return;
+	}
+	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
+	mat3 K = mat3( 0.0 );
+	for ( int k = 0; k < 4; k ++ ) {
+		if ( joints[ k ] < 0.0 ) break;
+		if ( k > 0 ) gcsJoint( int( joints[ k ] ), S, t, q );
+		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+		float w = weights[ k ];
+		float sw = dot( q, pivot ) < 0.0 ? - w : w;
+		br += sw * q;
+		bd += sw * d;
+		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
+	}
+	float inv2 = 1.0 / dot( br, br );
+	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
+	mat3 rot = gcsRotation( br, 2.0 * inv2 );
+	M = rot * K;
+	N = gcsNormalMatrix( rot, K, renorm );
+}
+// A normal or tangent as the CPU turns it: blended (smooth) normals get the cubic length fix when
+// both sides are rotations less than 35° apart, else are normalised (a vanished one keeps its rest
+// direction); unblended ones are normalised only when the scale asks for it.
+vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool normalise ) {
+	vec3 n = N * v;
+	if ( near ) { float e = dot( n, n ) - 1.0; return n * ( 1.0 + e * ( - 0.5 + 0.375 * e ) ); }
+	if ( normalise ) { float l = length( n ); return l > 0.0 ? n / l : v; }
+	return n;
+}
+`;
+
+/** Per vertex, once: its (blended) section transform and normal matrix. */
+const JOINT_BASE = /* glsl */ `
+	mat3 gcsM, gcsN;
+	vec3 gcsT;
+	bool gcsNear = false, gcsNormalise;
+	{
+		#ifdef GCS_SMOOTH
+		int sa = int( gcsBlend.x + 0.5 ), sb = int( gcsBlend.y + 0.5 );
+		gcsSectionBlend( sa, gcsM, gcsT, gcsN, gcsNormalise );
+		if ( sb != sa ) {
+			mat3 mb, nb; vec3 tb; bool rb;
+			gcsSectionBlend( sb, mb, tb, nb, rb );
+			float f = gcsBlend.z;
+			bool ra = gcsNormalise;
+			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
+			gcsNear = ! ra && ! rb && trace > 1.0 + 2.0 * 0.82;
+			gcsNormalise = true;
+			gcsM = gcsM + f * ( mb - gcsM );
+			gcsT = gcsT + f * ( tb - gcsT );
+			gcsN = gcsN + f * ( nb - gcsN );
+		}
+		#else
+		gcsSectionBlend( int( gcsSection + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
+		#endif
+	}
+`;
+
+const JOINT_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, gcsNear, gcsNormalise )`);
+
+const JOINT_POSITION = /* glsl */ `
+	transformed = gcsM * transformed + gcsT;
+`;
+
 const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', '#include <skinning_vertex>'] as const;
 
 /**
  * The vertex shader of a three.js built-in material (or any shader written with its chunks) with
- * three's skinning chunks replaced by GCS's: the section transforms come from the `gcsSections`
- * texture. Morph targets still apply first (three's order), then the section transform; normals
- * and tangents turn with the normal matrix. Throws GcsError 'INVALID_ARGUMENT' when the shader
- * lacks the chunks (a ShaderMaterial written without them).
+ * three's skinning chunks replaced by GCS's: path 'sections', the section transforms come from the
+ * `gcsSections` texture; path 'joints', each vertex's section is blended from the joint poses in
+ * `gcsJoints` and the static table `gcsTable`. Morph targets still apply first (three's order),
+ * then the section transform; normals and tangents turn with the normal matrix. Throws GcsError
+ * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
  */
-export function patchVertexShader(source: string, smooth: boolean): string {
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections'): string {
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
+  if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+  const joints = path === 'joints';
   let out = source
-    .replace(HOOKS[0], `${HOOKS[0]}\n${PARS}`)
-    .replace(HOOKS[1], BASE)
-    .replace(HOOKS[2], POSITION);
+    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? JOINT_PARS : PARS}`)
+    .replace(HOOKS[1], joints ? JOINT_BASE : BASE)
+    .replace(HOOKS[2], joints ? JOINT_POSITION : POSITION);
   // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
-  out = out.replace('#include <skinnormal_vertex>', NORMAL);
+  out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
   return `${smooth ? '#define GCS_SMOOTH\n' : ''}${out}`;
 }
 
@@ -129,19 +276,25 @@ export function gpuMaterialSupport(material: THREE.Material): string | null {
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
-  gcsSections: { value: THREE.DataTexture };
-  /** Texel of instance 0's first section. */
+  /** Path 'sections': the section transforms (per frame). */
+  gcsSections?: { value: THREE.DataTexture };
+  /** Path 'joints': the joint poses (per frame). */
+  gcsJoints?: { value: THREE.DataTexture };
+  /** Path 'joints': each section's joints and weights (static). */
+  gcsTable?: { value: THREE.DataTexture };
+  /** Texel of instance 0's first section or joint. */
   gcsBase: { value: number };
-  /** Texels per instance (sections × 3). */
+  /** Texels per instance (sections × 3, or joints × 4). */
   gcsStride: { value: number };
-  [name: string]: THREE.IUniform;
+  [name: string]: THREE.IUniform | undefined;
 }
 
 /**
  * A clone of `source` (sharing its textures) whose vertex shader applies GCS section transforms
- * read from `uniforms`. The source's own onBeforeCompile, if any, runs first.
+ * read from `uniforms` (path 'sections'), or blends them from the joint poses (path 'joints'). The
+ * source's own onBeforeCompile, if any, runs first.
  */
-export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean): M {
+export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): M {
   const reason = gpuMaterialSupport(source);
   if (reason) throw new GcsError('INVALID_ARGUMENT', reason);
   const material = source.clone() as M;
@@ -149,10 +302,10 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
   const ownKey = source.customProgramCacheKey();
   material.onBeforeCompile = (shader, renderer) => {
     own.call(source, shader, renderer);
-    Object.assign(shader.uniforms, uniforms);
-    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth);
+    for (const [name, u] of Object.entries(uniforms)) if (u) shader.uniforms[name] = u;
+    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path);
   };
-  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}`;
+  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}-${path}`;
   material.name = source.name;
   material.userData.gcsSource = source;
   return material;
@@ -162,7 +315,7 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
  */
-export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
+export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };
@@ -173,32 +326,49 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
       m.alphaMap = s.alphaMap ?? null;
     }
   }
-  return { depth: gcsMaterial(depth, uniforms, smooth), distance: gcsMaterial(distance, uniforms, smooth) };
+  return { depth: gcsMaterial(depth, uniforms, smooth, path), distance: gcsMaterial(distance, uniforms, smooth, path) };
 }
 
 // ---------------------------------------------------------------------------------- sections
 
 /**
- * The section transforms of `instanceCount` poses of one GCS model as a float texture: a
- * SectionTransforms (buffers in wasm memory) and a DataTexture whose `image.data` is its texel
- * view (no copy; re-pointed after wasm memory growth). Write poses into `skins` (J × 16 floats per
- * instance), then `update()` once per frame: one wasm call, one texture upload.
+ * What the GPU needs per frame for `instanceCount` poses of one GCS model, as a float texture:
+ * path 'joints' (default for the weights criterion) the joint poses (JointPoses) plus a static
+ * texture of each section's joints and weights, uploaded once; path 'sections' (any criterion;
+ * the default for 'y' and 'axial') the section transforms (SectionTransforms). The per-frame
+ * buffers live in wasm memory and the DataTexture's `image.data` views them (no copy; re-pointed
+ * after wasm memory growth). Write poses into `skins` (J × 16 floats per instance), then
+ * `update()` once per frame: one wasm call, one texture upload. Asking for 'joints' on a model
+ * built with the 'y' or 'axial' criterion is GcsError 'INVALID_ARGUMENT'.
  */
 export class GpuSections {
-  readonly transforms: SectionTransforms;
+  readonly path: GpuPath;
+  readonly transforms: PoseTexels;
+  /** The per-frame texture (joint poses or section transforms). */
   readonly texture: THREE.DataTexture;
+  /** Path 'joints': the static texture of each section's joints and weights; null otherwise. */
+  readonly table: THREE.DataTexture | null;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
 
-  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
-    this.transforms = new SectionTransforms(deformer, instanceCount, maxWidth);
+  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath) {
+    if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+    this.path = path ?? (deformer.jointLevel ? 'joints' : 'sections');
+    this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth) : new SectionTransforms(deformer, instanceCount, maxWidth);
     const t = this.transforms;
-    this.texture = new THREE.DataTexture(t.texels, t.width, t.height, THREE.RGBAFormat, THREE.FloatType);
-    this.texture.minFilter = THREE.NearestFilter;
-    this.texture.magFilter = THREE.NearestFilter;
-    this.texture.generateMipmaps = false;
-    this.texture.needsUpdate = true;
-    this.uniforms = { gcsSections: { value: this.texture }, gcsBase: { value: 0 }, gcsStride: { value: t.sectionCount * GPU_TEXELS_PER_SECTION } };
+    this.texture = floatTexture(t.texels, t.width, t.height);
+    const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
+    if (this.path === 'joints') {
+      const influences = deformer.sectionInfluences()!;
+      const texels = influences.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+      const data = new Float32Array(width * height * 4);
+      data.set(influences);
+      this.table = floatTexture(data, width, height);
+      this.uniforms = { gcsJoints: { value: this.texture }, gcsTable: { value: this.table }, ...base };
+    } else {
+      this.table = null;
+      this.uniforms = { gcsSections: { value: this.texture }, ...base };
+    }
     this.smooth = deformer.blendOther() !== null;
   }
 
@@ -211,12 +381,12 @@ export class GpuSections {
     return this.transforms.skins;
   }
 
-  /** Bytes one update() uploads: the whole texture (width × height × 16). */
+  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16). */
   get bytesPerUpdate(): number {
     return this.transforms.width * this.transforms.height * 16;
   }
 
-  /** Section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
+  /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
   update(): void {
     this.transforms.compute();
     const texels = this.transforms.texels; // re-created after memory growth
@@ -227,8 +397,19 @@ export class GpuSections {
 
   dispose(): void {
     this.texture.dispose();
+    this.table?.dispose();
     this.transforms.dispose();
   }
+}
+
+/** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */
+function floatTexture(data: Float32Array, width: number, height: number): THREE.DataTexture {
+  const texture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+  texture.minFilter = THREE.NearestFilter;
+  texture.magFilter = THREE.NearestFilter;
+  texture.generateMipmaps = false;
+  texture.needsUpdate = true;
+  return texture;
 }
 
 /**

@@ -19,7 +19,7 @@
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
-import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes } from './gpu.js';
+import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes, type GpuPath } from './gpu.js';
 
 /** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
 export type Backend = 'cpu' | 'gpu';
@@ -51,13 +51,22 @@ export interface SkinDeformerOptions {
   tangents?: 'deform' | 'drop';
   /**
    * 'cpu' (default): wasm deforms every vertex and three.js uploads the vertex buffers each frame.
-   * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the section
-   * transforms (a few KB, into a float texture) and the vertex shader of a patched clone of the
-   * material applies them (docs/gpu.md). GCS only: other methods, and materials that cannot be
+   * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the joint
+   * poses (weights criterion; about 1 KB) or the section transforms (a few KB), into a float
+   * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
+   * see gpuPath). GCS only: other methods, and materials that cannot be
    * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
    * `backendNote` why.
    */
   backend?: Backend;
+  /**
+   * GPU backend: what wasm hands the GPU per frame. 'auto' (default): 'joints' for the weights
+   * criterion (the joint poses, 64 bytes per joint; the shader blends each section from them and a
+   * static table), 'sections' for 'y' and 'axial' (the section transforms, 48 bytes per section).
+   * 'sections' forces the section-level path; 'joints' with 'y' or 'axial' is GcsError
+   * 'INVALID_ARGUMENT'.
+   */
+  gpuPath?: GpuPath | 'auto';
 }
 
 /**
@@ -289,6 +298,8 @@ interface PendingBuild {
   note: string;
   /** The backend asked for. */
   backend: Backend;
+  /** The GPU path asked for. */
+  gpuPath: GpuPath | 'auto';
 }
 
 /** What rebuild() may change. */
@@ -296,6 +307,7 @@ export interface RebuildOptions {
   gcs?: GcsOptions;
   classic?: ClassicOptions;
   backend?: Backend;
+  gpuPath?: GpuPath | 'auto';
 }
 
 /** The GPU backend of one build: section texture, patched materials, the geometry raycasts test. */
@@ -501,6 +513,9 @@ export class SkinDeformer {
     if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got '${String(backend)}'`);
     const note = backend === 'gpu' ? this.gpuUnsupported(method) : '';
     const onGpu = backend === 'gpu' && !note;
+    const gpuPath = options.gpuPath ?? this.options.gpuPath ?? 'auto';
+    if (gpuPath !== 'auto' && gpuPath !== 'joints' && gpuPath !== 'sections')
+      throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got '${String(gpuPath)}'`);
     const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
       : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
     const deformer = build(this.rig);
@@ -511,9 +526,9 @@ export class SkinDeformer {
       const morph = method === 'classic' ? null : morphData(this.source.geometry);
       if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
       if (onGpu) {
-        gpu = this.prepareGpu(deformer as GcsDeformer);
+        gpu = this.prepareGpu(deformer as GcsDeformer, gpuPath === 'auto' ? undefined : gpuPath);
         const geometry = this.makeGeometry(deformer, sourceVertex, null, gpu);
-        return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend };
+        return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
       }
       if (this.tangentRig && sourceVertex) {
         tangentDeformer = build(this.tangentRig);
@@ -525,7 +540,7 @@ export class SkinDeformer {
         }
       }
       const geometry = this.makeGeometry(deformer, sourceVertex, tangentDeformer, null);
-      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend };
+      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend, gpuPath };
     } catch (e) {
       if (gpu) disposeGpu(gpu);
       tangentDeformer?.dispose();
@@ -544,14 +559,15 @@ export class SkinDeformer {
     return '';
   }
 
-  /** The section texture and the patched materials of a GPU build. */
-  private prepareGpu(deformer: GcsDeformer): GpuBuild {
-    const sections = new GpuSections(deformer, 1);
+  /** The per-frame texture (joint poses or section transforms) and the patched materials of a GPU build. */
+  private prepareGpu(deformer: GcsDeformer, path?: GpuPath): GpuBuild {
+    const sections = new GpuSections(deformer, 1, 2048, path);
     const { uniforms, smooth } = sections;
     const base = this.baseMaterial;
-    const material = Array.isArray(base) ? base.map((m) => gcsMaterial(m, uniforms, smooth)) : gcsMaterial(base, uniforms, smooth);
+    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, sections.path);
+    const material = Array.isArray(base) ? base.map(patch) : patch(base);
     const first = Array.isArray(base) ? base[0] : base;
-    const shadow = gcsShadowMaterials(first, uniforms, smooth);
+    const shadow = gcsShadowMaterials(first, uniforms, smooth, sections.path);
     const raycast = new THREE.BufferGeometry();
     raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
     raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
@@ -584,7 +600,7 @@ export class SkinDeformer {
     this.balls = paper || next.method === 'classic' ? this.nearBalls : this.ownBalls;
     this.ballFactor = next.method === 'classic' ? 1 + CLASSIC_LIMITS.maxBulge : 1;
     this.method = next.method;
-    this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method, backend: next.backend };
+    this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method, backend: next.backend, gpuPath: next.gpuPath };
     const old = this.mesh.geometry;
     this.mesh.geometry = next.geometry;
     old.dispose();
@@ -827,9 +843,14 @@ export class SkinDeformer {
     return this.note;
   }
 
-  /** GPU backend: the section transforms and their texture (null on the CPU backend). */
+  /** GPU backend: the per-frame texels (joint poses or section transforms) and their texture (null on the CPU backend). */
   get gpuSections(): GpuSections | null {
     return this.gpu?.sections ?? null;
+  }
+
+  /** GPU backend: the path of the current build ('joints' or 'sections'); null on the CPU backend. */
+  get gpuPath(): GpuPath | null {
+    return this.gpu?.sections.path ?? null;
   }
 
   /** Bytes this skin sends to the GPU per update(): the vertex buffers (CPU backend) or the section texture (GPU backend). */
@@ -891,6 +912,8 @@ export interface GcsCharacterOptions {
   filter?: (mesh: THREE.SkinnedMesh) => boolean;
   /** See SkinDeformerOptions.backend: 'cpu' (default) or 'gpu' (GCS section transforms in the vertex shader). */
   backend?: Backend;
+  /** See SkinDeformerOptions.gpuPath. Default 'auto'. */
+  gpuPath?: GpuPath | 'auto';
 }
 
 /**
@@ -934,7 +957,7 @@ export class GcsCharacter {
       for (const source of sources) {
         skins.push(new SkinDeformer(gcs, source, {
           method: options.method, gcs: options.gcs, classic: options.classic, tangents: options.tangents, inPlace: true,
-          backend: options.backend,
+          backend: options.backend, gpuPath: options.gpuPath,
         }));
       }
     } catch (e) {

@@ -9,7 +9,7 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib/index.js';
 import { GcsCharacter, type Backend } from '../../../web/lib/three.js';
-import { patchVertexShader } from '../../../web/lib/gpu.js';
+import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
 import { createHuman } from '../../../web/lib/human/index.js';
 
 const W = 512, H = 512;
@@ -42,7 +42,7 @@ varying vec4 vOut;
 void main() { gl_FragColor = vOut; }`;
 
 /** What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals, float32. */
-function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform>, smooth: boolean): { positions: Float32Array; normals: Float32Array } {
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath): { positions: Float32Array; normals: Float32Array } {
   const src = mesh.geometry;
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
@@ -52,8 +52,8 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform>, sm
     if (a) points.setAttribute(name, a);
   }
   const material = new THREE.ShaderMaterial({
-    uniforms: { ...uniforms, readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
-    vertexShader: patchVertexShader(READ_VERTEX, smooth),
+    uniforms: { ...(uniforms as Record<string, THREE.IUniform>), readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
+    vertexShader: patchVertexShader(READ_VERTEX, smooth, path),
     fragmentShader: READ_FRAGMENT,
   });
   const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
@@ -96,6 +96,8 @@ async function load(model: string): Promise<Loaded> {
 export interface CheckResult {
   skins: number;
   backends: string[];
+  /** each skin's GPU path */
+  paths: string[];
   notes: string[];
   height: number;
   /** worst |GPU − CPU| position distance over every vertex and frame, divided by the height */
@@ -124,7 +126,7 @@ function differing(a: Uint8Array, b: Uint8Array): number {
 }
 
 /** Loads a character, deforms it on both backends on the same frames and compares. */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string): Promise<CheckResult> {
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CheckResult> {
   const gcs = await gcsReady;
   const { root, clips } = await load(model);
   const scene = new THREE.Scene();
@@ -136,7 +138,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   const mixer = new THREE.AnimationMixer(root);
   const clip = clips.find((c) => c.name === clipName) ?? clips[0];
   mixer.clipAction(clip).play();
-  const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu' });
+  const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
   // Frame the character from its bind-pose box.
   root.updateMatrixWorld(true);
   const box = new THREE.Box3().setFromObject(root);
@@ -144,7 +146,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   const camera = new THREE.PerspectiveCamera(40, W / H, size / 100, size * 10);
   camera.position.copy(centre).add(new THREE.Vector3(0.6, 0.3, 1).normalize().multiplyScalar(size * 1.3));
   camera.lookAt(centre);
-  const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), notes: character.skins.map((s) => s.backendNote),
+  const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
     extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float') };
   const pixels = (backend: Backend): Uint8Array => {
@@ -165,7 +167,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     for (const skin of character.skins) {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
-      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth);
+      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path);
       const d = skin.deformer as GcsDeformer;
       d.deform((skin as unknown as { skin: Float32Array }).skin); // the same frame on the CPU
       const cpuP = d.positions, cpuN = d.normals;
