@@ -1,10 +1,11 @@
 // The crowd bench (part of `npm run bench`): per character and frame, the skinning CPU time and the
-// bytes uploaded to the GPU, CPU backend vs GPU backend, for 1, 10 and 100 default humans
-// (17 k vertices), in the same run.
+// bytes uploaded to the GPU, CPU backend vs the GPU backend's two paths, for 1, 10 and 100 default
+// humans (17 k vertices), in the same run.
 //   CPU ms: in node, the same code the demo's crowd mode runs per frame (web/demo/crowd.ts): every
 //     character posed from a baked clip at its own time, then GPU backend: GcsCrowd.update() (one
-//     wasm call: section transforms of every character); CPU backend: one GCS deformer per
-//     character deforms its 17 k vertices. Rendering excluded. Median over many frames.
+//     wasm call: the joint poses of every character on the joint-level path, the default; their
+//     section transforms on the section-level path); CPU backend: one GCS deformer per character
+//     deforms its 17 k vertices. Rendering excluded. Median over many frames.
 //   bytes: the demo's crowd page (?crowd=N&backend=…) in headless Chromium, counted on the WebGL
 //     upload calls (texSubImage2D, bufferSubData, …) during renderer.render() — what the browser
 //     really sends. Software rendering (SwiftShader) gives no GPU times; its CPU ms are printed
@@ -27,16 +28,21 @@ function cpuTimes(gcs, human, n, quick) {
   const walkers = Array.from({ length: n }, (_, i) => ({ clip: clips[i % 3 === 2 ? 1 : 0], phase: (i * 0.37) % 4, speed: 0.85 + ((i * 0.13) % 0.3) }));
   const dt = 1 / 60;
   const timing = { minSamples: quick ? 30 : 120, minMs: quick ? 100 : 400, maxMs: quick ? 1500 : 6000, warmup: 10 };
-  // GPU backend.
-  const crowd = new GcsCrowd(gcs, human.mesh, n);
-  const gpu = timeFrames(240, (f) => {
-    const t = f * dt;
-    for (let i = 0; i < n; i++) crowd.setBakedPose(i, walkers[i].clip, t * walkers[i].speed + walkers[i].phase);
-    crowd.update();
-  }, timing);
-  const sections = crowd.deformer.sectionCount;
-  const textureBytes = crowd.bytesPerFrame;
-  crowd.dispose();
+  // GPU backend, both paths.
+  const gpuRun = (gpuPath) => {
+    const crowd = new GcsCrowd(gcs, human.mesh, n, { gpuPath });
+    if (crowd.sections.path !== gpuPath) throw new Error(`the crowd runs the ${crowd.sections.path} path, not ${gpuPath}`);
+    const timing_ = timeFrames(240, (f) => {
+      const t = f * dt;
+      for (let i = 0; i < n; i++) crowd.setBakedPose(i, walkers[i].clip, t * walkers[i].speed + walkers[i].phase);
+      crowd.update();
+    }, timing);
+    const out = { timing: timing_, sections: crowd.deformer.sectionCount, joints: crowd.jointCount, textureBytes: crowd.bytesPerFrame };
+    crowd.dispose();
+    return out;
+  };
+  const joints = gpuRun('joints');
+  const sectionLevel = gpuRun('sections');
   // CPU backend: a deformer per character, as GcsCharacter / the demo.
   const rig = gcs.createRig(rigInputFromSkinnedMesh(human.mesh));
   const deformers = Array.from({ length: n }, () => rig.buildGcs({}));
@@ -54,7 +60,8 @@ function cpuTimes(gcs, human, n, quick) {
   }, { ...timing, minSamples: quick ? 10 : 40, maxMs: quick ? 2000 : 8000 });
   for (const d of deformers) d.dispose();
   rig.dispose();
-  return { gpu, cpu, sections, textureBytes };
+  return { gpu: joints.timing, gpuSections: sectionLevel.timing, cpu, sections: joints.sections, joints: joints.joints,
+    textureBytes: joints.textureBytes, sectionTextureBytes: sectionLevel.textureBytes };
 }
 
 /** Chromium: bytes uploaded per frame by the demo's crowd page, and its own CPU ms, per backend and size. */
@@ -74,13 +81,14 @@ async function browserBytes(sizes, quick, log) {
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
   });
   const out = {};
+  const runs = { cpu: 'backend=cpu', gpu: 'backend=gpu&path=joints', gpuSections: 'backend=gpu&path=sections' };
   try {
-    for (const backend of ['cpu', 'gpu']) {
+    for (const [backend, params] of Object.entries(runs)) {
       for (const n of sizes) {
         const page = await context.newPage();
         const errors = [];
         page.on('pageerror', (e) => errors.push(e.message));
-        await page.goto(`${url}?crowd=${n}&backend=${backend}`);
+        await page.goto(`${url}?crowd=${n}&${params}`);
         await page.waitForFunction(() => window.__crowd !== undefined && window.__crowd.frame() > 2, null, { timeout: 300000 });
         const frames = n >= 100 ? 3 : quick ? 5 : 10;
         const m = await page.evaluate((f) => window.__crowd.measure(f), frames);
@@ -98,19 +106,20 @@ async function browserBytes(sizes, quick, log) {
   return out;
 }
 
-/** The whole crowd bench: rows per size, targets met/missed. */
+/** The whole crowd bench: rows per size (`gpu`: the joint-level path, the default; `gpuSections`: the section-level path), targets met/missed on the default path. */
 export async function crowdBench(gcs, human, { quick = false, log = console.log, sizes = CROWD_SIZES } = {}) {
   const rows = [];
   for (const n of sizes) {
     log(`bench: crowd of ${n} (node, CPU time)…`);
     const t = cpuTimes(gcs, human, n, quick);
-    rows.push({ characters: n, sections: t.sections, vertices: human.mesh.geometry.getAttribute('position').count,
-      gpu: { msPerFrame: t.gpu.medianMs, msPerCharacter: t.gpu.medianMs / n, p95Ms: t.gpu.p95Ms, textureBytes: t.textureBytes },
+    rows.push({ characters: n, sections: t.sections, joints: t.joints, vertices: human.mesh.geometry.getAttribute('position').count,
+      gpu: { path: 'joints', msPerFrame: t.gpu.medianMs, msPerCharacter: t.gpu.medianMs / n, p95Ms: t.gpu.p95Ms, textureBytes: t.textureBytes },
+      gpuSections: { path: 'sections', msPerFrame: t.gpuSections.medianMs, msPerCharacter: t.gpuSections.medianMs / n, p95Ms: t.gpuSections.p95Ms, textureBytes: t.sectionTextureBytes },
       cpu: { msPerFrame: t.cpu.medianMs, msPerCharacter: t.cpu.medianMs / n, p95Ms: t.cpu.p95Ms } });
   }
   const browser = await browserBytes(sizes, quick, log);
   for (const r of rows) {
-    for (const b of ['cpu', 'gpu']) {
+    for (const b of ['cpu', 'gpu', 'gpuSections']) {
       const m = browser[`${b}-${r.characters}`];
       r[b].bytesPerFrame = m ? m.bytesPerFrame : null;
       r[b].bytesPerCharacter = m ? m.bytesPerFrame / r.characters : null;
@@ -120,11 +129,13 @@ export async function crowdBench(gcs, human, { quick = false, log = console.log,
   const at = (n) => rows.find((r) => r.characters === n) ?? rows[rows.length - 1];
   const worstBytes = Math.max(...rows.map((r) => r.gpu.bytesPerCharacter ?? NaN));
   const worstMs = Math.max(...rows.map((r) => r.gpu.msPerCharacter));
+  const sectionNote = (key) => `section-level path: ${rows.map((r) => key === 'ms' ? `${r.gpuSections.msPerCharacter.toPrecision(3)} ms` : r.gpuSections.bytesPerCharacter === null ? 'n/a' : `${(r.gpuSections.bytesPerCharacter / 1024).toFixed(1)} KB`).join(' / ')}`;
   const targets = [
     { name: 'GPU backend bytes uploaded per character-frame (17 k vertices)', value: Number.isNaN(worstBytes) ? null : worstBytes, unit: 'bytes',
-      goal: '≤ 8 KB', met: Number.isNaN(worstBytes) ? null : worstBytes <= CROWD_TARGETS.bytes, note: browser.skipped ?? '' },
+      goal: '≤ 8 KB', met: Number.isNaN(worstBytes) ? null : worstBytes <= CROWD_TARGETS.bytes,
+      note: browser.skipped ?? `joint-level path, worst of ${sizes.join(', ')} characters (${sectionNote('bytes')})` },
     { name: 'GPU backend CPU ms per character-frame (17 k vertices)', value: worstMs, unit: 'ms', goal: '≤ 0.01 ms', met: worstMs <= CROWD_TARGETS.ms,
-      note: `worst of ${sizes.join(', ')} characters; ${at(100).gpu.msPerCharacter.toPrecision(3)} ms at ${at(100).characters}` },
+      note: `joint-level path, worst of ${sizes.join(', ')} characters; ${at(100).gpu.msPerCharacter.toPrecision(3)} ms at ${at(100).characters} (${sectionNote('ms')})` },
   ];
   return { rows, browser: browser.skipped ? { skipped: browser.skipped } : {}, targets };
 }

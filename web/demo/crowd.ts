@@ -272,8 +272,8 @@ export async function startCrowd(): Promise<void> {
 
   const gui = new GUI({ title: 'Crowd' });
   gui.add(params, 'characters', 1, MAX_CROWD, 1).name('characters').onFinishChange(() => build());
-  gui.add(params, 'backend', { 'GPU (the vertex shader skins)': 'gpu', 'CPU (wasm deforms every vertex)': 'cpu' }).name('backend').onChange(() => build());
-  gui.add(params, 'path', { 'joint poses (shader blends the sections)': 'joints', 'section transforms (from wasm)': 'sections' }).name('GPU path').onChange(() => build());
+  gui.add(params, 'backend', { 'GPU (vertex shader)': 'gpu', 'CPU (wasm, every vertex)': 'cpu' }).name('backend').onChange(() => build());
+  gui.add(params, 'path', { 'joint poses': 'joints', 'section transforms': 'sections' }).name('GPU path').onChange(() => build());
   gui.add(params, 'smooth').name('smooth mode').onChange(() => build());
   gui.add(params, 'shadows').onChange(() => { renderer.shadowMap.enabled = params.shadows; });
   gui.add(params, 'paused');
