@@ -104,6 +104,8 @@ export interface CheckResult {
   positionError: number;
   /** worst distance between the GPU normal and the CPU normal (both unit) */
   normalError: number;
+  /** worst distance between the GPU normal and the CPU normal as the CPU wrote it (its smooth-mode length fix included) */
+  normalErrorRaw: number;
   /** the same comparison against the bind pose: how far the frames moved the skin (not vacuous) */
   motion: number;
   vertices: number;
@@ -115,6 +117,8 @@ export interface CheckResult {
   /** share of pixels differing between the GPU backend's first frame and each later one: the picture moves */
   pixelMotion: number;
   extColorBufferFloat: boolean;
+  /** the largest ratio of the longest to the shortest column of a skin matrix's 3×3 (1: no non-uniform scale) */
+  anisotropy: number;
 }
 
 /** Share of pixels of which a channel differs by more than 16 (of 255). */
@@ -125,8 +129,13 @@ function differing(a: Uint8Array, b: Uint8Array): number {
   return n / (a.length / 4);
 }
 
-/** Loads a character, deforms it on both backends on the same frames and compares. */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CheckResult> {
+/**
+ * Loads a character, deforms it on both backends on the same frames and compares. `boneScale`: the
+ * first bone's scale multiplied by it on every frame (a non-uniform scale puts a different scale
+ * part K_j in every skin matrix below it).
+ */
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto',
+  boneScale?: [number, number, number]): Promise<CheckResult> {
   const gcs = await gcsReady;
   const { root, clips } = await load(model);
   const scene = new THREE.Scene();
@@ -147,8 +156,8 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   camera.position.copy(centre).add(new THREE.Vector3(0.6, 0.3, 1).normalize().multiplyScalar(size * 1.3));
   camera.lookAt(centre);
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
-    height: 0, positionError: 0, normalError: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
-    extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float') };
+    height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
+    extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1 };
   const pixels = (backend: Backend): Uint8Array => {
     if (character.backend !== backend) character.rebuild(undefined, { backend });
     character.update();
@@ -160,8 +169,13 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     return out;
   };
   let first: Uint8Array | null = null;
+  let scaled: THREE.Object3D | undefined;
+  root.traverse((o) => { if (!scaled && (o as THREE.Bone).isBone) scaled = o; });
+  const baseScale = scaled!.scale.clone();
   for (const t of times) {
+    scaled!.scale.copy(baseScale);
     mixer.setTime(t);
+    if (boneScale) scaled!.scale.multiply(new THREE.Vector3(...boneScale));
     if (character.backend !== 'gpu') character.rebuild(undefined, { backend: 'gpu' });
     character.update();
     for (const skin of character.skins) {
@@ -169,7 +183,12 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
       const sections = skin.gpuSections!;
       const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path);
       const d = skin.deformer as GcsDeformer;
-      d.deform((skin as unknown as { skin: Float32Array }).skin); // the same frame on the CPU
+      const S = (skin as unknown as { skin: Float32Array }).skin;
+      d.deform(S); // the same frame on the CPU
+      for (let j = 0; j < S.length / 16; j++) {
+        const l = [0, 1, 2].map((c) => Math.hypot(S[16 * j + 4 * c], S[16 * j + 4 * c + 1], S[16 * j + 4 * c + 2]));
+        result.anisotropy = Math.max(result.anisotropy, Math.max(...l) / Math.min(...l));
+      }
       const cpuP = d.positions, cpuN = d.normals;
       const rest = mesh.geometry.getAttribute('position').array as Float32Array;
       const height = skin.rig.height;
@@ -182,6 +201,8 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
         const dn = Math.hypot(gpuOut.normals[3 * v] - cpuN[3 * v] / l, gpuOut.normals[3 * v + 1] - cpuN[3 * v + 1] / l, gpuOut.normals[3 * v + 2] - cpuN[3 * v + 2] / l);
         if (!(dp <= result.positionError)) result.positionError = Number.isNaN(dp) ? Infinity : dp;
         if (!(dn <= result.normalError)) result.normalError = Number.isNaN(dn) ? Infinity : dn;
+        const raw = Math.hypot(gpuOut.normals[3 * v] - cpuN[3 * v], gpuOut.normals[3 * v + 1] - cpuN[3 * v + 1], gpuOut.normals[3 * v + 2] - cpuN[3 * v + 2]);
+        if (!(raw <= result.normalErrorRaw)) result.normalErrorRaw = Number.isNaN(raw) ? Infinity : raw;
         if (moved > result.motion) result.motion = moved;
       }
     }
