@@ -21,7 +21,7 @@ constexpr float kCutMargin = 0.05f;        // a trunk tube ends ¹⁄₂₀ bone
 constexpr float kMinTrunkSpan = 0.25f;     // … and keeps at least ¼ of its bone
 constexpr float kMinTubeSpan = 0.1f;       // a tube between its end loops spans ≥ ⅒ of its bone
 constexpr float kBandWidth = 0.02f;        // a tube ends ¹⁄₅₀ bone inside its loop
-constexpr uint32_t kProbeContours = 9;     // contours cast to decide whether a part resamples
+constexpr uint32_t kProbeContours = 5;     // contours cast to decide whether a part resamples
 
 glm::vec3 anyPerpendicular(const glm::vec3& a) {
   glm::vec3 g = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
@@ -68,12 +68,14 @@ glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
 void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
                  const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius) {
   const float step = 2.0f * kPi / float(k);
+  const float planeD = glm::dot(O, n);
   for (uint32_t i = 0; i < triCount; ++i) {
     const glm::vec3* c = &corners[size_t(i) * 3];
-    glm::vec3 p[3] = {c[0] - O, c[1] - O, c[2] - O};
-    float h[3] = {glm::dot(p[0], n), glm::dot(p[1], n), glm::dot(p[2], n)};
+    // Most triangles lie on one side of the plane: sides first, relative positions only if cut.
+    float h[3] = {glm::dot(c[0], n) - planeD, glm::dot(c[1], n) - planeD, glm::dot(c[2], n) - planeD};
     bool neg0 = h[0] < 0.0f, neg1 = h[1] < 0.0f, neg2 = h[2] < 0.0f;
     if (neg0 == neg1 && neg1 == neg2) continue;
+    glm::vec3 p[3] = {c[0] - O, c[1] - O, c[2] - O};
     glm::vec2 seg[2];
     int s = 0;
     for (int e = 0; e < 3 && s < 2; ++e) {

@@ -14,6 +14,11 @@ bool allFinite(const float* values, size_t count) {
 }
 
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
+  if (rig.welded) {
+    representative = rig.weldRepresentative;
+    return rig.weldGroup;
+  }
+  representative.clear();
   // A sort of the exact position bits, not a hash: O(n log n) for any input (a hash of raw float
   // bits put integer grids of power-of-two sizes into a few buckets: quadratic).
   struct Entry {
@@ -54,6 +59,9 @@ std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& repr
     }
     group[v] = id;
   }
+  rig.weldGroup = group;
+  rig.weldRepresentative = representative;
+  rig.welded = true;  // (after both copies: a failed allocation leaves no half cache)
   return group;
 }
 

@@ -23,6 +23,11 @@ struct Rig {
 
   // Index of the joint with the largest weight on vertex v (ties: the first listed).
   uint32_t dominantJoint(uint32_t v) const;
+
+  // weldByPosition's result, computed by the first build that asks and kept: the positions never
+  // change, and the sliders rebuild the same rig again and again.
+  mutable std::vector<uint32_t> weldGroup, weldRepresentative;
+  mutable bool welded = false;
 };
 
 // Validates the raw arrays (see gcs_rig_create in gcs_skin.h) and fills `rig`.
@@ -39,6 +44,7 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 // Vertices at the same bind-pose position (UV or normal seams split them in glTF) are one
 // surface point: returns each vertex's group id and fills `representative` (first vertex of
 // each group). Both models group by it, so a seam can never open.
+// (Computed once per rig, then copied from its cache.)
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
 
 // Checks that `count` floats are all finite.
