@@ -87,7 +87,8 @@ function fidelityOf(meshes, clips, heights) {
       const height = heights.meshUnits[i] > 0 ? heights.meshUnits[i] : rig.height;
       const probe = new FidelityProbe(input, frames, { height });
       // The classic model's resampling loss, rescaled from its mesh's own height to the character's.
-      const lossOf = (d) => ({ rms: d.detailLoss.rms * rig.height / height, max: d.detailLoss.max * rig.height / height });
+      const lossOf = (d) => ({ rms: d.detailLoss.rms * rig.height / height, max: d.detailLoss.max * rig.height / height,
+        resampledParts: d.parts.filter((p) => p.resampled).length });
       return { name: mesh.name, vertices: rig.vertexCount, triangles: input.indices.length / 3, frames: frames.length,
         methods: eachMethod(rig, (d, method) => ({ ...probe.measure(d), ...(method === 'classic' ? { loss: lossOf(d) } : {}) })) };
     } finally {
@@ -107,7 +108,8 @@ function fidelityOf(meshes, clips, heights) {
       flipped: sum(fs.map((f) => f.flipped)), stretched: sum(fs.map((f) => f.stretched)),
       normalOffUnit: Math.max(...fs.map((f) => f.normalOffUnit)), nonFinite: sum(fs.map((f) => f.nonFinite)),
       seamGap: Math.max(...fs.map((f) => f.seamGap)),
-      ...(fs[0].loss ? { loss: { rms: Math.max(...fs.map((f) => f.loss.rms)), max: Math.max(...fs.map((f) => f.loss.max)) } } : {}),
+      ...(fs[0].loss ? { loss: { rms: Math.max(...fs.map((f) => f.loss.rms)), max: Math.max(...fs.map((f) => f.loss.max)),
+        resampledParts: sum(fs.map((f) => f.loss.resampledParts)) } } : {}),
     };
   }
   return { meshes: perMesh, methods };
@@ -304,7 +306,8 @@ function fidelityRows(rep, first) {
     const head = [...first(i), METHOD_LABELS[method]];
     if (f.error) return [...head, 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a'];
     const flipped = method === 'lbs' || lbs.error ? String(f.flipped) : `${f.flipped} (LBS ${lbs.flipped})`;
-    const resampled = f.loss ? `resampled, loss ${num(f.loss.rms, 2)} / ${num(f.loss.max, 2)}` : 'resampled';
+    const resampled = !f.loss ? 'resampled' : f.loss.resampledParts ? `resampled, loss ${num(f.loss.rms, 2)} / ${num(f.loss.max, 2)}`
+      : 'all carried (no part resampled)';
     return [...head, f.rigidError === null ? resampled : num(f.rigidError, 3), f.dqsP95 === null ? 'resampled' : num(f.dqsP95, 3),
       f.dqsMax === null ? 'resampled' : num(f.dqsMax, 3), flipped, String(f.stretched), num(f.normalOffUnit, 3), String(f.nonFinite), num(f.seamGap, 3)];
   });
