@@ -12,7 +12,7 @@ import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { loadGltfFile } from '../dist/cli/gltf-node.js';
-import { classicAtBudget, classicFigures, coincidentPairs, meshBorder } from '../dist/measure.js';
+import { classicAtBudget, classicFigures, meshBorder } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';
 
@@ -48,13 +48,10 @@ for (const ch of characters)
     const paper = classicFigures(rig, 25, 20);
     const any = paper.resampled + paper.trunk > 0;
     const budget = any ? classicAtBudget(rig) : null;
-    const inBorder = meshBorder(input.indices, rig.vertexCount, coincidentPairs(input.positions)).open;
+    const inBorder = meshBorder(input.positions, input.indices).open;
     // Points on the thigh and the shank where the bones have human names.
-    const d = rig.buildClassic({ contours: 25, rays: 20 });
-    const bones = mesh.skeleton.bones;
-    const pointsOf = (name) => d.parts.find((p) => p.joint === findBone(bones, name) && p.resampled)?.vertexCount;
+    const pointsOf = (name) => paper.points.get(findBone(mesh.skeleton.bones, name));
     const thigh = pointsOf('LeftUpLeg'), shank = pointsOf('LeftLeg');
-    d.dispose();
     rows.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}`, String(rig.vertexCount),
       `${paper.resampled} + ${paper.trunk} / ${paper.carried}`, thigh ? `${thigh} / ${shank ?? '—'}` : '—',
       any ? `${num(paper.rms, 2)} / ${num(paper.max, 2)}` : 'nothing resampled', String(paper.outputVertices),

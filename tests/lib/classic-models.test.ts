@@ -62,7 +62,7 @@ function scaleSkin(skin: Float32Array, scale: number): void {
 
 /** The welded border of a classic output at rest. */
 function border(d: ClassicDeformer): { open: number; overused: number } {
-  return meshBorder(d.indices, d.vertexCount, coincidentPairs(d.positions.slice()));
+  return meshBorder(d.positions, d.indices);
 }
 
 describe('classic cross-sections on the default human', () => {
@@ -111,7 +111,7 @@ describe('classic cross-sections on the default human', () => {
     const human = createHuman();
     const input = rigInputFromSkinnedMesh(human.mesh);
     const rig = gcs.createRig(input);
-    const inputBorder = meshBorder(input.indices, rig.vertexCount, coincidentPairs(input.positions));
+    const inputBorder = meshBorder(input.positions, input.indices);
     expect(inputBorder).toEqual({ open: 0, overused: 0 }); // the human is closed
     for (const settings of [{ contours: 25, rays: 20, bulge: 0.3 }, { contours: 6, rays: 5, bulge: 2 }, { contours: 60, rays: 64, bulge: 0 }]) {
       const d = rig.buildClassic(settings);
@@ -171,7 +171,7 @@ describe.skipIf(files.length === 0)('classic cross-sections on the shared models
         const d = rig.buildClassic();
         const coarse = rig.buildClassic({ contours: 4, rays: 6, bulge: 2 });
         const loss = d.detailLoss;
-        const inputBorder = meshBorder(input.indices, rig.vertexCount, coincidentPairs(input.positions));
+        const inputBorder = meshBorder(input.positions, input.indices);
         const reasons = new Map<string, string[]>();
         for (const p of d.parts) reasons.set(p.reason, [...(reasons.get(p.reason) ?? []), names[p.joint]]);
         console.log(`classic ${basename(file)} / ${mesh.name}: ${rig.vertexCount} vertices; ${[...reasons].map(([r, n]) => `${r} ${n.length} [${n.join(', ')}]`).join('; ')}; detail loss RMS ${loss.rms.toFixed(3)} % / max ${loss.max.toFixed(3)} %; input border ${inputBorder.open}, output border ${border(d).open}`);

@@ -251,14 +251,14 @@ describe('classic cross-sections on analytic tubes', () => {
     for (const closed of [true, false]) {
       const t = tube3({ closed });
       const rig = gcs.createRig(t.input);
-      const inputBorder = meshBorder(t.input.indices, rig.vertexCount, coincidentPairs(t.input.positions));
+      const inputBorder = meshBorder(t.input.positions, t.input.indices);
       expect(inputBorder).toEqual({ open: closed ? 0 : 2 * 48, overused: 0 });
       for (const [contours, rays] of [[25, 40], [4, 3], [60, 64]]) {
         const d = rig.buildClassic({ contours, rays, bulge: 1 });
         expect(d.parts.map((p) => p.reason)).toEqual(['resampled', 'resampled', 'leaf']);
         const pairs = coincidentPairs(d.positions.slice());
         // Closed: nothing open. Open: the resampled bottom rim (rays edges) and the leaf's own top rim.
-        expect(meshBorder(d.indices, d.vertexCount, pairs)).toEqual({ open: closed ? 0 : rays + 48, overused: 0 });
+        expect(meshBorder(d.positions, d.indices)).toEqual({ open: closed ? 0 : rays + 48, overused: 0 });
         // Part 1's tube ends inside the leaf's border loop, which the band shares with the carried
         // triangles: bent, the ring, the band and the leaf stay joined (no coincident pair opens).
         for (const angle of [0.5, Math.PI / 2, 2.5]) {
@@ -277,7 +277,7 @@ describe('classic cross-sections on analytic tubes', () => {
     const rig = gcs.createRig(t.input);
     const d = rig.buildClassic({ contours: 25, rays: 40, bulge: 0 });
     expect(d.parts.map((p) => p.reason)).toEqual(['resampled', 'resampled', 'leaf']);
-    expect(meshBorder(d.indices, d.vertexCount, coincidentPairs(d.positions.slice()))).toEqual({ open: 0, overused: 0 });
+    expect(meshBorder(d.positions, d.indices)).toEqual({ open: 0, overused: 0 });
     // The patch's vertices are replaced by the tube: the carried leaf keeps only y ≥ ~2 skin.
     const leaf = d.parts[2];
     let lowest = Infinity;

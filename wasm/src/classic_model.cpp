@@ -525,6 +525,12 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       const ClassicPart& C = m.parts[P.child];
       return C.resampled && C.split != 1;
     };
+    // A tube's span along its bone: 0 / 1 at a shared joint, just inside its border loop where it
+    // meets carried skin, its own vertices' extent at an open end.
+    auto spanOf = [](const ClassicPart& P, float& lo, float& hi) {
+      lo = P.proxShared ? 0.0f : P.proxLoop >= 0 ? P.loopTLo : P.ownTMin;
+      hi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
+    };
     auto carry = [&](uint32_t j, uint8_t reason) {
       ClassicPart& P = m.parts[j];
       P.resampled = false;
@@ -539,7 +545,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       bool distal = false;
     };
     std::vector<Loop> loops;
-    std::vector<uint8_t> gCarried(G, 0), triCarried(T, 0);
+    std::vector<uint8_t> triCarried(T, 0);
     // Islands (real meshes: a strap or a pouch weighted to another bone, a few vertices of a part
     // inside its neighbour's skin): a tube region cut off from the main region of its part is
     // carried; a carried patch that touches one tube only, lies along its bone and is no bigger
@@ -640,8 +646,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           dirty[j] = 0;
           P.proxShared = P.parent >= 0 && m.parts[P.parent].child == int32_t(j) && shares(m.parts[P.parent]);
           P.distShared = shares(P);
-          P.tLo = P.proxShared ? 0.0f : P.proxLoop >= 0 ? P.loopTLo : P.ownTMin;
-          P.tHi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
+          spanOf(P, P.tLo, P.tHi);
           glm::vec3 nProx, nDist;
           endNormals(P, nProx, nDist);
           // The decision looks at up to kProbeContours contours (the full set is cast once, at the end).
@@ -684,10 +689,9 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
 
       // The carried mesh and its boundary loops with the tubes.
       computeOwners();
-      for (uint32_t g = 0; g < G; ++g) gCarried[g] = owner(g) < 0;
       for (uint32_t t = 0; t < T; ++t)
-        triCarried[t] = gCarried[group[rig.indices[3 * t]]] || gCarried[group[rig.indices[3 * t + 1]]] ||
-                        gCarried[group[rig.indices[3 * t + 2]]];
+        triCarried[t] = owner(group[rig.indices[3 * t]]) < 0 || owner(group[rig.indices[3 * t + 1]]) < 0 ||
+                        owner(group[rig.indices[3 * t + 2]]) < 0;
       // Loop edges: an edge of a carried triangle shared with a tube triangle, directed as in the
       // carried triangle (an edge of the input's own border stays open).
       std::vector<std::pair<uint32_t, uint32_t>> loopEdges;
@@ -793,8 +797,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       for (uint32_t j = 0; j < J; ++j) {
         ClassicPart& P = m.parts[j];
         if (!P.resampled) continue;
-        float lo = P.proxShared ? 0.0f : P.proxLoop >= 0 ? P.loopTLo : P.ownTMin;
-        float hi = P.distShared ? 1.0f : P.distLoop >= 0 ? P.loopTHi : P.ownTMax;
+        float lo, hi;
+        spanOf(P, lo, hi);
         // (the ray test is not run again on the final span: the loops only trim the ends of a
         // tube whose rays already hit, and the contours are cast below)
         if (!(hi - lo >= kMinTubeSpan)) carry(j, GCS_CLASSIC_SEAM), any = true;

@@ -7,7 +7,8 @@
  *   scene.add(crowd.mesh);
  *   crowd.mesh.setMatrixAt(i, placement);                       // where each one stands
  *   const walk = bakeClip(skinnedMesh, clip);                   // or your own skeletons:
- *   // each frame: crowd.setBakedPose(i, walk, t_i) (or writeSkinMatrices(mesh_i, crowd.skins, crowd.offsetOf(i)))
+ *   // each frame: crowd.setBakedPose(i, walk, t_i) (or writeSkinMatrices(mesh_i, crowd.skins, crowd.offsetOf(i), tmp)
+ *   //             with one reused THREE.Matrix4 `tmp`: without it each call allocates one)
  *   //             crowd.update(); renderer.render(scene, camera);
  *
  * Per frame one wasm call writes every instance's joint poses (the weights criterion, the default:

@@ -33,7 +33,6 @@ export type GpuPath = 'joints' | 'sections';
 
 // ---------------------------------------------------------------------------------- shader
 
-/** Declarations: the texture of section transforms and the static per-vertex section data. */
 /** Both paths: where instance 0's texels start, texels per instance, the static per-vertex section data. */
 const COMMON_PARS = /* glsl */ `
 uniform int gcsBase;

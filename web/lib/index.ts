@@ -554,7 +554,7 @@ export class GcsDeformer extends Deformer {
    * written as texels (GPU_TEXELS_PER_SECTION RGBA32F texels per section: the rows of its affine
    * 3×4) at byte offset `outPtr` in wasm memory; `skinPtr` holds instanceCount × J × 16 floats.
    * Pointers, not arrays, so that a crowd's buffers live in wasm memory and are never copied
-   * (SectionBuffer in gcs-skin/gpu owns such a pair). No allocation.
+   * (SectionTransforms owns such a pair; GpuSections in gcs-skin/gpu views it). No allocation.
    */
   computeSectionsAt(skinPtr: number, instanceCount: number, outPtr: number): void {
     const h = this.live();
@@ -616,17 +616,17 @@ export class ClassicDeformer extends Deformer {
    * carried input vertex: what the demo colours by. A copy (valid until the next rebuild).
    */
   get contourOfVertex(): Int32Array {
-    const h = this.live();
-    const ptr = this.gcs.core.gcs_classic_contour_of_vertex(h);
-    return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
+    return this.perVertex(this.gcs.core.gcs_classic_contour_of_vertex(this.live()));
   }
   /**
    * For each output vertex, the rig vertex a carried vertex copies (take its texture coordinates
    * and colours from there), or −1 for a resampled vertex. A copy (valid until the next rebuild).
    */
   get sourceOfVertex(): Int32Array {
-    const h = this.live();
-    const ptr = this.gcs.core.gcs_classic_source_of_vertex(h);
+    return this.perVertex(this.gcs.core.gcs_classic_source_of_vertex(this.live()));
+  }
+  /** A copy of an int32-per-output-vertex array of the core (empty when the core gives none). */
+  private perVertex(ptr: number): Int32Array {
     return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
   }
   /** Resampling detail loss, % of model height: RMS and max distance of original vertices to the resampled surface. */

@@ -120,12 +120,14 @@ export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): numbe
 }
 
 /**
- * The border of a triangle mesh whose coincident vertices are welded (`pairs` from
- * coincidentPairs): `open` edges used by one triangle, `overused` edges by more than two (a fold
+ * The border of a triangle mesh (`positions` xyz per vertex) with its coincident vertices welded
+ * (coincidentPairs): `open` edges used by one triangle, `overused` edges by more than two (a fold
  * or an overlap glued on). A closed manifold mesh has both 0; a closed input deformed into an
  * output with a gap or a torn seam has open > 0.
  */
-export function meshBorder(indices: ArrayLike<number>, vertexCount: number, pairs: Uint32Array): { open: number; overused: number } {
+export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): { open: number; overused: number } {
+  const vertexCount = Math.floor(positions.length / 3);
+  const pairs = coincidentPairs(positions);
   const weld = new Uint32Array(vertexCount);
   for (let v = 0; v < vertexCount; v++) weld[v] = v;
   for (let i = 0; i < pairs.length; i += 2) weld[pairs[i + 1]] = pairs[i];
@@ -593,6 +595,8 @@ export interface ClassicFigures {
   max: number;
   /** Welded border edges of the output at rest (equal to the input's: no gap where tubes meet carried skin). */
   border: number;
+  /** Ring vertices (contours × rays) of each resampled part, by joint. */
+  points: Map<number, number>;
 }
 
 /** Builds the classic model at one setting and measures it (disposes it). */
@@ -604,7 +608,8 @@ export function classicFigures(rig: Rig, contours: number, rays: number): Classi
     return {
       contours, rays, outputVertices: d.vertexCount, resampled: parts.filter((p) => p.reason === 'resampled').length,
       trunk: parts.filter((p) => p.reason === 'trunk').length, carried: parts.filter((p) => !p.resampled).length,
-      rms: loss.rms, max: loss.max, border: meshBorder(d.indices, d.vertexCount, coincidentPairs(d.positions.slice())).open,
+      rms: loss.rms, max: loss.max, border: meshBorder(d.positions, d.indices).open,
+      points: new Map(parts.filter((p) => p.resampled).map((p) => [p.joint, p.vertexCount])),
     };
   } finally {
     d.dispose();
