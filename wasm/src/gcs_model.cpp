@@ -117,8 +117,8 @@ void finishModel(GcsDeformerImpl& m) {
       lo = glm::min(lo, p);
       hi = glm::max(hi, p);
     }
-    sec.centre = 0.5f * (lo + hi);
-    sec.radius = 0.5f * glm::length(hi - lo);
+    sec.centre = sec.count ? 0.5f * (lo + hi) : glm::vec3(0.0f);  // a node only blended towards has no vertex
+    sec.radius = sec.count ? 0.5f * glm::length(hi - lo) : 0.0f;
     float* info = &m.sectionInfo[size_t(i) * 8];
     info[0] = float(sec.first);
     info[1] = float(sec.count);
@@ -378,6 +378,119 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   }
 }
 
+
+// Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
+// d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
+// (the other joints' shares of s, summing to 1). Sections are NODES on the rays leaving each rigid
+// core: (d, u quantised to multiples of 1/U, level l) with s = l/Q; a node moves by the DQS blend
+// at its exact weights (level 0 is the rigid core itself, S_d). A vertex belongs to the node at the
+// level just below its s and blends with the node just above by its fraction: the result is
+// continuous in s, and in u up to s/U of weight (U = 4Q: 1/64 at the default 6 sections), so no
+// step between bins (design.md §2a; creases measured in §7). Keys count weight in units of
+// 1/(Q·U): the even split of two joints is one key from either side, so their rays share that node.
+void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
+                      std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
+                      std::vector<float>& blendOfGroup) {
+  const uint32_t G = uint32_t(representative.size());
+  const uint32_t Q = 2 * (m.settings.sections - 2), U = 4 * Q, total = Q * U;
+  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
+  std::vector<WeightKey> keys;
+  auto keyId = [&](WeightKey key) {
+    key.canonical(total);
+    auto it = keyIndex.find(key);
+    if (it == keyIndex.end()) {
+      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
+      keys.push_back(key);
+    }
+    return it->second;
+  };
+  std::vector<uint32_t> lowKey(G), highKey(G);
+  blendOfGroup.assign(G, 0.0f);
+  for (uint32_t g = 0; g < G; ++g) {
+    uint32_t joint[4] = {0, 0, 0, 0};
+    float weight[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    const uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    uint32_t d = 0;
+    for (uint32_t i = 1; i < n; ++i)
+      if (weight[i] > weight[d]) d = i;
+    const float s = n > 1 ? glm::clamp(1.0f - weight[d], 0.0f, 1.0f) : 0.0f;
+    // u on the grid 1/U by largest remainders (the quantised shares sum to exactly U).
+    uint32_t q[4] = {0, 0, 0, 0};
+    float rem[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+    uint32_t used = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (i == d) continue;
+      const float x = weight[i] / s * float(U);
+      q[i] = uint32_t(std::floor(x));
+      rem[i] = x - float(q[i]);
+      used += q[i];
+    }
+    while (s > 0.0f && used < U) {
+      uint32_t best = d == 0 ? 1 : 0;
+      for (uint32_t i = 0; i < n; ++i)
+        if (i != d && rem[i] > rem[best]) best = i;
+      ++q[best], rem[best] = -1.0f, ++used;
+    }
+    const float x = s * float(Q);
+    const uint32_t level = std::min(uint32_t(std::floor(x)), Q);
+    const float frac = x - float(level);
+    auto nodeKey = [&](uint32_t l) {
+      WeightKey key;
+      key.n = n;
+      for (uint32_t i = 0; i < n; ++i) key.joint[i] = joint[i], key.q[i] = i == d ? (Q - l) * U : l * q[i];
+      return keyId(key);
+    };
+    lowKey[g] = nodeKey(level);
+    highKey[g] = lowKey[g];
+    if (frac > 1e-6f && level < Q) {
+      highKey[g] = nodeKey(level + 1);
+      blendOfGroup[g] = frac;
+    }
+  }
+  // Sections ordered by dominant joint, its rigid core first, then by key: a part is contiguous.
+  const uint32_t K = uint32_t(keys.size());
+  std::vector<uint32_t> order(K);
+  for (uint32_t k = 0; k < K; ++k) order[k] = k;
+  auto rank = [&](uint32_t k) {
+    const WeightKey& key = keys[k];
+    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
+                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
+  std::vector<uint32_t> sectionOfKey(K);
+  m.sections.resize(K);
+  m.influences.clear();
+  for (uint32_t i = 0; i < K; ++i) {
+    const uint32_t k = order[i];
+    sectionOfKey[k] = i;
+    const WeightKey& key = keys[k];
+    Section& sec = m.sections[i];
+    const uint32_t d = key.dominant();
+    sec.part = key.joint[d];
+    sec.rigid = key.n == 1;
+    sec.influenceFirst = uint32_t(m.influences.size());
+    uint32_t second = ~0u;
+    for (uint32_t t = 0; t < key.n; ++t) {
+      m.influences.push_back({key.joint[t], sec.rigid ? 1.0f : float(key.q[t]) / float(total)});
+      if (t != d && (second == ~0u || key.q[t] > key.q[second])) second = t;
+    }
+    sec.influenceCount = key.n;
+    sec.distal = second == ~0u ? -1 : int32_t(key.joint[second]);
+    sec.shared = second != ~0u && key.q[second] == key.q[d];
+    sec.alpha = m.influences[sec.influenceFirst + d].weight;
+    sec.beta = second == ~0u ? 0.0f : m.influences[sec.influenceFirst + second].weight;
+    sec.t = sec.beta;
+  }
+  sectionOfGroup.resize(G);
+  otherOfGroup.resize(G);
+  for (uint32_t g = 0; g < G; ++g) {
+    sectionOfGroup[g] = sectionOfKey[lowKey[g]];
+    otherOfGroup[g] = sectionOfKey[highKey[g]];
+  }
+  m.partCount = 0;
+  for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
+}
+
 }  // namespace
 
 float Deformer::stat(GcsStat) const { return std::nanf(""); }
@@ -426,7 +539,8 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     if (settings.criterion == GCS_CRITERION_WEIGHTS) {
       std::vector<uint32_t> sectionOfGroup, otherOfGroup;
       std::vector<float> blendOfGroup;
-      buildWeightSections(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
+      if (settings.smooth) buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
+      else buildWeightSections(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
       std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
       if (settings.smooth) {
         m.blendOther.resize(rig.vertexCount);

@@ -27,7 +27,8 @@ uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
   return (v * (12 + 12 + 16 + 16 + 12) + i * 4 + j * (64 * 2 + 12 + 4)) * 3 / 2 + 65536;
 }
 uint64_t gcsPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
-  return (v * 260 + i * 8 + j * 4096) * 3 / 2 + 65536;
+  // Smooth weights nodes: up to two sections per welded vertex (~300 bytes each, tables included).
+  return (v * 860 + i * 8 + j * 4096) * 3 / 2 + 65536;
 }
 uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
   return (v * (24 + 24 + 24 + 16 + 16 + 4) + i * 4 + j * 128) * 3 / 2 + 65536;

@@ -370,6 +370,12 @@ export interface Fidelity {
   dqsMax: number | null;
   /** Triangles whose normal turned against their rest normal carried by their dominant joint, summed over frames. */
   flipped: number;
+  /**
+   * Creases: interior edges (shared by exactly two triangles, vertices welded by rest position)
+   * whose dihedral angle changes by more than 20° from the rest pose, summed over frames. Steps
+   * between sections show here long before they flip a triangle (design.md §7).
+   */
+  creases: number;
   /** Triangles with an edge longer than twice its rest length, summed over frames. */
   stretched: number;
   /** Largest |length − 1| of an output normal. */
@@ -476,10 +482,12 @@ export class FidelityProbe {
       faceNormal(rest, a, b, c, restNormal, 3 * t);
       restEdge[3 * t] = dist(rest, a, b); restEdge[3 * t + 1] = dist(rest, b, c); restEdge[3 * t + 2] = dist(rest, c, a);
     }
+    const edges = interiorEdges(rest, indices);
+    const restCos = dihedralCosines(restNormal, edges);
+    const posedNormal = new Float64Array(3 * triCount);
     const scale = 100 / this.height;
-    let rigidError = 0, flipped = 0, stretched = 0, normalOff = 0, nonFinite = 0, gap = 0;
+    let rigidError = 0, flipped = 0, creases = 0, stretched = 0, normalOff = 0, nonFinite = 0, gap = 0;
     const dqsDistances = source ? new Float32Array(nOut * this.frames.length) : null;
-    const np = new Float64Array(3);
     this.frames.forEach((skin, f) => {
       deformer.deform(skin);
       const pos = deformer.positions, nrm = deformer.normals;
@@ -513,19 +521,20 @@ export class FidelityProbe {
         const a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
         const j = triJoint[t];
         const rx = restNormal[3 * t], ry = restNormal[3 * t + 1], rz = restNormal[3 * t + 2];
+        faceNormal(pos, a, b, c, posedNormal, 3 * t);
         if (j >= 0 && (rx !== 0 || ry !== 0 || rz !== 0)) {
-          faceNormal(pos, a, b, c, np, 0);
           const r = 9 * j;
           const cx = rot[r] * rx + rot[r + 3] * ry + rot[r + 6] * rz;
           const cy = rot[r + 1] * rx + rot[r + 4] * ry + rot[r + 7] * rz;
           const cz = rot[r + 2] * rx + rot[r + 5] * ry + rot[r + 8] * rz;
-          if (cx * np[0] + cy * np[1] + cz * np[2] < 0) flipped++;
+          if (cx * posedNormal[3 * t] + cy * posedNormal[3 * t + 1] + cz * posedNormal[3 * t + 2] < 0) flipped++;
         }
         // Stretch is relative to the triangle's own scale change: compare with the rest edge carried by S_j's scale.
         const k = j >= 0 ? jointScale(skin, j) : 1;
         if (dist(pos, a, b) > 2 * k * restEdge[3 * t] || dist(pos, b, c) > 2 * k * restEdge[3 * t + 1] ||
             dist(pos, c, a) > 2 * k * restEdge[3 * t + 2]) stretched++;
       }
+      creases += countCreases(posedNormal, edges, restCos);
     });
     return {
       frames: this.frames.length,
@@ -533,9 +542,86 @@ export class FidelityProbe {
       rigidVertices: this.rigidCount,
       dqsP95: dqsDistances ? percentile(dqsDistances, 95) * scale : null,
       dqsMax: dqsDistances ? maxOf(dqsDistances) * scale : null,
-      flipped, stretched, normalOffUnit: normalOff, nonFinite, seamGap: gap * scale,
+      flipped, creases, stretched, normalOffUnit: normalOff, nonFinite, seamGap: gap * scale,
     };
   }
+}
+
+// ------------------------------------------------------------------------------------ creases
+
+/** The crease threshold of design.md §7: a dihedral angle change of more than 20°. */
+export const CREASE_DEGREES = 20;
+
+/**
+ * The interior edges of a triangle mesh: edges shared by exactly two triangles once vertices at
+ * one rest position are welded (so UV seams are not borders). `a`/`b` are the two triangles.
+ * Edges of three or more triangles (non-manifold) and border edges are left out.
+ */
+export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>): { a: Uint32Array; b: Uint32Array } {
+  const n = Math.floor(rest.length / 3);
+  const weld = new Uint32Array(n);
+  const f = new Float32Array(3);
+  const u = new Uint32Array(f.buffer);
+  const seen = new Map<string, number>();
+  for (let v = 0; v < n; v++) {
+    f[0] = rest[3 * v] + 0; f[1] = rest[3 * v + 1] + 0; f[2] = rest[3 * v + 2] + 0;
+    const key = `${u[0]},${u[1]},${u[2]}`;
+    const at = seen.get(key);
+    if (at === undefined) seen.set(key, v);
+    weld[v] = at ?? v;
+  }
+  // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
+  const first = new Map<number, number>();
+  const second = new Map<number, number>();
+  const triCount = Math.floor(indices.length / 3);
+  for (let t = 0; t < triCount; t++) {
+    for (let e = 0; e < 3; e++) {
+      const p = weld[indices[3 * t + e]], q = weld[indices[3 * t + ((e + 1) % 3)]];
+      if (p === q) continue;
+      const key = Math.min(p, q) * n + Math.max(p, q);
+      const t0 = first.get(key);
+      if (t0 === undefined) first.set(key, t);
+      else if (t0 >= 0 && !second.has(key)) second.set(key, t);
+      else { first.set(key, -1); second.delete(key); }
+    }
+  }
+  const a = new Uint32Array(second.size), b = new Uint32Array(second.size);
+  let i = 0;
+  for (const [key, t1] of second) { a[i] = first.get(key)!; b[i] = t1; i++; }
+  return { a, b };
+}
+
+/** cos of the angle between the two face normals of each edge; NaN where a face is degenerate. */
+export function dihedralCosines(faceNormals: ArrayLike<number>, edges: { a: Uint32Array; b: Uint32Array }): Float64Array {
+  const out = new Float64Array(edges.a.length);
+  for (let i = 0; i < out.length; i++) out[i] = normalCos(faceNormals, edges.a[i], edges.b[i]);
+  return out;
+}
+
+/**
+ * Interior edges whose dihedral angle differs from its rest value by more than CREASE_DEGREES.
+ * Edges degenerate at rest are skipped; a face that collapses in the pose (or a non-finite one)
+ * counts as a crease.
+ */
+export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32Array; b: Uint32Array },
+  restCos: Float64Array, degrees = CREASE_DEGREES): number {
+  const limit = degrees * Math.PI / 180;
+  let count = 0;
+  for (let i = 0; i < restCos.length; i++) {
+    const c0 = restCos[i];
+    if (Number.isNaN(c0)) continue;
+    const c = normalCos(faceNormals, edges.a[i], edges.b[i]);
+    if (!(Math.abs(Math.acos(c) - Math.acos(c0)) <= limit)) count++;
+  }
+  return count;
+}
+
+function normalCos(nrm: ArrayLike<number>, s: number, t: number): number {
+  const ax = nrm[3 * s], ay = nrm[3 * s + 1], az = nrm[3 * s + 2];
+  const bx = nrm[3 * t], by = nrm[3 * t + 1], bz = nrm[3 * t + 2];
+  const l = Math.hypot(ax, ay, az) * Math.hypot(bx, by, bz);
+  if (!(l > 0)) return NaN;
+  return Math.max(-1, Math.min(1, (ax * bx + ay * by + az * bz) / l));
 }
 
 /** Largest extent of the bounding box of xyz positions. */
