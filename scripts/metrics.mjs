@@ -3,7 +3,8 @@
 // ../shared/models (skipped with a reason when absent):
 // - FidelityProbe (web/lib/measure.ts) over every sampled frame of every clip, on every skinned
 //   mesh of the character, in % of the character's height (gltf-node characterHeight): rigid
-//   error, distance from an independent DQS (p95, max), flipped triangles beside LBS's, stretched
+//   error, distance from an independent DQS (p95, max), flipped triangles beside LBS's, creases
+//   (beside the more of LBS's and DQS's), stretched
 //   triangles, normals off unit length, non-finite values, seam gap;
 // - where the skeleton has human bone names: joint thickness under 90°/135° knee and elbow bends,
 //   forearm width under 90°/180° twist, volume ratio under bends (closed meshes), the rest error
@@ -105,7 +106,7 @@ function fidelityOf(meshes, clips, heights) {
     methods[method] = {
       frames: fs[0].frames, rigidError: maxOrNull(fs.map((f) => f.rigidError)), rigidVertices: sum(fs.map((f) => f.rigidVertices)),
       dqsP95: maxOrNull(fs.map((f) => f.dqsP95)), dqsMax: maxOrNull(fs.map((f) => f.dqsMax)),
-      flipped: sum(fs.map((f) => f.flipped)), stretched: sum(fs.map((f) => f.stretched)),
+      flipped: sum(fs.map((f) => f.flipped)), creases: sum(fs.map((f) => f.creases)), stretched: sum(fs.map((f) => f.stretched)),
       normalOffUnit: Math.max(...fs.map((f) => f.normalOffUnit)), nonFinite: sum(fs.map((f) => f.nonFinite)),
       seamGap: Math.max(...fs.map((f) => f.seamGap)),
       ...(fs[0].loss ? { loss: { rms: Math.max(...fs.map((f) => f.loss.rms)), max: Math.max(...fs.map((f) => f.loss.max)),
@@ -300,19 +301,21 @@ if (args.json) {
 // ---------------------------------------------------------------- tables
 /** One row per method of a character's fidelity; `first` labels the character on its first row. */
 function fidelityRows(rep, first) {
-  const lbs = rep.fidelity.lbs;
+  const lbs = rep.fidelity.lbs, dqs = rep.fidelity.dqs;
+  const creaseBase = lbs.error || dqs.error ? 0 : Math.max(lbs.creases, dqs.creases);
   return METHODS.map((method, i) => {
     const f = rep.fidelity[method];
     const head = [...first(i), METHOD_LABELS[method]];
-    if (f.error) return [...head, 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a'];
+    if (f.error) return [...head, 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a', 'n/a'];
+    const creases = method === 'lbs' || method === 'dqs' || !creaseBase ? String(f.creases) : `${f.creases} (${num(f.creases / creaseBase, 2)}×)`;
     const flipped = method === 'lbs' || lbs.error ? String(f.flipped) : `${f.flipped} (LBS ${lbs.flipped})`;
     const resampled = !f.loss ? 'resampled' : f.loss.resampledParts ? `resampled, loss ${num(f.loss.rms, 2)} / ${num(f.loss.max, 2)}`
       : 'all carried (no part resampled)';
     return [...head, f.rigidError === null ? resampled : num(f.rigidError, 3), f.dqsP95 === null ? 'resampled' : num(f.dqsP95, 3),
-      f.dqsMax === null ? 'resampled' : num(f.dqsMax, 3), flipped, String(f.stretched), num(f.normalOffUnit, 3), String(f.nonFinite), num(f.seamGap, 3)];
+      f.dqsMax === null ? 'resampled' : num(f.dqsMax, 3), flipped, creases, String(f.stretched), num(f.normalOffUnit, 3), String(f.nonFinite), num(f.seamGap, 3)];
   });
 }
-const FIDELITY_HEADER = ['method', 'rigid error %', 'DQS p95 %', 'DQS max %', 'flipped', 'stretched', 'normal off unit', 'non-finite', 'seam gap %'];
+const FIDELITY_HEADER = ['method', 'rigid error %', 'DQS p95 %', 'DQS max %', 'flipped', 'creases', 'stretched', 'normal off unit', 'non-finite', 'seam gap %'];
 const describe = (rep) => `${rep.clips.length} clip${rep.clips.length === 1 ? '' : 's'} × ${framesPerClip} frames`;
 const failures = reports.flatMap((rep) => METHODS.filter((m) => rep.fidelity[m].error).map((m) => `${rep.name}, ${METHOD_LABELS[m]}: n/a — ${rep.fidelity[m].error.code}: ${rep.fidelity[m].error.message}`));
 
@@ -324,7 +327,8 @@ if (args.markdown) {
     'Distances in % of the character\'s height (bind-pose bounding box of all its skinned meshes, world units); counts summed over frames ' +
     '(and meshes). Rigid error: vertices bound ≥ 0.999 to one joint against S_j·x. DQS: distance from a scale-aware ' +
     'dual-quaternion skinning computed independently in JavaScript. Flipped: triangles whose normal turned against their rest ' +
-    'normal carried by their dominant joint, with LBS\'s count over the same frames. Stretched: an edge over twice its rest ' +
+    'normal carried by their dominant joint, with LBS\'s count over the same frames. Creases: interior edges whose dihedral ' +
+    'angle changed by more than 20° from the rest pose, with the ratio to the more of LBS\'s and DQS\'s counts. Stretched: an edge over twice its rest ' +
     'length. "resampled": the classic model has no vertex of the original mesh; "loss": its resampling detail loss, RMS / max ' +
     'distance of the replaced input vertices to the resampled surface (the largest over the meshes).' +
     (reports.some((r) => r.meshes.length > 1) ? ' Characters of several skinned meshes: the p95 is the largest over the meshes (an upper bound).' : ''));

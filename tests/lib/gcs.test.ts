@@ -300,11 +300,16 @@ describe('GCS weights criterion (default)', () => {
     const skin = tubeSkin(bend(tube, 100));
     const dqs = rig.buildDqs();
     dqs.deform(skin);
-    const weights = rig.buildGcs();
+    const weights = rig.buildGcs({ smooth: false });
     weights.deform(skin);
-    // 5 rings, weights 0, 0.16, 0.5, 0.84, 1 on joint 1: one section per ring.
+    // 5 rings, weights 0, 0.16, 0.5, 0.84, 1 on joint 1: stepped, one section per ring (its exact weights).
     expect(weights.sectionCount).toBe(5);
     expect(distance(weights, dqs)).toBeLessThan(1e-5);
+    // The default (smooth) interpolates between nodes at s = 1/8 and 2/8 from each core: close, not exact.
+    const byDefault = rig.buildGcs();
+    byDefault.deform(skin);
+    expect(byDefault.sectionCount).toBe(7);
+    expect(distance(byDefault, dqs)).toBeLessThan(0.01);
     const paper = rig.buildGcs({ criterion: 'axial' });
     paper.deform(skin);
     expect(distance(paper, dqs)).toBeGreaterThan(0.05);
@@ -345,13 +350,16 @@ describe('GCS weights criterion (default)', () => {
       d.dispose();
       return { e, n };
     };
-    const coarse = error({ sections: 3 }), mid = error({ sections: 6 }), fine = error({ sections: 20 });
-    const smooth = error({ sections: 6, smooth: true });
+    const coarse = error({ sections: 3, smooth: false }), mid = error({ sections: 6, smooth: false }), fine = error({ sections: 20, smooth: false });
     expect(coarse.n).toBeLessThan(mid.n);
     expect(mid.n).toBeLessThan(fine.n);
     expect(mid.e).toBeLessThan(coarse.e);
     expect(fine.e).toBeLessThan(mid.e);
+    // The default (smooth nodes) at the same setting: closer still, and also finer with more sections.
+    const smooth = error({ sections: 6 }), smoothCoarse = error({ sections: 3 }), smoothFine = error({ sections: 20 });
     expect(smooth.e).toBeLessThan(mid.e / 2);
+    expect(smooth.e).toBeLessThan(smoothCoarse.e);
+    expect(smoothFine.e).toBeLessThan(smooth.e);
     rig.dispose();
   });
 });

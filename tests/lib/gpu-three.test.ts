@@ -65,7 +65,7 @@ describe('GPU backend (three.js adapter)', () => {
     const position = g.getAttribute('position') as THREE.BufferAttribute;
     expect(position.usage).toBe(THREE.StaticDrawUsage);
     expect(position.array.buffer).not.toBe(gcs.memory.buffer);
-    expect(g.getAttribute('gcsSection')).toBeDefined();
+    expect(g.getAttribute('gcsBlend')).toBeDefined(); // the default blends two sections per vertex
     // Bind-pose positions: the rig's own, in output order.
     const src = skin.deformer.sourceVertex!;
     const rest = mesh.geometry.getAttribute('position');
@@ -103,7 +103,7 @@ describe('GPU backend (three.js adapter)', () => {
     const character = new GcsCharacter(gcs, group, { backend: 'gpu', gpuPath: 'sections' });
     const skin = character.skins[0];
     expect(skin.gpuPath).toBe('sections');
-    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-plain-sections');
+    expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain('gcs-smooth-sections');
     const sections = skin.gpuSections!;
     expect(sections.table).toBeNull();
     const S = skin.deformer.sectionCount;

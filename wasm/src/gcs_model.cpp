@@ -224,14 +224,12 @@ uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight
 // The weights criterion (design.md §2a): sections are bins of the welded vertices' skin weights on
 // a grid of step 1/Q, Q = 2 · (sections − 2) (so the even split between two joints is a bin: their
 // shared section). Each section's blend is its members' mean weights on the joints of its key; a
-// key with one joint is that joint's rigid core (transform exactly S_j). Smooth mode: each group
-// also gets the neighbouring bin along its most off-centre weight and the factor towards it.
+// key with one joint is that joint's rigid core (transform exactly S_j). The stepped level of
+// detail (smooth: false); smooth mode builds nodes instead (buildWeightNodes).
 void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
-                         std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
-                         std::vector<float>& blendOfGroup) {
+                         std::vector<uint32_t>& sectionOfGroup) {
   const uint32_t G = uint32_t(representative.size());
   const uint32_t Q = 2 * (m.settings.sections - 2);
-  std::vector<WeightKey> keyOfGroup(G);
   std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
   std::vector<WeightKey> keys;
   std::vector<uint32_t> keyOf(G);
@@ -261,7 +259,6 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
     }
     key.q[d] = std::max(others < Q ? Q - others : 0u, std::max(largest, 1u));
     key.canonical(Q);
-    keyOfGroup[g] = key;
     auto it = keyIndex.find(key);
     if (it == keyIndex.end()) {
       it = keyIndex.emplace(key, uint32_t(keys.size())).first;
@@ -322,62 +319,7 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = sectionOfKey[keyOf[g]];
   m.partCount = 0;
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
-  if (!m.settings.smooth) return;
-
-  // Smooth mode: a section's transform is the blend at its mean weights (a rigid core: weight 1 on
-  // its joint). Along the vertex's weight that lies farthest from its section's mean, the
-  // neighbouring bin on that side (weight moved to or from the dominant joint) and the factor of
-  // the vertex between the two means.
-  auto meanWeight = [&](uint32_t section, uint32_t joint) {
-    const Section& sec = m.sections[section];
-    for (uint32_t s = 0; s < sec.influenceCount; ++s)
-      if (m.influences[sec.influenceFirst + s].joint == joint) return m.influences[sec.influenceFirst + s].weight;
-    return 0.0f;
-  };
-  otherOfGroup.resize(G);
-  blendOfGroup.assign(G, 0.0f);
-  for (uint32_t g = 0; g < G; ++g) {
-    const uint32_t own = sectionOfGroup[g];
-    otherOfGroup[g] = own;
-    const glm::uvec4& joint = cleanJoints[g];
-    const glm::vec4& weight = cleanWeightsOf[g];
-    const uint32_t n = cleanCount[g];
-    uint32_t d = 0;
-    for (uint32_t i = 1; i < n; ++i)
-      if (weight[i] > weight[d]) d = i;
-    uint32_t pick = ~0u;
-    float offset = 0.0f;
-    for (uint32_t i = 0; i < n; ++i) {
-      if (i == d) continue;
-      float off = weight[i] - meanWeight(own, joint[i]);
-      if (std::fabs(off) > std::fabs(offset)) offset = off, pick = i;
-    }
-    if (pick == ~0u || offset == 0.0f) continue;
-    WeightKey nb = keyOfGroup[g];
-    const int step = offset > 0.0f ? 1 : -1;
-    uint32_t si = nb.slot(joint[pick]), sd = nb.slot(joint[d]);
-    if (sd == ~0u) continue;
-    if (si == ~0u) {
-      if (step < 0 || nb.n == 4) continue;
-      si = nb.n++;
-      nb.joint[si] = joint[pick];
-      nb.q[si] = 0;
-    }
-    if (step < 0 && nb.q[si] == 0) continue;
-    if (step > 0 && nb.q[sd] == 0) continue;
-    nb.q[si] = uint32_t(int(nb.q[si]) + step);
-    nb.q[sd] = uint32_t(int(nb.q[sd]) - step);
-    nb.canonical(Q);
-    auto it = keyIndex.find(nb);
-    if (it == keyIndex.end()) continue;
-    const uint32_t other = sectionOfKey[it->second];
-    float span = meanWeight(other, joint[pick]) - meanWeight(own, joint[pick]);
-    if (span * offset <= 0.0f) continue;
-    otherOfGroup[g] = other;
-    blendOfGroup[g] = glm::clamp(offset / span, 0.0f, 1.0f);
-  }
 }
-
 
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
 // d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
@@ -540,7 +482,7 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       std::vector<uint32_t> sectionOfGroup, otherOfGroup;
       std::vector<float> blendOfGroup;
       if (settings.smooth) buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
-      else buildWeightSections(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
+      else buildWeightSections(rig, m, representative, sectionOfGroup);
       std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
       if (settings.smooth) {
         m.blendOther.resize(rig.vertexCount);

@@ -62,7 +62,12 @@ export interface GcsOptions {
   criterion?: Criterion;
   /** Y/axial only: fraction of a part over which joint influence ramps, (0, 1]. Default 1 (the paper). */
   influenceWidth?: number;
-  /** Each vertex blends its section's transform with the neighbouring section's. Default false. */
+  /**
+   * Each vertex blends the transforms of the two sections around it (no steps between sections).
+   * Default true under 'weights' (sections are then nodes on the rays from each rigid core, design.md
+   * §2a: as smooth as DQS, measured by creases), false under the paper's 'y' and 'axial' (the paper's
+   * method as published). `false` under 'weights' is the fastest, stepped level of detail.
+   */
   smooth?: boolean;
   /** Y/axial only: spread a joint's twist along the child part. Default false. */
   twistSpread?: boolean;
@@ -289,7 +294,7 @@ export class Rig {
     if (!(width > 0 && width <= 1))
       throw new GcsError('OUT_OF_RANGE', `the influence width must be in (0, 1]; got ${width}`);
     const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
-      options.smooth ? 1 : 0, options.twistSpread ? 1 : 0);
+      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0);
     if (!h) this.gcs.raise('the GCS model could not be built');
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }

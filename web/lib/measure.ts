@@ -192,13 +192,13 @@ export function restError(deformer: Deformer, rigPositions: ArrayLike<number>): 
 
 /**
  * The methods the report, metrics and tests compare: GCS with the weights criterion (the default),
- * smooth, the paper's Y criterion and the axial variant (influence width 1), the classic
+ * plain (its stepped level of detail, smooth: false), the paper's Y criterion and the axial variant (influence width 1), the classic
  * cross-section model, LBS and DQS.
  */
-export type MethodName = 'gcs' | 'gcs-smooth' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
-export const METHODS: MethodName[] = ['gcs', 'gcs-smooth', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
+export type MethodName = 'gcs' | 'gcs-plain' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
+export const METHODS: MethodName[] = ['gcs', 'gcs-plain', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
 export const METHOD_LABELS: Record<MethodName, string> = {
-  gcs: 'GCS (weights, default)', 'gcs-smooth': 'GCS smooth (weights)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
+  gcs: 'GCS (weights, default)', 'gcs-plain': 'GCS plain (weights, stepped)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
   classic: 'classic', lbs: 'LBS', dqs: 'DQS',
 };
 
@@ -212,7 +212,7 @@ export interface BuildSettings {
 export function buildMethod(rig: Rig, method: MethodName, settings: BuildSettings = {}): Deformer {
   switch (method) {
     case 'gcs': return rig.buildGcs({ sections: settings.sections });
-    case 'gcs-smooth': return rig.buildGcs({ sections: settings.sections, smooth: true });
+    case 'gcs-plain': return rig.buildGcs({ sections: settings.sections, smooth: false });
     case 'gcs-y': return rig.buildGcs({ sections: settings.sections, criterion: 'y' });
     case 'gcs-axial': return rig.buildGcs({ sections: settings.sections, criterion: 'axial' });
     case 'classic': return rig.buildClassic({ contours: settings.contours, rays: settings.rays });

@@ -259,14 +259,18 @@ export function formatReport(r: Report): string {
     out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
     const lbs = m.methods.lbs?.fidelity?.flipped;
-    const rows = [['method', 'build ms', 'median ms', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'stretched', 'normal off', 'non-finite', 'seam gap %', 'note']];
+    // Creases against the baselines: the more of LBS's and DQS's count over the same frames.
+    const creaseBase = Math.max(m.methods.lbs?.fidelity?.creases ?? 0, m.methods.dqs?.fidelity?.creases ?? 0);
+    const rows = [['method', 'build ms', 'median ms', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'creases', 'stretched', 'normal off', 'non-finite', 'seam gap %', 'note']];
     for (const name of METHODS) {
       const x = m.methods[name];
-      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', `${x.error!.code}: ${x.error!.message}`]); continue; }
+      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', '', `${x.error!.code}: ${x.error!.message}`]); continue; }
       const f = x.fidelity;
       const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : `${f.flipped} (LBS ${lbs})`;
+      const creases = name === 'lbs' || name === 'dqs' || !(creaseBase > 0) ? String(f.creases)
+        : `${f.creases} (${(f.creases / creaseBase).toFixed(2)}× LBS/DQS)`;
       const note = x.detailLoss ? `resampled: detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of its height` : '';
-      rows.push([name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, String(f.stretched),
+      rows.push([name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, creases, String(f.stretched),
         fmt(f.normalOffUnit, 4), String(f.nonFinite), fmt(f.seamGap, 4), note]);
     }
     out.push(table(rows));
