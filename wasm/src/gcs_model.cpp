@@ -888,6 +888,7 @@ uint32_t GcsDeformerImpl::countAdjusted() const {
 void GcsDeformerImpl::computeSections(const glm::mat4* skin) {
   const uint32_t J = jointCount;
   const ScaleState scale = decomposeAll(skin, J, poses.data());
+  frameScale = scale;
   if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, scale);
   else sectionTransformsPaper(skin, scale);
   // The adjusted-section statistic is computed when asked for (stat), from a copy of the skin.
@@ -899,10 +900,17 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
   computeSections(skin);
   const uint32_t S = uint32_t(sections.size());
   if (settings.smooth) {
+    // Every scale the same uniform s (and the weights criterion, whose normal matrices are then the
+    // rotations of the position matrices): one lerp serves positions and normals.
+    const bool uniform = frameScale.uniform && settings.criterion == GCS_CRITERION_WEIGHTS && frameScale.s > 0.0f;
+    const float invS = uniform ? 1.0f / frameScale.s : 1.0f;
     for (const BlendRun& run : blendRuns) {
       size_t o = size_t(run.first) * 3;
       const uint32_t a = run.section, b = run.other;
-      if (a == b)
+      if (a != b && uniform && nearRotations(normalMatrices[a], normalMatrices[b]))
+        blendRunUniform(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
+                        &restNormals[o], &positions[o], &normals[o], run.count);
+      else if (a == b)
         transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
                      &positions[o], &normals[o], run.count);
       else

@@ -92,6 +92,7 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<uint8_t> renormalise;         // normals of the section need renormalising
   std::vector<const JointPose*> blendPoseScratch;
   std::vector<glm::mat4> lastSkin;          // the last frame's S_j, for the adjusted statistic
+  ScaleState frameScale;                    // what the last frame's scales have in common
   mutable uint32_t adjustedSections = 0;
   mutable bool adjustedValid = false;
 
