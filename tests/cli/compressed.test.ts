@@ -124,7 +124,9 @@ describe('compressed copies report the same figures as the original', () => {
             // 16, weights to 8 (quantize, meshopt) or 12 (Draco), which moves rigid vertices a little.
             near(f.rigidError, g.rigidError, 0.05, 0.02, `${at} ${method} rigidError`);
             near(f.dqsP95, g.dqsP95, 0.02, 0.1, `${at} ${method} dqsP95`);
-            near(f.dqsMax, g.dqsMax, 0.05, 0.1, `${at} ${method} dqsMax`);
+            // The max is one vertex's figure: 8-bit weights move a vertex of the default GCS to other
+            // nodes (its interpolation is exact at nodes, 1/64 of weight apart), so it moves more than the p95.
+            near(f.dqsMax, g.dqsMax, 0.08, 0.1, `${at} ${method} dqsMax`);
             near(f.seamGap, g.seamGap, 0.05, 0, `${at} ${method} seamGap`);
             expect(f.normalOffUnit, `${at} ${method}`).toBeLessThan(1e-3);
           }

@@ -74,7 +74,7 @@ describe('GPU backend (three.js adapter)', () => {
     expect(skin.mesh.material).not.toBe(mesh.material);
     expect((skin.mesh.material as THREE.Material).type).toBe((mesh.material as THREE.Material).type);
     for (const m of [skin.mesh.material as THREE.Material, skin.mesh.customDepthMaterial!, skin.mesh.customDistanceMaterial!])
-      expect(m.customProgramCacheKey()).toContain('gcs-plain-joints');
+      expect(m.customProgramCacheKey()).toContain('gcs-smooth-joints');
     const sections = skin.gpuSections!;
     const J = skin.deformer.jointCount;
     expect(sections.path).toBe('joints');
