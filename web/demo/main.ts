@@ -24,6 +24,7 @@ import { SkinDeformer } from '../lib/three.js';
 import { createHumanData, humanFromData, type HumanData } from '../lib/human/index.js';
 import { attributesNeeded, transferAttributes } from './transfer.js';
 import { crowdRequested, startCrowd } from './crowd.js';
+import { measureSettingCost, type SettingCost } from './cost.js';
 
 // ---------------------------------------------------------------------------------------------
 // State
@@ -120,7 +121,7 @@ const params = {
   sections: Math.round(Math.min(48, Math.max(3, qNumber('sections', 6)))),
   criterion: parseCriterion(query.get('criterion')),
   influenceWidth: 1,
-  smooth: qBool('smooth', false),
+  smooth: qBool('smooth', true), // the default: no steps (false: the stepped, faster level of detail)
   twistSpread: qBool('twist', false),
   // classic model (right)
   contours: 25,
@@ -340,7 +341,7 @@ function initGui(): void {
   const criterionCtl = g.add(params, 'criterion', CRITERION_MENU).onChange(() => { pendingGcs = true; updatePaperOnlyControls(); });
   criterionCtl.domElement.style.setProperty('--name-width', '22%'); // room for "axial (paper's rule, bone axis)"
   sectionsController = g.add(params, 'sections', 3, 48, 1).name('sections').onChange(() => { pendingGcs = true; });
-  g.add(params, 'smooth').name('smooth mode').onChange(() => { pendingGcs = true; });
+  g.add(params, 'smooth').name('smooth (no steps)').onChange(() => { pendingGcs = true; });
   paperOnlyControllers = [
     g.add(params, 'influenceWidth', 0.05, 1, 0.05).name('influence width').onChange(() => { pendingGcs = true; }),
     g.add(params, 'twistSpread').name('twist spread').onChange(() => { pendingGcs = true; }),
@@ -820,6 +821,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     };
     classicSummary(next);
     for (const s of next.gcs) { s.mesh.castShadow = true; gcsColours(s); }
+    scheduleCostMeasure(next);
     for (const s of next.classic) s.mesh.castShadow = true;
 
     // Swap: the new character is complete.
@@ -928,6 +930,19 @@ function rebuildGcs(ch: Character): void {
   }
   updateLabels();
   updateReadouts();
+  scheduleCostMeasure(ch);
+}
+
+// What the settings cost, measured once the sliders rest (a drag rebuilds every frame).
+let settingCost: SettingCost | null = null;
+let costTimer = 0;
+function scheduleCostMeasure(ch: Character): void {
+  settingCost = null;
+  clearTimeout(costTimer);
+  costTimer = window.setTimeout(() => {
+    if (ch !== current) return;
+    try { settingCost = measureSettingCost(ch.gcs, gcsOptions()); } catch { settingCost = null; }
+  }, 400);
 }
 
 function rebuildClassic(ch: Character): void {
@@ -1093,6 +1108,9 @@ function updateReadouts(): void {
     rows.gcs.push(`<b>${n(r.gcs.sections)}</b> sections` +
       (r.gcs.criterion === 'weights' ? ` · <b>${(r.gcs.rigidShare * 100).toFixed(0)} %</b> of vertices in rigid cores` : '') +
       ` · <b>${(r.gcs.adjustedShare * 100).toFixed(0)} %</b> adjusted this frame · rest pose exact`);
+    if (settingCost && r.gcs.criterion === 'weights')
+      rows.gcs.push(`cost in this page: <b>${ms(settingCost.current)} ms</b> as set · plain (stepped, smooth off) ${ms(settingCost.plain)} ms · ` +
+        'fewer sections: fewer transforms, coarser');
     const c = CRITERION_TEXT[r.gcs.criterion];
     rows.gcs.push(`<span class="criterion">criterion <b>${esc(c.name)}</b>: ${esc(c.why)}</span>`);
   }
