@@ -336,6 +336,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   const uint32_t G = uint32_t(representative.size());
   const uint32_t Q = 2 * (m.settings.sections - 2), U = 4 * Q, total = Q * U;
   std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
+  keyIndex.reserve(size_t(G) / 4 + 64);  // nodes are far fewer than vertices; no rehash on the way
   std::vector<WeightKey> keys;
   auto keyId = [&](WeightKey key) {
     key.canonical(total);

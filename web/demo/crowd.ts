@@ -6,7 +6,7 @@
 // frame uploads to the GPU, counted on the WebGL calls themselves.
 //
 // URL: ?crowd=N (1 … 500; default 100) &backend=gpu|cpu &path=joints|sections (the GPU path)
-//      &smooth=1 &shadows=1 &paused=1
+//      &smooth=0 (the stepped plain mode) &shadows=1 &paused=1
 //      &vertices=V (the human's vertex count, default 17,023)
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -145,7 +145,7 @@ export async function startCrowd(): Promise<void> {
     characters: clampCount(Number(query.get('crowd') || 100)),
     backend: (query.get('backend') === 'cpu' ? 'cpu' : 'gpu') as Backend,
     path: (query.get('path') === 'sections' ? 'sections' : 'joints') as Path,
-    smooth: query.get('smooth') === '1',
+    smooth: query.get('smooth') !== '0', // the default: no steps
     shadows: query.get('shadows') === '1',
     paused: query.get('paused') === '1',
   };
@@ -274,7 +274,7 @@ export async function startCrowd(): Promise<void> {
   gui.add(params, 'characters', 1, MAX_CROWD, 1).name('characters').onFinishChange(() => build());
   gui.add(params, 'backend', { 'GPU (vertex shader)': 'gpu', 'CPU (wasm, every vertex)': 'cpu' }).name('backend').onChange(() => build());
   gui.add(params, 'path', { 'joint poses': 'joints', 'section transforms': 'sections' }).name('GPU path').onChange(() => build());
-  gui.add(params, 'smooth').name('smooth mode').onChange(() => build());
+  gui.add(params, 'smooth').name('smooth (no steps)').onChange(() => build());
   gui.add(params, 'shadows').onChange(() => { renderer.shadowMap.enabled = params.shadows; });
   gui.add(params, 'paused');
 
