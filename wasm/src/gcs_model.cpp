@@ -324,7 +324,7 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
 // d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
 // (the other joints' shares of s, summing to 1). Sections are NODES on the rays leaving each rigid
-// core: (d, u quantised to multiples of 1/U, level l) with s = l/Q; a node moves by the DQS blend
+// core: (d, u quantised, level l) with s = l/Q; a node moves by the DQS blend
 // at its exact weights (level 0 is the rigid core itself, S_d). A vertex belongs to the node at the
 // level just below its s and blends with the node just above by its fraction: the result is
 // continuous in s, and in u up to s/U of weight (U = 4Q: 1/64 at the default 6 sections), so no
@@ -334,7 +334,9 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
                       std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
                       std::vector<float>& blendOfGroup) {
   const uint32_t G = uint32_t(representative.size());
-  const uint32_t Q = 2 * (m.settings.sections - 2), U = 4 * Q, total = Q * U;
+  // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
+  // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
+  const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
   std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
   keyIndex.reserve(size_t(G) / 4 + 64);  // nodes are far fewer than vertices; no rehash on the way
   std::vector<WeightKey> keys;
@@ -357,30 +359,31 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
     const float s = n > 1 ? glm::clamp(1.0f - weight[d], 0.0f, 1.0f) : 0.0f;
-    // u on the grid 1/U by largest remainders (the quantised shares sum to exactly U).
-    uint32_t q[4] = {0, 0, 0, 0};
-    float rem[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
-    uint32_t used = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-      if (i == d) continue;
-      const float x = weight[i] / s * float(U);
-      q[i] = uint32_t(std::floor(x));
-      rem[i] = x - float(q[i]);
-      used += q[i];
-    }
-    while (s > 0.0f && used < U) {
-      uint32_t best = d == 0 ? 1 : 0;
-      for (uint32_t i = 0; i < n; ++i)
-        if (i != d && rem[i] > rem[best]) best = i;
-      ++q[best], rem[best] = -1.0f, ++used;
-    }
     const float x = s * float(Q);
     const uint32_t level = std::min(uint32_t(std::floor(x)), Q);
     const float frac = x - float(level);
+    // The node at level l: d keeps 8·(Q − l) units, the shape u's 8·l units go by largest remainders.
     auto nodeKey = [&](uint32_t l) {
       WeightKey key;
       key.n = n;
-      for (uint32_t i = 0; i < n; ++i) key.joint[i] = joint[i], key.q[i] = i == d ? (Q - l) * U : l * q[i];
+      const uint32_t units = 8 * l;
+      float rem[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+      uint32_t used = 0;
+      for (uint32_t i = 0; i < n; ++i) {
+        key.joint[i] = joint[i];
+        if (i == d) continue;
+        const float share = s > 0.0f ? weight[i] / s * float(units) : 0.0f;
+        key.q[i] = uint32_t(std::floor(share));
+        rem[i] = share - float(key.q[i]);
+        used += key.q[i];
+      }
+      while (used < units) {
+        uint32_t best = d == 0 ? 1 : 0;
+        for (uint32_t i = 0; i < n; ++i)
+          if (i != d && rem[i] > rem[best]) best = i;
+        ++key.q[best], rem[best] = -1.0f, ++used;
+      }
+      key.q[d] = 8 * (Q - l);
       return keyId(key);
     };
     lowKey[g] = nodeKey(level);
