@@ -324,12 +324,12 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
 // d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
 // (the other joints' shares of s, summing to 1). Sections are NODES on the rays leaving each rigid
-// core: (d, u quantised, level l) with s = l/Q; a node moves by the DQS blend
-// at its exact weights (level 0 is the rigid core itself, S_d). A vertex belongs to the node at the
-// level just below its s and blends with the node just above by its fraction: the result is
-// continuous in s, and in u up to s/U of weight (U = 4Q: 1/64 at the default 6 sections), so no
-// step between bins (design.md §2a; creases measured in §7). Keys count weight in units of
-// 1/(Q·U): the even split of two joints is one key from either side, so their rays share that node.
+// core: (d, u quantised, level l) with s = l/Q; a node moves by the DQS blend at its exact weights
+// (level 0 is the rigid core itself, S_d). A vertex belongs to the node at the level just below its
+// s and blends with the node just above by its fraction: the result is continuous in s, and in u up
+// to 1/(8Q) of weight (1/64 at the default 6 sections), so no step between bins (design.md §2a;
+// creases measured in §7). The even split of two joints is one key from either side, so their rays
+// share that node.
 void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
                       std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
                       std::vector<float>& blendOfGroup) {
