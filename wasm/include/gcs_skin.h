@@ -128,9 +128,10 @@ typedef enum GcsDeformerKind {
  *   criterion       a GcsCriterion (values above GCS_CRITERION_WEIGHTS are rejected).
  *   influenceWidth  Y / axial: fraction of a part over which joint influence ramps, in (0, 1];
  *                   1 = the paper. Checked but unused by the weights criterion.
- *   smooth          nonzero: each vertex blends its section's transform with a neighbouring
- *                   section's (Y / axial: the sections bracketing its axial coordinate; weights: the
- *                   next bin along its weight farthest from its section's mean), normals renormalised.
+ *   smooth          nonzero: each vertex blends two sections' transforms, normals renormalised
+ *                   (Y / axial: the sections bracketing its axial coordinate; weights: the nodes
+ *                   around its weights, below). The JS API turns it on by default for the weights
+ *                   criterion; zero there is the stepped, fastest level of detail.
  *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
  *
  * Weights criterion (design.md §2a): welded vertices (same bind-pose position) are binned by their
@@ -141,6 +142,14 @@ typedef enum GcsDeformerKind {
  * dual-quaternion blend of its joints at its members' mean weights (for a parent/child pair: a
  * fraction of the child's rotation about the joint centre, the paper's rule), with the scale parts
  * of the S_j blended linearly and applied first.
+ * Weights criterion, smooth (the default of the JS API; no steps): a welded vertex's weights are
+ * w = (1 − s)·e_d + s·u (d dominant, s = 1 − w_d, u the other joints' shares). Sections are nodes
+ * (d, u, level l) at s = l/Q, Q = 2·(sections − 2), each node's weights on a grid of 1/(8Q) (the
+ * shape u gets 8·l units by largest remainders), moved by the dual-quaternion blend at exactly those
+ * weights (level 0: the rigid core, exactly S_d; the even split of two joints: one node for both).
+ * A vertex belongs to the node at the level below its s (its run in the output) and blends with the
+ * node above by its fraction (gcs_gcs_blend_other / gcs_gcs_blend_factor); a node only blended
+ * towards may hold no vertex (count 0). Up to two nodes per welded vertex.
  * Y / axial criteria (the paper, design.md §2b–3): parts by dominant weight, shared sections from
  * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
  * transform S_p · D_j^α · D_k^β on the rigid parts of the S_j (scale applied first).
