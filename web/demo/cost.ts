@@ -11,32 +11,43 @@ export interface SettingCost {
   plain: number;
 }
 
-/** Median ms of `deform` over repeated rounds (each round long enough for the browser's coarse clock). */
-function timeDeform(deform: () => void): number {
-  const rounds: number[] = [];
-  for (let r = 0; r < 5; r++) {
-    let n = 0;
-    const t0 = performance.now();
-    let t = t0;
-    while (t - t0 < 4 || n < 4) { deform(); n++; t = performance.now(); }
-    rounds.push((t - t0) / n);
-  }
-  return rounds.sort((a, b) => a - b)[2];
+/** ms per call of each function: rounds of each taken in turn (so both see the same noise: the
+ *  page renders on the same cores), each round long enough for the browser's coarse clock; medians. */
+function timeInTurn(fns: readonly (() => void)[]): number[] {
+  const rounds: number[][] = fns.map(() => []);
+  // Warm up first: V8 runs new wasm code in its baseline tier until the code is hot, and the
+  // model not on screen has not run yet.
+  for (const fn of fns) for (const t0 = performance.now(); performance.now() - t0 < 30;) fn();
+  for (let r = 0; r < 7; r++)
+    fns.forEach((fn, k) => {
+      let n = 0;
+      const t0 = performance.now();
+      let t = t0;
+      while (t - t0 < 3 || n < 4) { fn(); n++; t = performance.now(); }
+      rounds[k].push((t - t0) / n);
+    });
+  return rounds.map((x) => x.sort((a, b) => a - b)[x.length >> 1]);
 }
 
 /** Times the skins' current GCS models and plain ones built for the comparison (then disposed), in the bind pose. */
 export function measureSettingCost(skins: readonly SkinDeformer[], options: GcsOptions): SettingCost {
   let current = 0, plain = 0;
+  const byWeights = (options.criterion ?? 'weights') === 'weights';
   for (const s of skins) {
     const J = s.deformer.jointCount;
     const identity = new Float32Array(16 * J);
     for (let j = 0; j < J; j++) identity[16 * j] = identity[16 * j + 5] = identity[16 * j + 10] = identity[16 * j + 15] = 1;
-    // A scratch model of the current settings: timing the live one would leave the bind pose on screen.
+    // Scratch models: timing the live one would leave the bind pose on screen.
     const same = s.rig.buildGcs(options);
-    try { current += timeDeform(() => same.deform(identity)); } finally { same.dispose(); }
-    if ((options.criterion ?? 'weights') !== 'weights') { plain = NaN; continue; }
-    const stepped = s.rig.buildGcs({ ...options, smooth: false });
-    try { plain += timeDeform(() => stepped.deform(identity)); } finally { stepped.dispose(); }
+    const stepped = byWeights ? s.rig.buildGcs({ ...options, smooth: false }) : null;
+    try {
+      const [a, b] = timeInTurn([() => same.deform(identity), ...(stepped ? [() => stepped.deform(identity)] : [])]);
+      current += a;
+      plain += stepped ? b : NaN;
+    } finally {
+      same.dispose();
+      stepped?.dispose();
+    }
   }
   return { current, plain };
 }
