@@ -711,7 +711,9 @@ void checkStructure(Built& b, const RigInput& in) {
           "GCS introspection on LBS/DQS");
   }
   if (b.kind == GCS_KIND_GCS) {
-    CHECK(statSections >= 1.0f && statSections <= float(N) && statSections == std::floor(statSections),
+    // Smooth weights nodes: up to two per welded vertex, and a node only blended towards holds none.
+    const bool nodes = b.c == GCS_CRITERION_WEIGHTS && b.smooth != 0;
+    CHECK(statSections >= 1.0f && statSections <= float(nodes ? 2 * N : N) && statSections == std::floor(statSections),
           "section count %g (vertices %u)", double(statSections), N);
     CHECK(statParts >= 1.0f && statParts <= float(in.jointCount) && statParts == std::floor(statParts), "part count %g",
           double(statParts));
@@ -724,7 +726,7 @@ void checkStructure(Built& b, const RigInput& in) {
     for (uint32_t s = 0; s < S; ++s) {
       const float* e = &info[8 * size_t(s)];
       CHECK(e[0] == float(next), "section %u starts at %g, the previous ended at %u", s, double(e[0]), next);
-      CHECK(e[1] >= 1.0f && e[1] == std::floor(e[1]) && double(e[0]) + double(e[1]) <= double(N),
+      CHECK(e[1] >= (nodes ? 0.0f : 1.0f) && e[1] == std::floor(e[1]) && double(e[0]) + double(e[1]) <= double(N),
             "section %u range [%g, +%g) outside the output (%u vertices)", s, double(e[0]), double(e[1]), N);
       CHECK(e[2] >= 0.0f && e[2] < float(in.jointCount) && e[2] == std::floor(e[2]), "section %u part %g", s, double(e[2]));
       CHECK(e[3] == -1.0f || (e[3] >= 0.0f && e[3] < float(in.jointCount) && e[3] == std::floor(e[3])),
