@@ -76,6 +76,8 @@ export interface SkinDeformerOptions {
   gpuPath?: GpuPath | 'auto';
   /** @internal How materials run GCS on the GPU (gcs-skin/webgpu passes its TSL kit). Default: the GLSL kit (WebGLRenderer). */
   gpuKit?: GpuMaterialKit;
+  /** @internal The backend notes already warned about (a GcsCharacter shares one set: one warning per cause). */
+  warned?: Set<string>;
 }
 
 /**
@@ -359,6 +361,8 @@ export class SkinDeformer {
   private readonly kit: GpuMaterialKit;
   /** A geometry replaced during a draw (renderer fallback), freed at the next update(). */
   private retired: THREE.BufferGeometry | null = null;
+  /** The backend notes already printed as console warnings. */
+  private readonly warned: Set<string>;
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
@@ -393,6 +397,7 @@ export class SkinDeformer {
 
     this.baseMaterial = options.material ?? source.material;
     this.kit = options.gpuKit ?? glslKit;
+    this.warned = options.warned ?? new Set();
     const mesh = new DeformedMesh(new THREE.BufferGeometry(), this.baseMaterial);
     mesh.exactBounds = () => this.exactBounds();
     mesh.onBeforeRender = (renderer, _scene, _camera, geometry, material) => {
@@ -552,7 +557,6 @@ export class SkinDeformer {
   private checkRenderer(renderer: unknown, geometry: THREE.BufferGeometry, material: THREE.Material): void {
     const why = this.kit.mismatch(renderer, material);
     if (!why) return;
-    console.warn(`gcs-skin: ${why}. This skin runs on the CPU backend instead.`);
     geometry.setDrawRange(0, 0); // this draw: nothing rather than the bind pose
     const next = this.prepare(this.method, { backend: 'cpu' });
     next.note = why;
@@ -578,6 +582,10 @@ export class SkinDeformer {
     if (this.gpu) disposeGpu(this.gpu);
     this.gpu = next.gpu;
     this.note = next.note;
+    if (next.note && !this.warned.has(next.note)) {
+      this.warned.add(next.note);
+      console.warn(`gcs-skin: ${next.note}. This skin runs on the CPU backend.`);
+    }
     const mesh = this.mesh as DeformedMesh;
     const gpuMaterials = next.gpu?.materials;
     mesh.material = gpuMaterials ? gpuMaterials.material : this.baseMaterial;
@@ -937,11 +945,12 @@ export class GcsCharacter {
     if (!sources.length) throw new GcsError('NO_SKIN', 'no skinned mesh (THREE.SkinnedMesh with a skeleton) under this object: there is nothing to deform');
     updateWorld(root);
     const skins: SkinDeformer[] = [];
+    const warned = new Set<string>();
     try {
       for (const source of sources) {
         skins.push(new SkinDeformer(gcs, source, {
           method: options.method, gcs: options.gcs, classic: options.classic, tangents: options.tangents, inPlace: true,
-          backend: options.backend, gpuPath: options.gpuPath, gpuKit: options.gpuKit,
+          backend: options.backend, gpuPath: options.gpuPath, gpuKit: options.gpuKit, warned,
         }));
       }
     } catch (e) {

@@ -5,6 +5,7 @@
 //   crowd: GcsCrowd on WebGPURenderer, drawn and moving, one draw call per skin;
 //   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials.
 import * as THREE from 'three/webgpu';
+import { WebGLRenderer, WebGLRenderTarget } from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { WebGLNodesHandler } from 'three/addons/tsl/WebGLNodesHandler.js';
 import { initGcsSkin, type GcsOptions } from '../../../web/lib/index.js';
@@ -37,15 +38,15 @@ async function gpuRenderer(): Promise<THREE.WebGPURenderer> {
   return r;
 }
 
-function glRenderer(handler = false): THREE.WebGLRenderer {
-  const r = new THREE.WebGLRenderer({ antialias: false });
+function glRenderer(handler = false): WebGLRenderer {
+  const r = new WebGLRenderer({ antialias: false });
   r.setSize(W, H);
   r.setPixelRatio(1);
   if (handler) r.setNodesHandler(new WebGLNodesHandler());
   return r;
 }
 
-type AnyRenderer = THREE.WebGPURenderer | THREE.WebGLRenderer;
+type AnyRenderer = THREE.WebGPURenderer | WebGLRenderer;
 
 /** Draws into a render target and reads the pixels back (rows bottom-up on both renderers). */
 async function draw(renderer: AnyRenderer, scene: THREE.Scene, camera: THREE.Camera): Promise<Uint8Array> {
@@ -60,8 +61,8 @@ async function draw(renderer: AnyRenderer, scene: THREE.Scene, camera: THREE.Cam
     target.dispose();
     return new Uint8Array(pixels.buffer, pixels.byteOffset, pixels.byteLength).slice();
   }
-  const r = renderer as THREE.WebGLRenderer;
-  const target = new THREE.WebGLRenderTarget(W, H);
+  const r = renderer as WebGLRenderer;
+  const target = new WebGLRenderTarget(W, H);
   r.setRenderTarget(target);
   r.setClearColor(0x000000, 1);
   r.clear();
@@ -192,7 +193,11 @@ async function glslVsTsl(model: string, gcsOptions: GcsOptions, time: number, cl
     character.dispose();
   }
   renderers.glsl.dispose();
-  return { diff: differing(pictures[0], pictures[1]), coverage: coverage(pictures[1]), backends };
+  // MeshNormalNodeMaterial writes its colour sRGB-decoded (so that both look alike on screen);
+  // in a linear render target the GLSL picture is compared after the same decoding.
+  const decode = Array.from({ length: 256 }, (_, v) => Math.round(255 * new THREE.Color().setRGB(v / 255, 0, 0, THREE.SRGBColorSpace).r));
+  const decoded = pictures[0].map((v, i) => (i % 4 === 3 ? v : decode[v]));
+  return { diff: differing(decoded, pictures[1]), coverage: coverage(pictures[1]), backends };
 }
 
 export interface CrowdResult { drawCalls: number; coverage: number; moving: number; bytesPerFrame: number; jointCount: number; path: string }
@@ -226,8 +231,16 @@ async function crowd(model: string, count: number, clipName?: string): Promise<C
     c.update();
     return draw(renderer, scene, camera);
   };
+  // The WebGL2 backend keeps no draw-call count: count the backend's draws of the crowd's mesh.
+  const backend = (renderer as unknown as { backend: { draw(o: { object: THREE.Object3D }, ...rest: unknown[]): void } }).backend;
+  const backendDraw = backend.draw;
+  let calls = 0;
+  backend.draw = function (renderObject, ...rest) {
+    if (renderObject.object === c.mesh) calls++;
+    return backendDraw.call(this, renderObject, ...rest);
+  };
   const a = await frame(0.2);
-  const calls = renderer.info.render.drawCalls;
+  backend.draw = backendDraw;
   const b = await frame(0.6);
   const result = { drawCalls: calls, coverage: coverage(a), moving: differing(a, b).image, bytesPerFrame: c.bytesPerFrame, jointCount: c.jointCount, path: c.sections.path };
   c.dispose();
@@ -236,6 +249,8 @@ async function crowd(model: string, count: number, clipName?: string): Promise<C
 
 export interface FallbackResult {
   before: string; after: string; note: string; warnings: string[];
+  /** the first frame vs the CPU backend's picture: drawn right, or (firstCoverage 0) not at all */
+  firstVsCpu: { image: number; covered: number };
   /** the second frame vs the CPU backend's picture (the fallback draws right) */
   vsCpu: { image: number; covered: number };
   /** the first frame's coverage: nothing, or the right picture; never the bind pose */
@@ -265,7 +280,8 @@ async function fallback(model: string, which: Case): Promise<FallbackResult> {
       if (!mesh.isSkinnedMesh) return;
       if (which === 'webgpu-custom-shader') {
         mesh.material = new THREE.ShaderMaterial({ vertexShader: 'void main() { gl_Position = vec4(position, 1.0); }', fragmentShader: 'void main() { gl_FragColor = vec4(1.0); }' });
-      } else if (which === 'webgpu-node-position' || which === 'webgpu-node-plain') {
+      } else if (which === 'webgpu-node-position' || which === 'webgpu-node-plain' || which === 'webgpu-on-webgl-handler') {
+        // (with the handler: node materials on both backends, so both pictures go through the handler's lighting)
         const material = new THREE.MeshStandardNodeMaterial({ color: 0xc08060 });
         if (which === 'webgpu-node-position') material.positionNode = THREE.TSL.positionLocal.mul(1.01);
         mesh.material = material;
@@ -277,25 +293,28 @@ async function fallback(model: string, which: Case): Promise<FallbackResult> {
   character.update();
   let error = '';
   let first: Uint8Array | null = null, second: Uint8Array | null = null, cpu: Uint8Array | null = null;
+  let after = character.skins.map((s) => s.backend).join(',');
+  let note = character.skins.map((s) => s.backendNote).join(' | ');
   if (which !== 'webgpu-custom-shader') { // WebGPURenderer draws no ShaderMaterial at all
     try {
       first = await draw(renderer, scene, camera);
       character.update();
       second = await draw(renderer, scene, camera);
+      after = character.skins.map((s) => s.backend).join(',');
+      note = character.skins.map((s) => s.backendNote).join(' | ');
       character.rebuild(undefined, { backend: 'cpu' });
       character.update();
       cpu = await draw(renderer, scene, camera);
     } catch (e) {
-      error = String(e);
+      error = `${String(e)} ${(e as Error).stack?.split('\n').slice(1, 4).join(' ')}`;
     }
   }
-  const after = character.skins.map((s) => s.backend).join(',');
-  const note = character.skins.map((s) => s.backendNote).join(' | ');
   character.dispose();
-  if ((renderer as THREE.WebGLRenderer).isWebGLRenderer) renderer.dispose();
+  if ((renderer as WebGLRenderer).isWebGLRenderer) renderer.dispose();
   return {
     before, after: after.split(',')[0], note, warnings: [...warnings],
     vsCpu: second && cpu ? differing(second, cpu) : { image: -1, covered: -1 },
+    firstVsCpu: first && cpu ? differing(first, cpu) : { image: -1, covered: -1 },
     firstCoverage: first ? coverage(first) : -1, error,
   };
 }
@@ -320,7 +339,7 @@ async function crowdOnWrongRenderer(model: string, entry: 'webgpu' | 'three'): P
     code = (e as { code?: string }).code ?? '';
   }
   c.dispose();
-  if ((renderer as THREE.WebGLRenderer).isWebGLRenderer) renderer.dispose();
+  if ((renderer as WebGLRenderer).isWebGLRenderer) renderer.dispose();
   return { error, code, warnings: [...warnings] };
 }
 

@@ -21,8 +21,24 @@ const NODE_MATERIALS: Record<string, new () => THREE.NodeMaterial> = {
   MeshNormalMaterial: THREE.MeshNormalNodeMaterial,
 };
 
-/** Properties not carried from a built-in material to its node equivalent (identity, not look). */
-const NOT_CARRIED = new Set(['uuid', 'type', 'version']);
+/** Properties not carried from a built-in material to its node equivalent: identity and class flags, not look. */
+const NOT_CARRIED = (key: string) => key === 'uuid' || key === 'type' || key === 'version' || /^is[A-Z]/.test(key);
+
+/**
+ * What a WebGLRenderer without a nodes handler (which cannot run node materials) compiles in their
+ * place for the one draw before onBeforeRender moves the skin to the CPU: a program that puts every
+ * vertex beyond the far plane, so nothing is drawn rather than a crash. WebGLNodesHandler and
+ * WebGPURenderer never read these fields.
+ */
+const NOTHING = {
+  vertexShader: 'void main() { gl_Position = vec4( 0.0, 0.0, 2.0, 1.0 ); }',
+  fragmentShader: 'void main() { gl_FragColor = vec4( 0.0 ); }',
+};
+
+/** Uniforms for that program: WebGLRenderer wires its lights into whichever it asks for; the program reads none. */
+function placeholderUniforms(): Record<string, { value: unknown }> {
+  return new Proxy({} as Record<string, { value: unknown }>, { get: (target, key: string) => (target[key] ??= { value: null }) });
+}
 
 type Nodes = { positionNode?: unknown; vertexNode?: unknown; castShadowPositionNode?: unknown };
 
@@ -45,7 +61,7 @@ export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
   const Node = NODE_MATERIALS[source.type];
   const material = new Node();
   const from = source as unknown as Record<string, unknown>, to = material as unknown as Record<string, unknown>;
-  for (const key in source) if (!NOT_CARRIED.has(key)) to[key] = from[key];
+  for (const key in source) if (!NOT_CARRIED(key)) to[key] = from[key];
   material.userData = { ...source.userData };
   material.needsUpdate = true;
   return material;
@@ -63,6 +79,7 @@ export const tslKit: GpuMaterialKit = {
       material.castShadowPositionNode = material.positionNode;
       material.name = m.name;
       material.userData.gcsSource = m;
+      Object.assign(material, { ...NOTHING, uniforms: placeholderUniforms() });
       return material;
     };
     return { material: Array.isArray(source) ? source.map(convert) : convert(source), depth: null, distance: null };
