@@ -310,7 +310,7 @@ async function fallback(model: string, which: Case): Promise<FallbackResult> {
     }
   }
   character.dispose();
-  if ((renderer as WebGLRenderer).isWebGLRenderer) renderer.dispose();
+  if (!(renderer as THREE.WebGPURenderer).isWebGPURenderer) renderer.dispose();
   return {
     before, after: after.split(',')[0], note, warnings: [...warnings],
     vsCpu: second && cpu ? differing(second, cpu) : { image: -1, covered: -1 },
@@ -339,7 +339,7 @@ async function crowdOnWrongRenderer(model: string, entry: 'webgpu' | 'three'): P
     code = (e as { code?: string }).code ?? '';
   }
   c.dispose();
-  if ((renderer as WebGLRenderer).isWebGLRenderer) renderer.dispose();
+  if (!(renderer as THREE.WebGPURenderer).isWebGPURenderer) renderer.dispose();
   return { error, code, warnings: [...warnings] };
 }
 
