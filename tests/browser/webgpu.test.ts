@@ -9,9 +9,8 @@
 import { existsSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { BrowserContext, Page } from 'playwright-core';
-import type { ViteDevServer } from 'vite';
-import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
+import type { Page } from 'playwright-core';
+import { MODELS_DIR, openFixture, skipReason, type FixturePage } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -19,32 +18,18 @@ if (reason) console.log(reason);
 /** The bound: at most 1 % of pixels differ by more than 8/255. */
 const PIXEL_SHARE = 0.01;
 
-let server: ViteDevServer | null = null;
-let context: BrowserContext | null = null;
+let fixture: FixturePage | null = null;
 let page: Page | null = null;
-const errors: string[] = [];
+let errors: string[] = [];
 
 beforeAll(async () => {
   if (reason) return;
-  const vite = await import('vite');
-  server = await vite.createServer({
-    root: join(ROOT, 'tests/browser/webgpu-fixture'),
-    configFile: false,
-    logLevel: 'error',
-    server: { host: '127.0.0.1', port: 0, fs: { allow: [ROOT, MODELS_DIR] } },
-  });
-  await server.listen();
-  context = await launchChromium();
-  page = await context.newPage();
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  await page.goto(server.resolvedUrls!.local[0]);
-  await page.waitForFunction(() => (window as unknown as { __webgpu?: unknown }).__webgpu !== undefined, null, { timeout: 120000 });
+  fixture = await openFixture('webgpu-fixture', '__webgpu');
+  ({ page, errors } = fixture);
 });
 
 afterAll(async () => {
-  await context?.close();
-  await server?.close();
+  await fixture?.close();
 });
 
 // eslint-disable-next-line @typescript-eslint/no-explicit-any

@@ -6,16 +6,16 @@
 //   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials.
 import * as THREE from 'three/webgpu';
 import { WebGLRenderer, WebGLRenderTarget } from 'three';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { WebGLNodesHandler } from 'three/addons/tsl/WebGLNodesHandler.js';
 import { initGcsSkin, type GcsOptions } from '../../../web/lib/index.js';
 import * as WebGL from '../../../web/lib/three.js';
 import { GcsCrowd as WebGLCrowd } from '../../../web/lib/crowd.js';
 import { bakeClip, GcsCharacter, GcsCrowd } from '../../../web/lib/webgpu.js';
 import type { GpuPath } from '../../../web/lib/gpu.js';
-import { createHuman } from '../../../web/lib/human/index.js';
+import { load, stage as stageAt, type Loaded } from '../fixture-scene.js';
 
 const W = 384, H = 384;
+const stage = (root: THREE.Object3D) => stageAt(root, W, H);
 const gcsReady = initGcsSkin();
 
 /** Warnings gcs-skin printed (console.warn lines starting with 'gcs-skin:'). */
@@ -88,36 +88,6 @@ function coverage(a: Uint8Array): number {
   let n = 0;
   for (let o = 0; o < a.length; o += 4) if (a[o] + a[o + 1] + a[o + 2] > 0) n++;
   return n / (a.length / 4);
-}
-
-interface Loaded { root: THREE.Object3D; clips: THREE.AnimationClip[] }
-
-async function load(model: string): Promise<Loaded> {
-  if (model === 'human') {
-    const h = createHuman();
-    const root = new THREE.Group();
-    root.add(h.mesh);
-    return { root, clips: h.clips };
-  }
-  const gltf = await new GLTFLoader().loadAsync(model);
-  return { root: gltf.scene, clips: gltf.animations };
-}
-
-/** A lit scene holding `root`, and a camera framing its rest pose. */
-function stage(root: THREE.Object3D): { scene: THREE.Scene; camera: THREE.PerspectiveCamera } {
-  const scene = new THREE.Scene();
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2));
-  const sun = new THREE.DirectionalLight(0xffffff, 2);
-  sun.position.set(2, 4, 3);
-  scene.add(sun);
-  scene.add(root);
-  root.updateMatrixWorld(true);
-  const box = new THREE.Box3().setFromObject(root);
-  const centre = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length();
-  const camera = new THREE.PerspectiveCamera(40, W / H, size / 100, size * 10);
-  camera.position.copy(centre).add(new THREE.Vector3(0.6, 0.3, 1).normalize().multiplyScalar(size * 1.3));
-  camera.lookAt(centre);
-  return { scene, camera };
 }
 
 function play(loaded: Loaded, clipName?: string): THREE.AnimationMixer {
