@@ -6,10 +6,22 @@ import { createHuman } from '../../web/lib/human/index.js';
 
 export interface Loaded { root: THREE.Object3D; clips: THREE.AnimationClip[] }
 
-/** 'human' (the default human) or a glTF URL. */
+/**
+ * 'human' (the default human), 'human-morph' (the same with a morph target at influence 0.8 that
+ * swells the body along its normals by up to 4 cm, varying along the body) or a glTF URL.
+ */
 export async function load(model: string): Promise<Loaded> {
-  if (model === 'human') {
+  if (model === 'human' || model === 'human-morph') {
     const h = createHuman();
+    if (model === 'human-morph') {
+      const g = h.mesh.geometry, p = g.getAttribute('position'), n = g.getAttribute('normal');
+      const delta = new Float32Array(3 * p.count);
+      for (let i = 0; i < p.count; i++) for (let c = 0; c < 3; c++) delta[3 * i + c] = n.getComponent(i, c) * 0.04 * (0.5 + 0.5 * Math.sin(8 * p.getY(i)));
+      g.morphAttributes.position = [new THREE.BufferAttribute(delta, 3)];
+      g.morphTargetsRelative = true;
+      h.mesh.updateMorphTargets();
+      h.mesh.morphTargetInfluences![0] = 0.8;
+    }
     const root = new THREE.Group();
     root.add(h.mesh);
     return { root, clips: h.clips };

@@ -69,6 +69,18 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     }
   }
 
+  // Morph targets apply before GCS (three.js's order, the CPU's too): a swelling morph at 0.8 on the human.
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    test(`default human with a morph target, ${gpuPath} path: GPU backend = CPU backend`, async () => {
+      const r = await call<{ backends: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number }>('check', 'human-morph', {}, [0.3, 0.7], 'walk', gpuPath);
+      console.log(`human + morph ${gpuPath}: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+      expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+      for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+      for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+      expect(errors).toEqual([]);
+    });
+  }
+
   const cesium = join(MODELS_DIR, 'CesiumMan.glb');
   const soldier = join(MODELS_DIR, 'Soldier.glb');
   const noCesium = !existsSync(cesium), noSoldier = !existsSync(soldier);

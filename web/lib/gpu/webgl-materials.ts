@@ -12,7 +12,7 @@ import type { GcsUniforms, GpuSections } from './sections.js';
 /** Why a material cannot draw a GCS mesh on the GPU, or null when it can. */
 export function gpuMaterialSupport(material: THREE.Material): string | null {
   const m = material as THREE.Material & { isShaderMaterial?: boolean; isNodeMaterial?: boolean };
-  if (m.isNodeMaterial) return `${material.type} is a node material (WebGPU / TSL): the GPU backend patches WebGLRenderer's GLSL materials`;
+  if (m.isNodeMaterial) return `${material.type} is a node material (WebGPU / TSL): gcs-skin/three patches WebGLRenderer's GLSL materials; gcs-skin/webgpu runs GCS in node materials`;
   if (m.isShaderMaterial) return `${material.type} is a custom shader: the GPU backend patches three.js's built-in materials`;
   return null;
 }
