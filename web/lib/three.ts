@@ -19,14 +19,12 @@
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
-import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
+import { bindGeometry, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
 import type { GpuPath } from './gpu/layout.js';
 import { GpuSections } from './gpu/sections.js';
 import { glslKit } from './gpu/webgl-materials.js';
 
-/** @internal Moved to gpu/bind.ts; kept here for the modules that imported them from three.ts. */
-export { remapAttribute, SKINNING_ATTRIBUTES };
 
 /** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
 export type Backend = 'cpu' | 'gpu';
@@ -63,7 +61,8 @@ export interface SkinDeformerOptions {
    * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
    * see gpuPath). GCS only: other methods, and materials that cannot be
    * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
-   * `backendNote` why.
+   * `backendNote` why, and one console warning says so. The same happens at the first draw by a
+   * WebGPURenderer, which never runs the patch: gcs-skin/webgpu is the GPU backend for it (TSL).
    */
   backend?: Backend;
   /**

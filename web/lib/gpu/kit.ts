@@ -16,8 +16,6 @@ export interface GpuMaterials {
 }
 
 export interface GpuMaterialKit {
-  /** The renderer these materials are made for, as its class is named ('WebGLRenderer', 'WebGPURenderer'). */
-  readonly renderer: string;
   /** The package entry that draws with this kit (named in notes and errors). */
   readonly entry: string;
   /** Why `material` cannot draw GCS through this kit, or null when it can. */

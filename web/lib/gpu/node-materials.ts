@@ -69,7 +69,6 @@ export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
 
 /** The TSL kit: what gcs-skin/webgpu draws with. */
 export const tslKit: GpuMaterialKit = {
-  renderer: 'WebGPURenderer',
   entry: 'gcs-skin/webgpu',
   support: nodeMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {

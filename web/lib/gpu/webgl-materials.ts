@@ -59,7 +59,6 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
 
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
 export const glslKit: GpuMaterialKit = {
-  renderer: 'WebGLRenderer',
   entry: 'gcs-skin/three',
   support: gpuMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
