@@ -9,6 +9,7 @@
  */
 import * as THREE from 'three';
 import * as TSL from 'three/tsl';
+import type { Node } from 'three/webgpu';
 import {
   BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JOINTS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
   SECTION_ATTRIBUTE, TABLE_TEXELS_PER_SECTION, UNIFORM_SCALE_TOLERANCE,
@@ -217,7 +218,7 @@ function sectionVertex(sections: N, first: N, smooth: boolean): VertexTransform 
  * instance by then, so it starts from the bind-pose attributes and places the instance itself
  * with the mesh's own `instanceMatrix` (each instance's pose at `instanceIndex`).
  */
-export function gcsPositionNode(sections: GpuSections, instanced: boolean): N {
+export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node {
   const perFrame = texture(sections.texture);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);
