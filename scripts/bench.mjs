@@ -67,11 +67,12 @@ function printCrowd(crowd) {
   const r0 = crowd.rows[0];
   console.log(`\nCrowd: default humans (${r0.vertices} vertices, ${r0.joints} joints, ${r0.sections} GCS sections each), per character and frame; ` +
     'GPU joints: the joint-level path (the default for the weights criterion), GPU sections: the section-level path ' +
-    '(CPU ms: skinning in node, posing included, rendering excluded; bytes: uploads counted on WebGL calls in headless Chromium)');
-  const rows = [['characters', 'CPU backend ms', 'CPU backend bytes', 'GPU joints ms', 'GPU joints bytes', 'GPU sections ms', 'GPU sections bytes', 'ms ratio (CPU/joints)', 'bytes ratio (CPU/joints)']];
+    '(CPU ms: skinning in node, posing included, rendering excluded; bytes: uploads counted on WebGL calls in headless Chromium); ' +
+    `WebGPU joints: gcs-skin/webgpu on WebGPURenderer, joint-level path (${r0.gpuWebgpu.rendererLabel ?? 'WebGPURenderer'} in the browser)`);
+  const rows = [['characters', 'CPU backend ms', 'CPU backend bytes', 'GPU joints ms', 'GPU joints bytes', 'GPU sections ms', 'GPU sections bytes', 'WebGPU joints ms', 'WebGPU joints bytes', 'ms ratio (CPU/joints)', 'bytes ratio (CPU/joints)']];
   for (const r of crowd.rows)
     rows.push([String(r.characters), ms(r.cpu.msPerCharacter), kb(r.cpu.bytesPerCharacter), ms(r.gpu.msPerCharacter), kb(r.gpu.bytesPerCharacter),
-      ms(r.gpuSections.msPerCharacter), kb(r.gpuSections.bytesPerCharacter),
+      ms(r.gpuSections.msPerCharacter), kb(r.gpuSections.bytesPerCharacter), ms(r.gpuWebgpu.msPerCharacter), kb(r.gpuWebgpu.bytesPerCharacter),
       `${(r.cpu.msPerCharacter / r.gpu.msPerCharacter).toFixed(1)}×`,
       r.gpu.bytesPerCharacter ? `${(r.cpu.bytesPerCharacter / r.gpu.bytesPerCharacter).toFixed(0)}×` : 'n/a']);
   console.log(fmtTable(rows));

@@ -100,6 +100,23 @@ describe('the npm tarball, alone in an empty folder', () => {
     expect(result.code).toBe('SECTION_COUNT');
   });
 
+  test('gcs-skin/webgpu resolves through the exports map: GcsCharacter, GcsCrowd and SkinDeformer for WebGPURenderer, no internals in its types', () => {
+    writeFileSync(join(a, 'webgpu.mjs'), `
+    import * as webgpu from 'gcs-skin/webgpu';
+    import * as three from 'gcs-skin/three';
+    import * as crowd from 'gcs-skin/crowd';
+    console.log(JSON.stringify({
+      names: Object.keys(webgpu).sort(),
+      subclasses: webgpu.GcsCharacter.prototype instanceof three.GcsCharacter && webgpu.GcsCrowd.prototype instanceof crowd.GcsCrowd && webgpu.SkinDeformer.prototype instanceof three.SkinDeformer,
+    }));
+  `);
+    const result = JSON.parse(execFileSync(process.execPath, ['webgpu.mjs'], { cwd: a, encoding: 'utf8' }).trim().split('\n').pop()!);
+    expect(result.names).toEqual(expect.arrayContaining(['GcsCharacter', 'GcsCrowd', 'SkinDeformer', 'bakeClip', 'writeSkinMatrices']));
+    expect(result.subclasses).toBe(true);
+    for (const file of ['webgpu.d.ts', 'three.d.ts', 'crowd.d.ts'])
+      expect(readFileSync(join(a, 'node_modules/gcs-skin/dist', file), 'utf8')).not.toMatch(/@internal|gpuKit\?:|warned\?:/);
+  });
+
   test('npx gcs-skin human, then npx gcs-skin report on meshopt-compressed and quantized copies', async () => {
     const human = spawnSync(npx, ['gcs-skin', 'human', '--vertices', '3000', '-o', 'h.glb'], { cwd: a, encoding: 'utf8' });
     expect(human.status, human.stderr).toBe(0);

@@ -8,13 +8,18 @@
 //     deforms its 17 k vertices. Rendering excluded. Median over many frames.
 //   bytes: the demo's crowd page (?crowd=N&backend=…) in headless Chromium, counted on the WebGL
 //     upload calls (texSubImage2D, bufferSubData, …) during renderer.render() — what the browser
-//     really sends. Software rendering (SwiftShader) gives no GPU times; its CPU ms are printed
+//     really sends.
+//   WebGPURenderer: gcs-skin/webgpu's GcsCrowd (TSL node materials) on the joint-level path, CPU ms
+//     in node as above and bytes from the crowd page with &renderer=webgpu. Headless Chromium has
+//     no GPU, so WebGPURenderer runs its WebGL2 fallback there and the same WebGL calls are counted
+//     (real WebGPU, counted on its queue by the demo, is not measured here). Software rendering (SwiftShader) gives no GPU times; its CPU ms are printed
 //     as a cross-check (performance.now() is coarse in a page).
 import { existsSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { GcsCrowd, bakeClip } from '../../dist/crowd.js';
+import { GcsCrowd as WebGPUCrowd } from '../../dist/webgpu.js';
 import { rigInputFromSkinnedMesh } from '../../dist/three.js';
 import { timeFrames } from '../../dist/measure.js';
 
@@ -29,8 +34,8 @@ function cpuTimes(gcs, human, n, quick) {
   const dt = 1 / 60;
   const timing = { minSamples: quick ? 30 : 120, minMs: quick ? 100 : 400, maxMs: quick ? 1500 : 6000, warmup: 10 };
   // GPU backend, both paths.
-  const gpuRun = (gpuPath) => {
-    const crowd = new GcsCrowd(gcs, human.mesh, n, { gpuPath });
+  const gpuRun = (gpuPath, Crowd = GcsCrowd) => {
+    const crowd = new Crowd(gcs, human.mesh, n, { gpuPath });
     if (crowd.sections.path !== gpuPath) throw new Error(`the crowd runs the ${crowd.sections.path} path, not ${gpuPath}`);
     const timing_ = timeFrames(240, (f) => {
       const t = f * dt;
@@ -43,6 +48,7 @@ function cpuTimes(gcs, human, n, quick) {
   };
   const joints = gpuRun('joints');
   const sectionLevel = gpuRun('sections');
+  const webgpu = gpuRun('joints', WebGPUCrowd);
   // CPU backend: a deformer per character, as GcsCharacter / the demo.
   const rig = gcs.createRig(rigInputFromSkinnedMesh(human.mesh));
   const deformers = Array.from({ length: n }, () => rig.buildGcs({}));
@@ -60,7 +66,7 @@ function cpuTimes(gcs, human, n, quick) {
   }, { ...timing, minSamples: quick ? 10 : 40, maxMs: quick ? 2000 : 8000 });
   for (const d of deformers) d.dispose();
   rig.dispose();
-  return { gpu: joints.timing, gpuSections: sectionLevel.timing, cpu, sections: joints.sections, joints: joints.joints,
+  return { gpu: joints.timing, gpuSections: sectionLevel.timing, gpuWebgpu: webgpu.timing, cpu, sections: joints.sections, joints: joints.joints,
     textureBytes: joints.textureBytes, sectionTextureBytes: sectionLevel.textureBytes };
 }
 
@@ -81,7 +87,7 @@ async function browserBytes(sizes, quick, log) {
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
   });
   const out = {};
-  const runs = { cpu: 'backend=cpu', gpu: 'backend=gpu&path=joints', gpuSections: 'backend=gpu&path=sections' };
+  const runs = { cpu: 'backend=cpu', gpu: 'backend=gpu&path=joints', gpuSections: 'backend=gpu&path=sections', gpuWebgpu: 'backend=gpu&path=joints&renderer=webgpu' };
   try {
     for (const [backend, params] of Object.entries(runs)) {
       for (const n of sizes) {
@@ -115,15 +121,17 @@ export async function crowdBench(gcs, human, { quick = false, log = console.log,
     rows.push({ characters: n, sections: t.sections, joints: t.joints, vertices: human.mesh.geometry.getAttribute('position').count,
       gpu: { path: 'joints', msPerFrame: t.gpu.medianMs, msPerCharacter: t.gpu.medianMs / n, p95Ms: t.gpu.p95Ms, textureBytes: t.textureBytes },
       gpuSections: { path: 'sections', msPerFrame: t.gpuSections.medianMs, msPerCharacter: t.gpuSections.medianMs / n, p95Ms: t.gpuSections.p95Ms, textureBytes: t.sectionTextureBytes },
+      gpuWebgpu: { path: 'joints', renderer: 'WebGPURenderer', msPerFrame: t.gpuWebgpu.medianMs, msPerCharacter: t.gpuWebgpu.medianMs / n, p95Ms: t.gpuWebgpu.p95Ms, textureBytes: t.textureBytes },
       cpu: { msPerFrame: t.cpu.medianMs, msPerCharacter: t.cpu.medianMs / n, p95Ms: t.cpu.p95Ms } });
   }
   const browser = await browserBytes(sizes, quick, log);
   for (const r of rows) {
-    for (const b of ['cpu', 'gpu', 'gpuSections']) {
+    for (const b of ['cpu', 'gpu', 'gpuSections', 'gpuWebgpu']) {
       const m = browser[`${b}-${r.characters}`];
       r[b].bytesPerFrame = m ? m.bytesPerFrame : null;
       r[b].bytesPerCharacter = m ? m.bytesPerFrame / r.characters : null;
       r[b].pageMsPerFrame = m ? m.msPerFrame : null;
+      if (m?.renderer) r[b].rendererLabel = m.renderer;
     }
   }
   const at = (n) => rows.find((r) => r.characters === n) ?? rows[rows.length - 1];

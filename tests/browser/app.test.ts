@@ -296,6 +296,15 @@ test("src/main.ts is the README's example: every line of it is there, but the on
   expect(absent, 'README lines missing from tests/browser/app-fixture/src/main.ts (update the fixture, or list them in REPLACED)').toEqual([]);
 });
 
+test("src/webgpu.ts is the README's WebGPURenderer example, line for line (type-checked with the app)", () => {
+  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
+  const section = readme.slice(readme.indexOf('### With WebGPURenderer'));
+  const block = /```ts\n([\s\S]*?)```/.exec(section);
+  expect(block, 'no ```ts block under "### With WebGPURenderer" in README.md').not.toBeNull();
+  const code = (text: string) => text.split('\n').filter((l) => l.trim() && !l.trim().startsWith('//'));
+  expect(code(readFileSync(join(ROOT, 'tests/browser/app-fixture/src/webgpu.ts'), 'utf8'))).toEqual(code(block![1]));
+});
+
 async function waitForServer(address: string): Promise<void> {
   const t0 = performance.now();
   for (;;) {

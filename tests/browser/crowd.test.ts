@@ -9,7 +9,7 @@ import { analyse, launchChromium, skipReason, startDemo, type DemoServer } from 
 const reason = skipReason();
 if (reason) console.log(reason);
 
-interface Measure { characters: number; backend: string; path: string | null; joints: number; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
+interface Measure { renderer: string; characters: number; backend: string; path: string | null; joints: number; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
 interface CrowdHook {
   frame(): number; count(): number; backend(): string; drawn(): number; drawCalls(): number; readout(): string;
   set(n: number, backend?: string, path?: string): void; measure(frames: number): Promise<Measure>; pause(t?: number): void;
@@ -85,6 +85,29 @@ describe.skipIf(!!reason)('crowd mode', () => {
     const cpu = await page.evaluate(() => window.__crowd.measure(3));
     console.log(`CPU backend, 6 characters: ${cpu.msPerFrame.toFixed(3)} ms, ${cpu.bytesPerFrame} bytes per frame`);
     expect(cpu.bytesPerFrame).toBeGreaterThanOrEqual(6 * cpu.vertices * 24); // positions + normals, float32
+    expect(errors).toEqual([]);
+    await page.close();
+  }, 300000);
+
+  test('?crowd=16&renderer=webgpu: WebGPURenderer (WebGL2 fallback here) with gcs-skin/webgpu, drawn and moving, the joint poses uploaded', async () => {
+    const { page, errors } = await open('?crowd=16&renderer=webgpu', { width: 640, height: 360 });
+    expect(await page.evaluate(() => window.__crowd.drawn())).toBe(16);
+    expect(await page.evaluate(() => window.__crowd.backend())).toBe('gpu');
+    const m = await page.evaluate(() => window.__crowd.measure(4));
+    console.log(`${m.renderer}, GPU backend, 16 characters: ${m.msPerFrame.toFixed(3)} ms skinning CPU per frame, ${m.bytesPerFrame} bytes uploaded per frame`);
+    expect(m.renderer).toBe('WebGPURenderer (WebGL2 fallback)');
+    expect(m.path).toBe('joints');
+    // The joint poses, plus the renderer's own per-frame uniforms (camera, lights: a few KB).
+    expect(m.bytesPerFrame).toBeGreaterThanOrEqual(16 * m.joints * 64);
+    expect(m.bytesPerFrame / 16).toBeLessThanOrEqual(8 * 1024);
+    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/16 characters .*WebGPURenderer \(WebGL2 fallback\) · GPU backend \(joint poses\)/);
+    const region = { x: 0, y: 0, width: 640 - 300, height: 360 };
+    const a = await page.screenshot();
+    await page.waitForFunction((f) => window.__crowd.frame() > f + 3, await page.evaluate(() => window.__crowd.frame()));
+    const [stats] = await analyse(page, await page.screenshot(), [region], a);
+    console.log(`WebGPURenderer crowd pixels: ${(100 * stats.skin).toFixed(1)} % skin colour, ${(100 * stats.changed).toFixed(1)} % changed in 3 frames`);
+    expect(stats.skin).toBeGreaterThan(0.02);
+    expect(stats.changed).toBeGreaterThan(0.005);
     expect(errors).toEqual([]);
     await page.close();
   }, 300000);

@@ -469,6 +469,37 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     }
   }, 180000);
 
+  test('?renderer=webgpu draws both views with WebGPURenderer (its WebGL2 fallback here: no GPU), walking; the readouts name renderer and backend', async () => {
+    expect(await page.locator('.readout[data-view=gcs]').innerText()).toMatch(/WebGLRenderer · CPU backend/);
+    const other = await context.newPage();
+    const errors: string[] = [];
+    other.on('pageerror', (e) => errors.push(e.message));
+    other.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+    try {
+      await other.goto(`${server.url}?renderer=webgpu`);
+      await other.waitForFunction(() => window.__demo !== undefined);
+      await other.evaluate(() => window.__demo.ready);
+      await frames(other, 3);
+      expect(await other.evaluate(() => window.__demo.error())).toBe('');
+      for (const view of ['gcs', 'classic'])
+        expect(await other.locator(`.readout[data-view=${view}]`).innerText()).toMatch(/WebGPURenderer \(WebGL2 fallback\) · CPU backend/);
+      const regions = await viewRegions(other);
+      const a = await other.screenshot();
+      await other.waitForTimeout(300);
+      await frames(other, 3);
+      const stats = await analyse(other, await other.screenshot(), regions, a);
+      stats.forEach((s, i) => {
+        expect(s.colours, `distinct colours in view ${i}`).toBeGreaterThan(150);
+        expect(s.skin, `share of skin pixels in view ${i}`).toBeGreaterThan(0.02);
+      });
+      expect(stats[0].changed).toBeGreaterThan(0.003); // walking
+      await expect(other.locator('.lil-gui .controller .name', { hasText: /^renderer$/ }).isVisible()).resolves.toBe(true);
+      expect(errors).toEqual([]);
+    } finally {
+      await other.close();
+    }
+  }, 180000);
+
   test('no uncaught errors in the page', () => {
     expect(pageErrors).toEqual([]);
   });

@@ -9,9 +9,8 @@
 import { existsSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { BrowserContext, Page } from 'playwright-core';
-import type { ViteDevServer } from 'vite';
-import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
+import type { Page } from 'playwright-core';
+import { MODELS_DIR, openFixture, skipReason, type FixturePage } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -28,33 +27,18 @@ const JOINT_NORMAL_TOLERANCE = 1e-5;
 /** Pictures: the share of pixels that may differ (edge pixels flipped by float rounding). */
 const PIXEL_TOLERANCE = 0.002;
 
-let server: ViteDevServer | null = null;
-let context: BrowserContext | null = null;
+let fixture: FixturePage | null = null;
 let page: Page | null = null;
-const errors: string[] = [];
+let errors: string[] = [];
 
 beforeAll(async () => {
   if (reason) return;
-  const vite = await import('vite');
-  server = await vite.createServer({
-    root: join(ROOT, 'tests/browser/gpu-fixture'),
-    configFile: false,
-    logLevel: 'error',
-    server: { host: '127.0.0.1', port: 0, fs: { allow: [ROOT, MODELS_DIR] } },
-  });
-  await server.listen();
-  const url = server.resolvedUrls!.local[0];
-  context = await launchChromium();
-  page = await context.newPage();
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  await page.goto(url);
-  await page.waitForFunction(() => window.__gpu !== undefined, null, { timeout: 120000 });
+  fixture = await openFixture('gpu-fixture', '__gpu');
+  ({ page, errors } = fixture);
 });
 
 afterAll(async () => {
-  await context?.close();
-  await server?.close();
+  await fixture?.close();
 });
 
 interface Result {

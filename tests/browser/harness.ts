@@ -5,6 +5,7 @@ import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import type { BrowserContext, Page } from 'playwright-core';
+import type { ViteDevServer } from 'vite';
 
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
 export const MODELS_DIR = resolve(ROOT, '../shared/models');
@@ -71,6 +72,34 @@ export async function launchChromium(): Promise<BrowserContext> {
     args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
   });
+}
+
+/** A fixture page (tests/browser/<folder>/index.html) served by Vite's dev server and open in Chromium. */
+export interface FixturePage {
+  page: Page;
+  /** Page errors and console errors, as they come. */
+  errors: string[];
+  close(): Promise<void>;
+}
+
+/** Serves tests/browser/`folder` (the shared models readable through /@fs) and opens it; resolves once `window[hook]` exists. */
+export async function openFixture(folder: string, hook: string): Promise<FixturePage> {
+  const vite = await import('vite');
+  const server: ViteDevServer = await vite.createServer({
+    root: join(ROOT, 'tests/browser', folder),
+    configFile: false,
+    logLevel: 'error',
+    server: { host: '127.0.0.1', port: 0, fs: { allow: [ROOT, MODELS_DIR] } },
+  });
+  await server.listen();
+  const context = await launchChromium();
+  const page = await context.newPage();
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await page.goto(server.resolvedUrls!.local[0]);
+  await page.waitForFunction((h) => (window as unknown as Record<string, unknown>)[h] !== undefined, hook, { timeout: 120000 });
+  return { page, errors, close: async () => { await context.close(); await server.close(); } };
 }
 
 export interface Rect { x: number; y: number; width: number; height: number }

@@ -6,6 +6,7 @@
 // frame uploads to the GPU, counted on the WebGL calls themselves.
 //
 // URL: ?crowd=N (1 … 500; default 100) &backend=gpu|cpu &path=joints|sections (the GPU path)
+//      &renderer=webgl|webgpu (WebGLRenderer + gcs-skin/crowd, or WebGPURenderer + gcs-skin/webgpu)
 //      &smooth=0 (the stepped plain mode) &shadows=1 &paused=1
 //      &vertices=V (the human's vertex count, default 17,023)
 import * as THREE from 'three';
@@ -16,6 +17,7 @@ import { initGcsSkin, type GcsDeformer, type GcsSkin, type Rig } from '../lib/in
 import { bakeClip, GcsCrowd, type BakedClip } from '../lib/crowd.js';
 import { rigInputFromSkinnedMesh } from '../lib/three.js';
 import { createHumanData, humanFromData, type Human, type HumanData } from '../lib/human/index.js';
+import { addRendererSwitch, createRenderer, glContext, rendererKind, rendererLabel, type DemoRenderer } from './renderer.js';
 
 export const MAX_CROWD = 500;
 /** The CPU backend keeps a deformer (about 1.4 MB of wasm memory at 17 k vertices) per character. */
@@ -32,10 +34,34 @@ export function crowdRequested(): boolean {
   return query.has('crowd');
 }
 
-/** Bytes uploaded to the GPU, counted on the WebGL calls that upload (textures and buffers). */
+/**
+ * Bytes uploaded to the GPU, counted on the calls that upload (textures and buffers): WebGL's
+ * (WebGLRenderer, or WebGPURenderer's WebGL2 fallback) or, on real WebGPU, the device queue's.
+ */
 class UploadCounter {
   bytes = 0;
-  constructor(gl: WebGL2RenderingContext) {
+  constructor(renderer: DemoRenderer) {
+    const gl = glContext(renderer);
+    if (gl) this.countGl(gl);
+    else this.countQueue((renderer as unknown as { backend: { device: { queue: object } } }).backend.device.queue);
+  }
+
+  private countQueue(queue: object): void {
+    const q = queue as unknown as Record<string, (...a: unknown[]) => unknown>;
+    const writeBuffer = q.writeBuffer.bind(queue), writeTexture = q.writeTexture.bind(queue);
+    q.writeBuffer = (...a: unknown[]) => {
+      const data = a[2] as ArrayBufferView | ArrayBuffer;
+      this.bytes += (a[4] as number | undefined) ?? data.byteLength;
+      return writeBuffer(...a);
+    };
+    q.writeTexture = (...a: unknown[]) => {
+      const layout = a[2] as { bytesPerRow?: number }, size = a[3] as { height?: number; depthOrArrayLayers?: number } & number[];
+      this.bytes += (layout.bytesPerRow ?? 0) * (size.height ?? size[1] ?? 1) * (size.depthOrArrayLayers ?? size[2] ?? 1);
+      return writeTexture(...a);
+    };
+  }
+
+  private countGl(gl: WebGL2RenderingContext): void {
     const channels: Record<number, number> = { [gl.RGBA]: 4, [gl.RGB]: 3, [gl.RG]: 2, [gl.RED]: 1, [gl.RGBA_INTEGER]: 4, [gl.RED_INTEGER]: 1, [gl.LUMINANCE]: 1, [gl.ALPHA]: 1, [gl.LUMINANCE_ALPHA]: 2 };
     const size: Record<number, number> = { [gl.FLOAT]: 4, [gl.HALF_FLOAT]: 2, [gl.UNSIGNED_BYTE]: 1, [gl.BYTE]: 1, [gl.UNSIGNED_SHORT]: 2, [gl.SHORT]: 2, [gl.UNSIGNED_INT]: 4, [gl.INT]: 4 };
     const texel = (format: number, type: number) => (channels[format] ?? 4) * (size[type] ?? 1);
@@ -153,12 +179,15 @@ export async function startCrowd(): Promise<void> {
   status.hidden = false;
   status.textContent = 'building… generating the human character';
   for (const id of ['hint', 'credit']) document.getElementById(id)?.remove();
-  const renderer = new THREE.WebGLRenderer({ antialias: true });
+  const kind = rendererKind();
+  const renderer = await createRenderer(kind);
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
   renderer.setSize(window.innerWidth, window.innerHeight);
   renderer.shadowMap.enabled = params.shadows;
   document.body.prepend(renderer.domElement);
-  const counter = new UploadCounter(renderer.getContext() as WebGL2RenderingContext);
+  const counter = new UploadCounter(renderer);
+  // WebGPURenderer draws the crowd with gcs-skin/webgpu's GcsCrowd (node materials, TSL).
+  const Crowd: typeof GcsCrowd = kind === 'webgpu' ? (await import('../lib/webgpu.js')).GcsCrowd : GcsCrowd;
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0x242a35);
   scene.fog = new THREE.Fog(0x242a35, 18, 60);
@@ -221,7 +250,7 @@ export async function startCrowd(): Promise<void> {
     walkers = Array.from({ length: count }, (_, i) => ({ clip: i % 3 === 2 ? 1 : 0, phase: random() * 4, speed: 0.85 + 0.3 * random() }));
     const p = new THREE.Vector3();
     if (backend === 'gpu') {
-      gpuCrowd = new GcsCrowd(gcs, source, count, { gcs: { smooth: params.smooth }, gpuPath: params.path });
+      gpuCrowd = new Crowd(gcs, source, count, { gcs: { smooth: params.smooth }, gpuPath: params.path });
       gpuCrowd.mesh.castShadow = true;
       for (let i = 0; i < count; i++) gpuCrowd.mesh.setMatrixAt(i, placement.makeTranslation(positionOf(i, count, p)));
       gpuCrowd.mesh.instanceMatrix.needsUpdate = true;
@@ -271,6 +300,7 @@ export async function startCrowd(): Promise<void> {
   clock.connect(document);
 
   const gui = new GUI({ title: 'Crowd' });
+  addRendererSwitch(gui, kind);
   gui.add(params, 'characters', 1, MAX_CROWD, 1).name('characters').onFinishChange(() => build());
   gui.add(params, 'backend', { 'GPU (vertex shader)': 'gpu', 'CPU (wasm, every vertex)': 'cpu' }).name('backend').onChange(() => build());
   gui.add(params, 'path', { 'joint poses': 'joints', 'section transforms': 'sections' }).name('GPU path').onChange(() => build());
@@ -314,7 +344,7 @@ export async function startCrowd(): Promise<void> {
       smoothedMs = m.msPerFrame;
       smoothedBytes = m.bytesPerFrame;
       const vertices = m.vertices;
-      readout.innerHTML = `<b>${count}</b> characters × ${vertices.toLocaleString('en')} vertices · <b>${backend.toUpperCase()}</b> backend` +
+      readout.innerHTML = `<b>${count}</b> characters × ${vertices.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
         `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}` +
         `${params.smooth ? ' (smooth)' : ''}<br>skinning CPU <b>${smoothedMs.toFixed(2)} ms</b>/frame (median) (${(smoothedMs / count * 1000).toFixed(1)} µs per character)` +
         ` · uploaded <b>${fmtBytes(smoothedBytes)}</b>/frame (${fmtBytes(smoothedBytes / count)} per character)` +
@@ -327,7 +357,7 @@ export async function startCrowd(): Promise<void> {
   const measureLast = (frames: number): CrowdMeasure => {
     const last = samples.slice(-frames);
     const ms = median(last.map((s) => s.ms)), bytes = median(last.map((s) => s.bytes));
-    return { characters: count, backend, path: gpuCrowd?.sections.path ?? null, joints: rig.jointCount, frames: last.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
+    return { renderer: rendererLabel(renderer), characters: count, backend, path: gpuCrowd?.sections.path ?? null, joints: rig.jointCount, frames: last.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
       vertices: source.geometry.getAttribute('position').count, sections: gpuCrowd?.deformer.sectionCount ?? cpuCrowd?.deformers[0]?.sectionCount ?? 0 };
   };
 
@@ -338,7 +368,9 @@ export async function startCrowd(): Promise<void> {
       backend: () => backend,
       /** Characters drawn: instances of the GPU crowd's one mesh, or the CPU backend's meshes. */
       drawn: () => (gpuCrowd ? gpuCrowd.mesh.count : cpuCrowd ? cpuCrowd.group.children.length : 0),
-      drawCalls: () => renderer.info.render.calls,
+      /** WebGLRenderer's count; WebGPURenderer's WebGL2 fallback counts none (its `drawCalls` stays 0). */
+      drawCalls: () => { const r = renderer.info.render as { calls: number; drawCalls?: number }; return r.drawCalls ?? r.calls; },
+      renderer: () => rendererLabel(renderer),
       readout: () => readout.textContent ?? '',
       set: (n: number, b: Backend = params.backend, path: Path = params.path) => { params.characters = clampCount(n); params.backend = b; params.path = path; gui.controllersRecursive().forEach((c) => c.updateDisplay()); build(); },
       /** Medians over the next `frames` frames: skinning CPU ms and bytes uploaded, per frame and per character. */
@@ -350,6 +382,8 @@ export async function startCrowd(): Promise<void> {
 }
 
 export interface CrowdMeasure {
+  /** rendererLabel(): which renderer (and WebGPURenderer's backend) drew */
+  renderer: string;
   characters: number;
   backend: Backend;
   /** GPU backend: its path; null on the CPU backend. */

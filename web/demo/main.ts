@@ -25,6 +25,7 @@ import { createHumanData, humanFromData, type HumanData } from '../lib/human/ind
 import { attributesNeeded, transferAttributes } from './transfer.js';
 import { crowdRequested, startCrowd } from './crowd.js';
 import { measureSettingCost, type SettingCost } from './cost.js';
+import { addRendererSwitch, createRenderer, rendererKind, rendererLabel, type DemoRenderer } from './renderer.js';
 
 // ---------------------------------------------------------------------------------------------
 // State
@@ -142,7 +143,9 @@ const params = {
 };
 
 let gcs: GcsSkin;
-let renderer: THREE.WebGLRenderer;
+let renderer: DemoRenderer;
+/** gcs-skin/three's SkinDeformer, or gcs-skin/webgpu's with ?renderer=webgpu. */
+let Skin: typeof SkinDeformer = SkinDeformer;
 let scene: THREE.Scene;
 let camera: THREE.PerspectiveCamera;
 let controls: OrbitControls;
@@ -244,7 +247,9 @@ function enqueue(task: () => Promise<void>): Promise<void> {
 // init
 
 async function init(): Promise<void> {
-  renderer = new THREE.WebGLRenderer({ antialias: true });
+  const kind = rendererKind();
+  renderer = await createRenderer(kind);
+  if (kind === 'webgpu') Skin = (await import('../lib/webgpu.js')).SkinDeformer;
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
   renderer.setSize(window.innerWidth, window.innerHeight);
   renderer.shadowMap.enabled = true;
@@ -364,6 +369,7 @@ function initGui(): void {
   v.add(params, 'colourBySection').name('colour by section').onChange(applyMaterials);
   v.add(params, 'showSkeleton').name('show skeleton').onChange(() => { if (current) current.skeletonHelper.visible = params.showSkeleton; });
   v.add(params, 'lbsView').name('three.js LBS view').onChange(onWindowResize);
+  addRendererSwitch(v, rendererKind());
   (gui as unknown as { $children: HTMLElement }).$children.appendChild($('hint'));
 }
 
@@ -795,7 +801,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
       showStatus(`building… GCS model${sources.length > 1 ? ` ${i + 1}/${sources.length}` : ''} (${src.geometry.getAttribute('position').count.toLocaleString('en')} vertices)`);
       await yieldToPage();
       // The source's own material (the same object: textures, colours), named explicitly.
-      const skin = new SkinDeformer(gcs, src, { method: 'gcs', gcs: gcsOptions(), material: src.material });
+      const skin = new Skin(gcs, src, { method: 'gcs', gcs: gcsOptions(), material: src.material });
       skin.mesh.layers.set(LAYER.gcs);
       built.push(skin);
       builtCriterion = params.criterion;
@@ -854,7 +860,7 @@ function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; er
   classicBuilds++;
   try {
     for (const src of sources) {
-      const skin = new SkinDeformer(gcs, src, { method: 'classic', classic: classicOptions(), material: src.material });
+      const skin = new Skin(gcs, src, { method: 'classic', classic: classicOptions(), material: src.material });
       skins.push(skin);
       skin.mesh.layers.set(LAYER.classic);
       carrySurfaceAttributes(skin);
@@ -1119,6 +1125,10 @@ function updateReadouts(): void {
     rows.classic.push(`<b>${n(r.classic.contours)}</b> contours · resampling detail loss <b>${r.classic.detailLoss.rms.toFixed(2)} %</b> rms, ` +
       `<b>${r.classic.detailLoss.max.toFixed(2)} %</b> max (of height)`);
   }
+  // Which renderer draws, and where each view's skinning runs.
+  const backendOf = (list: SkinDeformer[] | undefined) => (list?.length && list.every((s) => s.backend === 'gpu') ? 'GPU' : 'CPU');
+  if (r.gcs) rows.gcs.push(`<span class="criterion">${rendererLabel(renderer)} · ${backendOf(current?.gcs)} backend</span>`);
+  if (r.classic) rows.classic.push(`<span class="criterion">${rendererLabel(renderer)} · ${backendOf(current?.classic)} backend</span>`);
   if (r.lbs) rows.lbs.push(`skinned on the GPU by three.js · ${n(r.lbs.vertices)} vertices · ${n(r.lbs.triangles)} triangles`);
   const clip = current?.action ? current.action.getClip().name : '';
   let html = '';

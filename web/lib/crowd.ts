@@ -19,8 +19,12 @@
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import type { GcsDeformer, GcsOptions, GcsSkin, Rig } from './index.js';
-import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes, type GpuPath } from './gpu.js';
-import { remapAttribute, rigInputFromSkinnedMesh, SKINNING_ATTRIBUTES, writeSkinMatrices } from './three.js';
+import { bindGeometry } from './gpu/bind.js';
+import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
+import type { GpuPath } from './gpu/layout.js';
+import { GpuSections } from './gpu/sections.js';
+import { glslKit } from './gpu/webgl-materials.js';
+import { rigInputFromSkinnedMesh, writeSkinMatrices } from './three.js';
 
 export { writeSkinMatrices } from './three.js';
 
@@ -72,6 +76,8 @@ export interface GcsCrowdOptions {
   maxTextureWidth?: number;
   /** See SkinDeformerOptions.gpuPath: 'auto' (default: 'joints' for the weights criterion), 'joints' or 'sections'. */
   gpuPath?: GpuPath | 'auto';
+  /** @internal How the materials run GCS (gcs-skin/webgpu passes its TSL kit). Default: the GLSL kit (WebGLRenderer). */
+  gpuKit?: GpuMaterialKit;
 }
 
 /**
@@ -91,12 +97,17 @@ export class GcsCrowd {
   readonly count: number;
   readonly jointCount: number;
   private isDisposed = false;
+  private readonly kit: GpuMaterialKit;
+  private readonly materials: GpuMaterials;
+  /** Set when a renderer that cannot run the kit's materials drew the crowd; update() throws it. */
+  private rendererError: GcsError | null = null;
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, count: number, options: GcsCrowdOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
     const material = options.material ?? source.material;
+    const kit = this.kit = options.gpuKit ?? glslKit;
     for (const m of Array.isArray(material) ? material : [material]) {
-      const reason = gpuMaterialSupport(m);
+      const reason = kit.support(m);
       if (reason) throw new GcsError('INVALID_ARGUMENT', `GcsCrowd draws on the GPU only: ${reason}`);
     }
     this.rig = gcs.createRig(input);
@@ -114,27 +125,17 @@ export class GcsCrowd {
     this.sections = sections;
     this.count = count;
     this.jointCount = this.rig.jointCount;
-    // The bind pose (a bind-pose deform is bit-exact), the section data, the carried attributes.
-    const identity = new Float32Array(this.jointCount * 16);
-    for (let j = 0; j < this.jointCount; j++) for (let c = 0; c < 4; c++) identity[16 * j + 5 * c] = 1;
-    deformer.deform(identity);
-    const geometry = new THREE.BufferGeometry();
-    geometry.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
-    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
-    const { name, attribute } = sectionAttributes(deformer);
-    geometry.setAttribute(name, attribute);
-    const sourceVertex = deformer.sourceVertex!;
-    for (const [key, attr] of Object.entries(source.geometry.attributes))
-      if (!SKINNING_ATTRIBUTES.has(key) || key === 'tangent') geometry.setAttribute(key, remapAttribute(attr, sourceVertex));
+    // The bind pose, the section data, the carried attributes (no morphs: see above).
+    const geometry = bindGeometry(deformer, this.jointCount, source.geometry, { tangents: true, morphs: false });
     for (const g of source.geometry.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
-    const { uniforms, smooth, path } = sections;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path);
-    const patched = Array.isArray(material) ? material.map(patch) : patch(material);
-    this.mesh = new THREE.InstancedMesh(geometry, patched, count);
-    const shadow = gcsShadowMaterials(Array.isArray(material) ? material[0] : material, uniforms, smooth, path);
-    this.mesh.customDepthMaterial = shadow.depth;
-    this.mesh.customDistanceMaterial = shadow.distance;
+    this.mesh = new THREE.InstancedMesh(geometry, undefined, count);
+    this.materials = kit.build(material, sections, this.mesh.instanceMatrix);
+    this.mesh.material = this.materials.material;
+    if (this.materials.depth) this.mesh.customDepthMaterial = this.materials.depth;
+    if (this.materials.distance) this.mesh.customDistanceMaterial = this.materials.distance;
+    this.mesh.onBeforeRender = (renderer, _scene, _camera, drawn, drawnMaterial) => {
+      if (!this.rendererError) this.checkRenderer(renderer, drawn, drawnMaterial);
+    };
     this.mesh.castShadow = source.castShadow;
     this.mesh.receiveShadow = source.receiveShadow;
     this.mesh.frustumCulled = false;
@@ -143,6 +144,19 @@ export class GcsCrowd {
 
   private live(): void {
     if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCrowd has been disposed');
+  }
+
+  /**
+   * At each draw: a renderer that cannot run the kit's materials would draw every instance in the
+   * bind pose (or nothing). A crowd has no CPU backend, so the crowd stops drawing, one console
+   * warning says why, and the next update() throws GcsError 'INVALID_ARGUMENT' naming the fix.
+   */
+  private checkRenderer(renderer: unknown, geometry: THREE.BufferGeometry, material: THREE.Material): void {
+    const why = this.kit.mismatch(renderer, material);
+    if (!why) return;
+    geometry.setDrawRange(0, 0);
+    this.rendererError = new GcsError('INVALID_ARGUMENT', `GcsCrowd (${this.kit.entry}): ${why}`);
+    console.warn(`gcs-skin: ${this.rendererError.message}`);
   }
 
   /** Every instance's skin matrices (count × J × 16 floats), a view on wasm memory: write poses here. */
@@ -172,6 +186,7 @@ export class GcsCrowd {
   /** Once per frame after posing: every instance's joint poses or section transforms (one wasm call); the texture uploads at the next render. */
   update(): void {
     this.live();
+    if (this.rendererError) throw this.rendererError;
     this.sections.update();
   }
 
@@ -185,9 +200,7 @@ export class GcsCrowd {
     this.isDisposed = true;
     this.mesh.removeFromParent();
     this.mesh.geometry.dispose();
-    for (const m of Array.isArray(this.mesh.material) ? this.mesh.material : [this.mesh.material]) m.dispose();
-    this.mesh.customDepthMaterial?.dispose();
-    this.mesh.customDistanceMaterial?.dispose();
+    disposeGpuMaterials(this.materials);
     this.mesh.dispose();
     this.sections.dispose();
     this.deformer.dispose();

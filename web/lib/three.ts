@@ -19,7 +19,12 @@
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
-import { GpuSections, gcsMaterial, gcsShadowMaterials, gpuMaterialSupport, sectionAttributes, type GpuPath } from './gpu.js';
+import { bindGeometry, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
+import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
+import type { GpuPath } from './gpu/layout.js';
+import { GpuSections } from './gpu/sections.js';
+import { glslKit } from './gpu/webgl-materials.js';
+
 
 /** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
 export type Backend = 'cpu' | 'gpu';
@@ -56,7 +61,8 @@ export interface SkinDeformerOptions {
    * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
    * see gpuPath). GCS only: other methods, and materials that cannot be
    * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
-   * `backendNote` why.
+   * `backendNote` why, and one console warning says so. The same happens at the first draw by a
+   * WebGPURenderer, which never runs the patch: gcs-skin/webgpu is the GPU backend for it (TSL).
    */
   backend?: Backend;
   /**
@@ -67,6 +73,10 @@ export interface SkinDeformerOptions {
    * 'INVALID_ARGUMENT'.
    */
   gpuPath?: GpuPath | 'auto';
+  /** @internal How materials run GCS on the GPU (gcs-skin/webgpu passes its TSL kit). Default: the GLSL kit (WebGLRenderer). */
+  gpuKit?: GpuMaterialKit;
+  /** @internal The backend notes already warned about (a GcsCharacter shares one set: one warning per cause). */
+  warned?: Set<string>;
 }
 
 /**
@@ -149,37 +159,6 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
 }
 
 type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
-type TypedArray = Float32Array | Float64Array | Int8Array | Uint8Array | Uint8ClampedArray | Int16Array | Uint16Array | Int32Array | Uint32Array;
-
-/** @internal The attributes a deformer replaces or consumes: everything else is carried to the output. */
-export const SKINNING_ATTRIBUTES: ReadonlySet<string> = new Set(['position', 'normal', 'tangent', 'skinIndex', 'skinWeight']);
-
-/** Raw (un-normalised) element i·itemSize+k of an attribute, interleaved or not. */
-function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offset: number } {
-  const inter = attr as THREE.InterleavedBufferAttribute;
-  return inter.isInterleavedBufferAttribute
-    ? { array: inter.data.array as TypedArray, stride: inter.data.stride, offset: inter.offset }
-    : { array: (attr as THREE.BufferAttribute).array as TypedArray, stride: attr.itemSize, offset: 0 };
-}
-
-/** @internal A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
-export function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
-  const { array, stride, offset } = rawArray(attr);
-  const size = attr.itemSize;
-  const Ctor = array.constructor as new (length: number) => TypedArray;
-  const out = new Ctor(map.length * size);
-  for (let o = 0; o < map.length; o++) {
-    const s = map[o] * stride + offset;
-    for (let k = 0; k < size; k++) out[o * size + k] = array[s + k];
-  }
-  const result = (attr as { isFloat16BufferAttribute?: boolean }).isFloat16BufferAttribute
-    ? new THREE.Float16BufferAttribute(out as Uint16Array, size, attr.normalized)
-    : new THREE.BufferAttribute(out, size, attr.normalized);
-  result.name = attr.name;
-  const gpuType = (attr as THREE.BufferAttribute).gpuType;
-  if (gpuType !== undefined) result.gpuType = gpuType;
-  return result;
-}
 
 /** Morph targets as relative deltas in the source's vertex order (glTF / three: morphTargetsRelative). */
 interface MorphData {
@@ -313,9 +292,7 @@ export interface RebuildOptions {
 /** The GPU backend of one build: section texture, patched materials, the geometry raycasts test. */
 interface GpuBuild {
   sections: GpuSections;
-  material: THREE.Material | THREE.Material[];
-  depth: THREE.Material;
-  distance: THREE.Material;
+  materials: GpuMaterials;
   raycast: THREE.BufferGeometry;
 }
 
@@ -379,6 +356,12 @@ export class SkinDeformer {
   private note = '';
   /** The material drawn by the CPU backend (the source's or options.material). */
   private readonly baseMaterial: THREE.Material | THREE.Material[];
+  /** How the GPU backend's materials run GCS (GLSL for WebGLRenderer, TSL for WebGPURenderer). */
+  private readonly kit: GpuMaterialKit;
+  /** A geometry replaced during a draw (renderer fallback), freed at the next update(). */
+  private retired: THREE.BufferGeometry | null = null;
+  /** The backend notes already printed as console warnings. */
+  private readonly warned: Set<string>;
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
@@ -412,8 +395,13 @@ export class SkinDeformer {
     this.scope = commonAncestor([source, ...source.skeleton.bones]);
 
     this.baseMaterial = options.material ?? source.material;
+    this.kit = options.gpuKit ?? glslKit;
+    this.warned = options.warned ?? new Set();
     const mesh = new DeformedMesh(new THREE.BufferGeometry(), this.baseMaterial);
     mesh.exactBounds = () => this.exactBounds();
+    mesh.onBeforeRender = (renderer, _scene, _camera, geometry, material) => {
+      if (this.gpu) this.checkRenderer(renderer, geometry, material);
+    };
     mesh.name = source.name;
     mesh.castShadow = source.castShadow;
     mesh.receiveShadow = source.receiveShadow;
@@ -553,40 +541,56 @@ export class SkinDeformer {
   private gpuUnsupported(method: DeformerKind): string {
     if (method !== 'gcs') return `the GPU backend runs GCS; '${method}' runs on the CPU`;
     for (const m of Array.isArray(this.baseMaterial) ? this.baseMaterial : [this.baseMaterial]) {
-      const reason = gpuMaterialSupport(m);
+      const reason = this.kit.support(m);
       if (reason) return reason;
     }
     return '';
   }
 
-  /** The per-frame texture (joint poses or section transforms) and the patched materials of a GPU build. */
+  /**
+   * At each draw of a GPU build: a renderer that cannot run this kit's materials (WebGPURenderer
+   * never runs the GLSL patch; WebGLRenderer without a nodes handler cannot draw node materials)
+   * would draw the bind pose or nothing. Instead this draw is skipped, the skin moves to the CPU
+   * backend (backendNote says why) and one console warning says so; the next frame is right.
+   */
+  private checkRenderer(renderer: unknown, geometry: THREE.BufferGeometry, material: THREE.Material): void {
+    const why = this.kit.mismatch(renderer, material);
+    if (!why) return;
+    geometry.setDrawRange(0, 0); // this draw: nothing rather than the bind pose
+    const next = this.prepare(this.method, { backend: 'cpu' });
+    next.note = why;
+    this.commit(next, true); // the old geometry is being drawn: freed at the next update()
+  }
+
+  /** The per-frame texture (joint poses or section transforms) and the GCS materials of a GPU build. */
   private prepareGpu(deformer: GcsDeformer, path?: GpuPath): GpuBuild {
     const sections = new GpuSections(deformer, 1, 2048, path);
-    const { uniforms, smooth } = sections;
-    const base = this.baseMaterial;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, sections.path);
-    const material = Array.isArray(base) ? base.map(patch) : patch(base);
-    const first = Array.isArray(base) ? base[0] : base;
-    const shadow = gcsShadowMaterials(first, uniforms, smooth, sections.path);
+    const materials = this.kit.build(this.baseMaterial, sections, null);
     const raycast = new THREE.BufferGeometry();
     raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
     raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
     raycast.boundingBox = this.box;
     raycast.boundingSphere = this.sphere;
-    return { sections, material, depth: shadow.depth, distance: shadow.distance, raycast };
+    return { sections, materials, raycast };
   }
 
-  /** @internal Shows a prepared build; the previous deformer and geometry are freed. */
-  commit(next: PendingBuild): void {
+  /** @internal Shows a prepared build; the previous deformer and geometry are freed (the geometry at the next update() when `duringDraw`). */
+  commit(next: PendingBuild, duringDraw = false): void {
     this.deformer?.dispose();
     this.tangentDeformer?.dispose();
     if (this.gpu) disposeGpu(this.gpu);
     this.gpu = next.gpu;
     this.note = next.note;
+    if (next.note && !this.warned.has(next.note)) {
+      this.warned.add(next.note);
+      console.warn(`gcs-skin: ${next.note}. This skin runs on the CPU backend.`);
+    }
     const mesh = this.mesh as DeformedMesh;
-    mesh.material = next.gpu ? next.gpu.material : this.baseMaterial;
-    mesh.customDepthMaterial = next.gpu ? next.gpu.depth : this.source.customDepthMaterial;
-    mesh.customDistanceMaterial = next.gpu ? next.gpu.distance : this.source.customDistanceMaterial;
+    const gpuMaterials = next.gpu?.materials;
+    mesh.material = gpuMaterials ? gpuMaterials.material : this.baseMaterial;
+    // Node materials cast their shadows through their own position node: no custom depth material.
+    mesh.customDepthMaterial = gpuMaterials ? gpuMaterials.depth ?? undefined : this.source.customDepthMaterial;
+    mesh.customDistanceMaterial = gpuMaterials ? gpuMaterials.distance ?? undefined : this.source.customDistanceMaterial;
     mesh.raycastGeometry = next.gpu ? next.gpu.raycast : null;
     // GPU: three.js applies the morph targets in the shader, from the source's influences (the same array).
     const gpuMorphs = next.gpu && next.geometry.morphAttributes.position;
@@ -603,8 +607,9 @@ export class SkinDeformer {
     this.options = { ...this.options, gcs: next.gcs, classic: next.classic, method: next.method, backend: next.backend, gpuPath: next.gpuPath };
     const old = this.mesh.geometry;
     this.mesh.geometry = next.geometry;
-    old.dispose();
     this.update();
+    if (duringDraw) this.retired = old;
+    else old.dispose();
   }
 
   /** @internal Frees a prepared build that will not be shown. */
@@ -615,46 +620,26 @@ export class SkinDeformer {
     next.geometry.dispose();
   }
 
-  /** Identity skin matrices (the bind pose), J × 16. */
-  private identity(): Float32Array {
-    const out = new Float32Array(this.rig.jointCount * 16);
-    for (let j = 0; j < this.rig.jointCount; j++) for (let c = 0; c < 4; c++) out[16 * j + 5 * c] = 1;
-    return out;
-  }
-
   private makeGeometry(deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null, gpu: GpuBuild | null): THREE.BufferGeometry {
     const src = this.source.geometry;
-    const geometry = new THREE.BufferGeometry();
     const indices = deformer.indices;
-    geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+    let geometry: THREE.BufferGeometry;
     if (gpu) {
-      // The bind pose, uploaded once (a bind-pose deform is bit-exact), and the section data.
-      deformer.deform(this.identity());
-      geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
-      geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
-      const { name, attribute } = sectionAttributes(deformer as GcsDeformer);
-      geometry.setAttribute(name, attribute);
+      // The bind pose, uploaded once, with the section data; three.js morphs in the shader, before GCS.
+      geometry = bindGeometry(deformer as GcsDeformer, this.rig.jointCount, src, { tangents: this.options.tangents !== 'drop', morphs: true });
     } else {
+      geometry = new THREE.BufferGeometry();
+      geometry.setIndex(new THREE.BufferAttribute(indices, 1));
       geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
       geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
-    }
-    if (sourceVertex) {
-      for (const [name, attr] of Object.entries(src.attributes))
-        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
-      const tangent = src.getAttribute('tangent');
-      if (gpu && tangent && this.options.tangents !== 'drop') geometry.setAttribute('tangent', remapAttribute(tangent, sourceVertex));
-      if (gpu) {
-        // three.js morphs in the shader, before the section transform (its order).
-        for (const key of ['position', 'normal'] as const) {
-          const list = src.morphAttributes[key];
-          if (list?.length) geometry.morphAttributes[key] = list.map((a) => remapAttribute(a, sourceVertex));
+      if (sourceVertex) {
+        for (const [name, attr] of Object.entries(src.attributes))
+          if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+        if (tangentDeformer && this.tangentW) {
+          const w = new Float32Array(4 * sourceVertex.length);
+          for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = this.tangentW[sourceVertex[o]];
+          geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
         }
-        geometry.morphTargetsRelative = src.morphTargetsRelative;
-      }
-      if (tangentDeformer && this.tangentW) {
-        const w = new Float32Array(4 * sourceVertex.length);
-        for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = this.tangentW[sourceVertex[o]];
-        geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
       }
     }
     // Groups (multi-material) and the draw range count index entries: they carry over when the
@@ -703,6 +688,10 @@ export class SkinDeformer {
    */
   update(options?: { updateMatrixWorld?: boolean }): void {
     this.live();
+    if (this.retired) {
+      this.retired.dispose();
+      this.retired = null;
+    }
     const source = this.source;
     const mesh = this.mesh;
     if (options?.updateMatrixWorld !== false) updateWorld(this.scope);
@@ -914,6 +903,8 @@ export interface GcsCharacterOptions {
   backend?: Backend;
   /** See SkinDeformerOptions.gpuPath. Default 'auto'. */
   gpuPath?: GpuPath | 'auto';
+  /** @internal See SkinDeformerOptions.gpuKit. */
+  gpuKit?: GpuMaterialKit;
 }
 
 /**
@@ -953,11 +944,12 @@ export class GcsCharacter {
     if (!sources.length) throw new GcsError('NO_SKIN', 'no skinned mesh (THREE.SkinnedMesh with a skeleton) under this object: there is nothing to deform');
     updateWorld(root);
     const skins: SkinDeformer[] = [];
+    const warned = new Set<string>();
     try {
       for (const source of sources) {
         skins.push(new SkinDeformer(gcs, source, {
           method: options.method, gcs: options.gcs, classic: options.classic, tangents: options.tangents, inPlace: true,
-          backend: options.backend, gpuPath: options.gpuPath,
+          backend: options.backend, gpuPath: options.gpuPath, gpuKit: options.gpuKit, warned,
         }));
       }
     } catch (e) {
@@ -1020,11 +1012,9 @@ export class GcsCharacter {
 
 const NO_WORLD_UPDATE = Object.freeze({ updateMatrixWorld: false });
 
-/** Frees a GPU build: its wasm buffers, texture, patched materials and raycast geometry. */
+/** Frees a GPU build: its wasm buffers, texture, GCS materials and raycast geometry. */
 function disposeGpu(gpu: GpuBuild): void {
   gpu.sections.dispose();
-  for (const m of Array.isArray(gpu.material) ? gpu.material : [gpu.material]) m.dispose();
-  gpu.depth.dispose();
-  gpu.distance.dispose();
+  disposeGpuMaterials(gpu.materials);
   gpu.raycast.dispose();
 }

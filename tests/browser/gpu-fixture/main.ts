@@ -6,11 +6,10 @@
 //   pictures: the character drawn by its patched source material (GPU backend) and by the CPU
 //     backend, same frame, same camera, read back as pixels.
 import * as THREE from 'three';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib/index.js';
 import { GcsCharacter, type Backend } from '../../../web/lib/three.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
-import { createHuman } from '../../../web/lib/human/index.js';
+import { load, stage } from '../fixture-scene.js';
 
 const W = 512, H = 512;
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
@@ -80,19 +79,6 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   return out;
 }
 
-interface Loaded { root: THREE.Object3D; clips: THREE.AnimationClip[] }
-
-async function load(model: string): Promise<Loaded> {
-  if (model === 'human') {
-    const h = createHuman();
-    const root = new THREE.Group();
-    root.add(h.mesh);
-    return { root, clips: h.clips };
-  }
-  const gltf = await new GLTFLoader().loadAsync(model);
-  return { root: gltf.scene, clips: gltf.animations };
-}
-
 export interface CheckResult {
   skins: number;
   backends: string[];
@@ -138,23 +124,11 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   boneScale?: [number, number, number]): Promise<CheckResult> {
   const gcs = await gcsReady;
   const { root, clips } = await load(model);
-  const scene = new THREE.Scene();
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2));
-  const sun = new THREE.DirectionalLight(0xffffff, 2);
-  sun.position.set(2, 4, 3);
-  scene.add(sun);
-  scene.add(root);
+  const { scene, camera } = stage(root, W, H); // framed from the bind pose
   const mixer = new THREE.AnimationMixer(root);
   const clip = clips.find((c) => c.name === clipName) ?? clips[0];
   mixer.clipAction(clip).play();
   const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
-  // Frame the character from its bind-pose box.
-  root.updateMatrixWorld(true);
-  const box = new THREE.Box3().setFromObject(root);
-  const centre = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length();
-  const camera = new THREE.PerspectiveCamera(40, W / H, size / 100, size * 10);
-  camera.position.copy(centre).add(new THREE.Vector3(0.6, 0.3, 1).normalize().multiplyScalar(size * 1.3));
-  camera.lookAt(centre);
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
     extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1 };

@@ -1,0 +1,319 @@
+// The page of tests/browser/webgpu.test.ts: gcs-skin/webgpu on three.js's WebGPURenderer (its
+// WebGL2 backend here: forceWebGL, no GPU in headless Chromium), read back as pixels.
+//   check: GPU backend (TSL) vs CPU backend, same frames, same camera; the pose differs from the rest pose;
+//   glslVsTsl: the same pose drawn by gcs-skin/three (GLSL, WebGLRenderer) and gcs-skin/webgpu (TSL, WebGPURenderer);
+//   crowd: GcsCrowd on WebGPURenderer, drawn and moving, one draw call per skin;
+//   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials.
+import * as THREE from 'three/webgpu';
+import { WebGLRenderer, WebGLRenderTarget } from 'three';
+import { WebGLNodesHandler } from 'three/addons/tsl/WebGLNodesHandler.js';
+import { initGcsSkin, type GcsOptions } from '../../../web/lib/index.js';
+import * as WebGL from '../../../web/lib/three.js';
+import { GcsCrowd as WebGLCrowd } from '../../../web/lib/crowd.js';
+import { bakeClip, GcsCharacter, GcsCrowd } from '../../../web/lib/webgpu.js';
+import type { GpuPath } from '../../../web/lib/gpu.js';
+import { load, stage as stageAt, type Loaded } from '../fixture-scene.js';
+
+const W = 384, H = 384;
+const stage = (root: THREE.Object3D) => stageAt(root, W, H);
+const gcsReady = initGcsSkin();
+
+/** Warnings gcs-skin printed (console.warn lines starting with 'gcs-skin:'). */
+const warnings: string[] = [];
+const warn = console.warn.bind(console);
+console.warn = (...args: unknown[]) => {
+  if (typeof args[0] === 'string' && args[0].startsWith('gcs-skin:')) warnings.push(args[0]);
+  warn(...args);
+};
+
+let webgpu: THREE.WebGPURenderer | null = null;
+async function gpuRenderer(): Promise<THREE.WebGPURenderer> {
+  if (webgpu) return webgpu;
+  const r = new THREE.WebGPURenderer({ forceWebGL: true, antialias: false });
+  r.setSize(W, H);
+  r.setPixelRatio(1);
+  await r.init();
+  document.body.append(r.domElement);
+  webgpu = r;
+  return r;
+}
+
+function glRenderer(handler = false): WebGLRenderer {
+  const r = new WebGLRenderer({ antialias: false });
+  r.setSize(W, H);
+  r.setPixelRatio(1);
+  if (handler) r.setNodesHandler(new WebGLNodesHandler());
+  return r;
+}
+
+type AnyRenderer = THREE.WebGPURenderer | WebGLRenderer;
+
+/** Draws into a render target and reads the pixels back (rows bottom-up on both renderers). */
+async function draw(renderer: AnyRenderer, scene: THREE.Scene, camera: THREE.Camera): Promise<Uint8Array> {
+  if ((renderer as THREE.WebGPURenderer).isWebGPURenderer) {
+    const r = renderer as THREE.WebGPURenderer;
+    const target = new THREE.RenderTarget(W, H);
+    r.setRenderTarget(target);
+    r.setClearColor(0x000000, 1);
+    r.render(scene, camera);
+    const pixels = await r.readRenderTargetPixelsAsync(target, 0, 0, W, H);
+    r.setRenderTarget(null);
+    target.dispose();
+    return new Uint8Array(pixels.buffer, pixels.byteOffset, pixels.byteLength).slice();
+  }
+  const r = renderer as WebGLRenderer;
+  const target = new WebGLRenderTarget(W, H);
+  r.setRenderTarget(target);
+  r.setClearColor(0x000000, 1);
+  r.clear();
+  r.render(scene, camera);
+  const out = new Uint8Array(4 * W * H);
+  r.readRenderTargetPixels(target, 0, 0, W, H, out);
+  r.setRenderTarget(null);
+  target.dispose();
+  return out;
+}
+
+/** Share of pixels of which a channel differs by more than `by` (of 255): of the image, and of the pixels either picture covers. */
+function differing(a: Uint8Array, b: Uint8Array, by = 8): { image: number; covered: number } {
+  let n = 0, covered = 0;
+  for (let o = 0; o < a.length; o += 4) {
+    if (a[o] + a[o + 1] + a[o + 2] > 0 || b[o] + b[o + 1] + b[o + 2] > 0) covered++;
+    if (Math.abs(a[o] - b[o]) > by || Math.abs(a[o + 1] - b[o + 1]) > by || Math.abs(a[o + 2] - b[o + 2]) > by) n++;
+  }
+  return { image: n / (a.length / 4), covered: n / Math.max(1, covered) };
+}
+
+function coverage(a: Uint8Array): number {
+  let n = 0;
+  for (let o = 0; o < a.length; o += 4) if (a[o] + a[o + 1] + a[o + 2] > 0) n++;
+  return n / (a.length / 4);
+}
+
+function play(loaded: Loaded, clipName?: string): THREE.AnimationMixer {
+  const mixer = new THREE.AnimationMixer(loaded.root);
+  mixer.clipAction(loaded.clips.find((c) => c.name === clipName) ?? loaded.clips[0]).play();
+  return mixer;
+}
+
+export interface CheckResult {
+  backends: string[]; paths: string[]; notes: string[];
+  /** per frame: GPU vs CPU backend pictures */
+  vsCpu: { image: number; covered: number }[];
+  /** per frame: the GPU picture vs the unanimated one */
+  vsRest: { image: number; covered: number }[];
+  coverage: number;
+  warnings: string[];
+}
+
+/** gcs-skin/webgpu's GPU backend against its CPU backend on WebGPURenderer, frame by frame. */
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CheckResult> {
+  const gcs = await gcsReady;
+  const renderer = await gpuRenderer();
+  warnings.length = 0;
+  const loaded = await load(model);
+  const { scene, camera } = stage(loaded.root);
+  const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+  const result: CheckResult = {
+    backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
+    vsCpu: [], vsRest: [], coverage: 0, warnings,
+  };
+  character.update();
+  const rest = await draw(renderer, scene, camera);
+  const mixer = play(loaded, clipName);
+  for (const t of times) {
+    mixer.setTime(t);
+    character.rebuild(undefined, { backend: 'gpu' });
+    character.update();
+    const gpu = await draw(renderer, scene, camera);
+    result.backends = character.skins.map((s) => s.backend); // still 'gpu' after drawing: no fallback happened
+    character.rebuild(undefined, { backend: 'cpu' });
+    character.update();
+    const cpu = await draw(renderer, scene, camera);
+    result.vsCpu.push(differing(gpu, cpu));
+    result.vsRest.push(differing(gpu, rest));
+    result.coverage = Math.max(result.coverage, coverage(gpu));
+  }
+  character.dispose();
+  return result;
+}
+
+/**
+ * One pose drawn by gcs-skin/three's GPU backend (GLSL) on WebGLRenderer and by gcs-skin/webgpu's
+ * (TSL) on WebGPURenderer, with MeshNormalMaterial (colour = view-space normal, no lighting
+ * model that differs between the renderers): the two shaders' positions and normals, compared.
+ */
+async function glslVsTsl(model: string, gcsOptions: GcsOptions, time: number, clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<{ diff: { image: number; covered: number }; coverage: number; backends: string[] }> {
+  const gcs = await gcsReady;
+  const renderers = { glsl: glRenderer(), tsl: await gpuRenderer() };
+  const pictures: Uint8Array[] = [];
+  const backends: string[] = [];
+  for (const which of ['glsl', 'tsl'] as const) {
+    const loaded = await load(model);
+    const { scene, camera } = stage(loaded.root);
+    const material = new THREE.MeshNormalMaterial();
+    loaded.root.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) (o as THREE.SkinnedMesh).material = material; });
+    const Character = which === 'glsl' ? WebGL.GcsCharacter : GcsCharacter;
+    const character = new Character(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+    const mixer = play(loaded, clipName);
+    mixer.setTime(time);
+    character.update();
+    pictures.push(await draw(renderers[which], scene, camera));
+    backends.push(character.backend);
+    character.dispose();
+  }
+  renderers.glsl.dispose();
+  // MeshNormalNodeMaterial writes its colour sRGB-decoded (so that both look alike on screen);
+  // in a linear render target the GLSL picture is compared after the same decoding.
+  const decode = Array.from({ length: 256 }, (_, v) => Math.round(255 * new THREE.Color().setRGB(v / 255, 0, 0, THREE.SRGBColorSpace).r));
+  const decoded = pictures[0].map((v, i) => (i % 4 === 3 ? v : decode[v]));
+  return { diff: differing(decoded, pictures[1]), coverage: coverage(pictures[1]), backends };
+}
+
+export interface CrowdResult { drawCalls: number; coverage: number; moving: number; bytesPerFrame: number; jointCount: number; path: string }
+
+/** `count` instances of a character on WebGPURenderer, each at its own clip time; two frames. */
+async function crowd(model: string, count: number, clipName?: string): Promise<CrowdResult> {
+  const gcs = await gcsReady;
+  const renderer = await gpuRenderer();
+  const loaded = await load(model);
+  let source: THREE.SkinnedMesh | null = null;
+  loaded.root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+  const skinned = source! as THREE.SkinnedMesh;
+  const clip = loaded.clips.find((c) => c.name === clipName) ?? loaded.clips[0];
+  const baked = bakeClip(skinned, clip, 30);
+  const group = new THREE.Group();
+  const c = new GcsCrowd(gcs, skinned, count);
+  group.add(c.mesh);
+  loaded.root.updateMatrixWorld(true);
+  const height = new THREE.Box3().setFromObject(skinned).getSize(new THREE.Vector3()).y || 1;
+  const side = Math.ceil(Math.sqrt(count));
+  const m = new THREE.Matrix4();
+  for (let i = 0; i < count; i++) {
+    m.makeTranslation((i % side - side / 2) * height * 0.6, 0, Math.floor(i / side) * height * 0.6);
+    c.mesh.setMatrixAt(i, m.multiply(skinned.matrixWorld));
+  }
+  c.mesh.instanceMatrix.needsUpdate = true;
+  const { scene, camera } = stage(group);
+  camera.position.multiplyScalar(1.2);
+  const frame = async (t: number) => {
+    for (let i = 0; i < count; i++) c.setBakedPose(i, baked, t + i * 0.13);
+    c.update();
+    return draw(renderer, scene, camera);
+  };
+  // The WebGL2 backend keeps no draw-call count: count the backend's draws of the crowd's mesh.
+  const backend = (renderer as unknown as { backend: { draw(o: { object: THREE.Object3D }, ...rest: unknown[]): void } }).backend;
+  const backendDraw = backend.draw;
+  let calls = 0;
+  backend.draw = function (renderObject, ...rest) {
+    if (renderObject.object === c.mesh) calls++;
+    return backendDraw.call(this, renderObject, ...rest);
+  };
+  const a = await frame(0.2);
+  backend.draw = backendDraw;
+  const b = await frame(0.6);
+  const result = { drawCalls: calls, coverage: coverage(a), moving: differing(a, b).image, bytesPerFrame: c.bytesPerFrame, jointCount: c.jointCount, path: c.sections.path };
+  c.dispose();
+  return result;
+}
+
+export interface FallbackResult {
+  before: string; after: string; note: string; warnings: string[];
+  /** the first frame vs the CPU backend's picture: drawn right, or (firstCoverage 0) not at all */
+  firstVsCpu: { image: number; covered: number };
+  /** the second frame vs the CPU backend's picture (the fallback draws right) */
+  vsCpu: { image: number; covered: number };
+  /** the first frame's coverage: nothing, or the right picture; never the bind pose */
+  firstCoverage: number;
+  error: string;
+}
+
+type Case = 'three-on-webgpu' | 'webgpu-on-webgl' | 'webgpu-on-webgl-handler' | 'webgpu-custom-shader' | 'webgpu-node-position' | 'webgpu-node-plain';
+
+/** The "never silently wrong" cases, each on CesiumMan at t = 1 s. */
+async function fallback(model: string, which: Case): Promise<FallbackResult> {
+  const gcs = await gcsReady;
+  warnings.length = 0;
+  const loaded = await load(model);
+  const { scene, camera } = stage(loaded.root);
+  const mixer = play(loaded);
+  mixer.setTime(1);
+  let renderer: AnyRenderer = await gpuRenderer();
+  let character: WebGL.GcsCharacter;
+  if (which === 'three-on-webgpu') {
+    character = new WebGL.GcsCharacter(gcs, loaded.root, { backend: 'gpu' });
+  } else {
+    if (which === 'webgpu-on-webgl') renderer = glRenderer();
+    if (which === 'webgpu-on-webgl-handler') renderer = glRenderer(true);
+    loaded.root.traverse((o) => {
+      const mesh = o as THREE.SkinnedMesh;
+      if (!mesh.isSkinnedMesh) return;
+      if (which === 'webgpu-custom-shader') {
+        mesh.material = new THREE.ShaderMaterial({ vertexShader: 'void main() { gl_Position = vec4(position, 1.0); }', fragmentShader: 'void main() { gl_FragColor = vec4(1.0); }' });
+      } else if (which === 'webgpu-node-position' || which === 'webgpu-node-plain' || which === 'webgpu-on-webgl-handler') {
+        // (with the handler: node materials on both backends, so both pictures go through the handler's lighting)
+        const material = new THREE.MeshStandardNodeMaterial({ color: 0xc08060 });
+        if (which === 'webgpu-node-position') material.positionNode = THREE.TSL.positionLocal.mul(1.01);
+        mesh.material = material;
+      }
+    });
+    character = new GcsCharacter(gcs, loaded.root, { backend: 'gpu' });
+  }
+  const before = character.backend;
+  character.update();
+  let error = '';
+  let first: Uint8Array | null = null, second: Uint8Array | null = null, cpu: Uint8Array | null = null;
+  let after = character.skins.map((s) => s.backend).join(',');
+  let note = character.skins.map((s) => s.backendNote).join(' | ');
+  if (which !== 'webgpu-custom-shader') { // WebGPURenderer draws no ShaderMaterial at all
+    try {
+      first = await draw(renderer, scene, camera);
+      character.update();
+      second = await draw(renderer, scene, camera);
+      after = character.skins.map((s) => s.backend).join(',');
+      note = character.skins.map((s) => s.backendNote).join(' | ');
+      character.rebuild(undefined, { backend: 'cpu' });
+      character.update();
+      cpu = await draw(renderer, scene, camera);
+    } catch (e) {
+      error = `${String(e)} ${(e as Error).stack?.split('\n').slice(1, 4).join(' ')}`;
+    }
+  }
+  character.dispose();
+  if (!(renderer as THREE.WebGPURenderer).isWebGPURenderer) renderer.dispose();
+  return {
+    before, after: after.split(',')[0], note, warnings: [...warnings],
+    vsCpu: second && cpu ? differing(second, cpu) : { image: -1, covered: -1 },
+    firstVsCpu: first && cpu ? differing(first, cpu) : { image: -1, covered: -1 },
+    firstCoverage: first ? coverage(first) : -1, error,
+  };
+}
+
+/** A crowd drawn by the other renderer: the next update() throws a GcsError naming the fix. */
+async function crowdOnWrongRenderer(model: string, entry: 'webgpu' | 'three'): Promise<{ error: string; code: string; warnings: string[] }> {
+  const gcs = await gcsReady;
+  warnings.length = 0;
+  const loaded = await load(model);
+  let source: THREE.SkinnedMesh | null = null;
+  loaded.root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+  const c = entry === 'webgpu' ? new GcsCrowd(gcs, source!, 4) : new WebGLCrowd(gcs, source!, 4);
+  const { scene, camera } = stage(c.mesh);
+  const renderer: AnyRenderer = entry === 'webgpu' ? glRenderer() : await gpuRenderer();
+  c.update();
+  await draw(renderer, scene, camera);
+  let error = '', code = '';
+  try {
+    c.update();
+  } catch (e) {
+    error = (e as Error).message;
+    code = (e as { code?: string }).code ?? '';
+  }
+  c.dispose();
+  if (!(renderer as THREE.WebGPURenderer).isWebGPURenderer) renderer.dispose();
+  return { error, code, warnings: [...warnings] };
+}
+
+declare global {
+  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer } }
+}
+window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer };

@@ -1,0 +1,187 @@
+// gcs-skin/webgpu on three.js's WebGPURenderer in headless Chromium. There is no GPU here, so
+// WebGPURenderer runs its WebGL2 backend (`forceWebGL: true`, SwiftShader); real WebGPU is not
+// exercised by these tests. Pictures are read back from render targets (webgpu-fixture):
+//   GPU backend (TSL) vs CPU backend on CesiumMan and Soldier at fixed clip times, both GPU paths,
+//   plain and smooth: ≤ 1 % of the pixels differ by more than 8/255, and the pose differs from
+//   the rest pose; GLSL (gcs-skin/three, WebGLRenderer) vs TSL (gcs-skin/webgpu, WebGPURenderer)
+//   on the same pose; a crowd drawn and moving in one draw call; and each "never silently wrong"
+//   case: it works, or runs on the CPU with a note and one warning, or throws a GcsError.
+import { existsSync } from 'node:fs';
+import { join } from 'node:path';
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { Page } from 'playwright-core';
+import { MODELS_DIR, openFixture, skipReason, type FixturePage } from './harness.js';
+
+const reason = skipReason();
+if (reason) console.log(reason);
+
+/** The issue's bound: at most 1 % of pixels differ by more than 8/255. */
+const PIXEL_SHARE = 0.01;
+
+let fixture: FixturePage | null = null;
+let page: Page | null = null;
+let errors: string[] = [];
+
+beforeAll(async () => {
+  if (reason) return;
+  fixture = await openFixture('webgpu-fixture', '__webgpu');
+  ({ page, errors } = fixture);
+});
+
+afterAll(async () => {
+  await fixture?.close();
+});
+
+// eslint-disable-next-line @typescript-eslint/no-explicit-any
+async function call<T>(fn: string, ...args: unknown[]): Promise<T> {
+  return page!.evaluate(([f, a]) => (window as unknown as Record<string, Record<string, (...x: unknown[]) => Promise<unknown>>>).__webgpu[f as string](...(a as unknown[])), [fn, args] as const) as Promise<T>;
+}
+
+interface Diff { image: number; covered: number }
+const pct = (d: Diff) => `${(100 * d.image).toFixed(2)} % of the image (${(100 * d.covered).toFixed(2)} % of the character's pixels)`;
+
+const SHARED = [
+  { file: 'CesiumMan.glb', times: [0.5, 1.0, 1.6], clip: undefined },
+  { file: 'Soldier.glb', times: [0.2, 0.55], clip: 'Run' },
+];
+
+describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', () => {
+  for (const m of SHARED) {
+    const path = join(MODELS_DIR, m.file);
+    const missing = existsSync(path) ? '' : `skipped: ${path} is absent (the shared test models are not on this machine)`;
+    if (missing) console.log(missing);
+    for (const gpuPath of ['joints', 'sections'] as const) {
+      for (const smooth of [false, true]) {
+        const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
+        test.skipIf(!!missing)(`${m.file}, ${mode}: GPU backend = CPU backend, posed`, async () => {
+          const r = await call<{ backends: string[]; paths: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number; warnings: string[] }>(
+            'check', `/@fs${path}`, { smooth }, m.times, m.clip, gpuPath);
+          console.log(`${m.file} ${mode}: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}; coverage ${(100 * r.coverage).toFixed(1)} %`);
+          expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+          expect(r.paths.every((p) => p === gpuPath)).toBe(true);
+          expect(r.warnings).toEqual([]);
+          expect(r.coverage).toBeGreaterThan(0.02);
+          for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+          for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05); // the pose is applied, not the rest pose
+          expect(errors).toEqual([]);
+        });
+      }
+    }
+  }
+
+  // Morph targets apply before GCS (three.js's order, the CPU's too): a swelling morph at 0.8 on the human.
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    test(`default human with a morph target, ${gpuPath} path: GPU backend = CPU backend`, async () => {
+      const r = await call<{ backends: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number }>('check', 'human-morph', {}, [0.3, 0.7], 'walk', gpuPath);
+      console.log(`human + morph ${gpuPath}: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+      expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+      for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+      for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+      expect(errors).toEqual([]);
+    });
+  }
+
+  const cesium = join(MODELS_DIR, 'CesiumMan.glb');
+  const soldier = join(MODELS_DIR, 'Soldier.glb');
+  const noCesium = !existsSync(cesium), noSoldier = !existsSync(soldier);
+
+  // One source of truth (docs/gpu.md): the GLSL chunk and the TSL function compute the same
+  // positions and normals; MeshNormalMaterial paints the normals, so a wrong normal shows too.
+  for (const [file, path, missing, time, clip] of [['CesiumMan.glb', cesium, noCesium, 1.0, undefined], ['Soldier.glb', soldier, noSoldier, 0.4, 'Run']] as const) {
+    for (const gpuPath of ['joints', 'sections'] as const) {
+      for (const smooth of [false, true]) {
+        test.skipIf(missing)(`${file}, ${smooth ? 'smooth' : 'plain'}, ${gpuPath} path: GLSL on WebGLRenderer = TSL on WebGPURenderer`, async () => {
+          const r = await call<{ diff: Diff; coverage: number; backends: string[] }>('glslVsTsl', `/@fs${path}`, { smooth }, time, clip, gpuPath);
+          console.log(`${file} ${smooth ? 'smooth' : 'plain'} ${gpuPath}: GLSL vs TSL ${pct(r.diff)}; coverage ${(100 * r.coverage).toFixed(1)} %`);
+          expect(r.backends).toEqual(['gpu', 'gpu']);
+          expect(r.coverage).toBeGreaterThan(0.02);
+          expect(r.diff.image).toBeLessThanOrEqual(PIXEL_SHARE);
+          expect(errors).toEqual([]);
+        });
+      }
+    }
+  }
+
+  test.skipIf(noSoldier)('a crowd of 16 Soldiers: one draw call for the skin, drawn and moving, joint poses uploaded', async () => {
+    const r = await call<{ drawCalls: number; coverage: number; moving: number; bytesPerFrame: number; jointCount: number; path: string }>('crowd', `/@fs${soldier}`, 16, 'Run');
+    console.log(`crowd of 16: ${r.drawCalls} draw call(s), coverage ${(100 * r.coverage).toFixed(1)} %, ${(100 * r.moving).toFixed(1)} % of pixels change between frames, ${r.bytesPerFrame} bytes per frame (${r.jointCount} joints, ${r.path} path)`);
+    expect(r.path).toBe('joints');
+    expect(r.drawCalls).toBe(1);
+    expect(r.coverage).toBeGreaterThan(0.02);
+    expect(r.moving).toBeGreaterThan(0.01);
+    expect(r.bytesPerFrame).toBeGreaterThanOrEqual(16 * r.jointCount * 64);
+    expect(r.bytesPerFrame).toBeLessThan(16 * r.jointCount * 64 + 2048 * 16);
+    expect(errors).toEqual([]);
+  });
+
+  interface Fallback { before: string; after: string; note: string; warnings: string[]; vsCpu: Diff; firstVsCpu: Diff; firstCoverage: number; error: string }
+  const fallback = (which: string) => call<Fallback>('fallback', `/@fs${cesium}`, which);
+  /** Ran on the CPU from the first draw on: a note, one warning, and the right picture from the second frame. */
+  function expectCpuFallback(r: Fallback, note: RegExp): void {
+    console.log(`  → ${r.before} then ${r.after}; note: ${r.note}; warnings: ${r.warnings.length}; second frame vs CPU ${r.vsCpu.image >= 0 ? pct(r.vsCpu) : 'not drawn'}; first frame coverage ${r.firstCoverage}`);
+    expect(r.error).toBe('');
+    expect(r.after).toBe('cpu');
+    expect(r.note).toMatch(note);
+    expect(r.warnings).toHaveLength(1);
+    expect(r.warnings[0]).toMatch(note);
+  }
+
+  test.skipIf(noCesium)("gcs-skin/three's GPU backend drawn by WebGPURenderer: the CPU backend, a note naming gcs-skin/webgpu, one warning", async () => {
+    const r = await fallback('three-on-webgpu');
+    expectCpuFallback(r, /gcs-skin\/webgpu/);
+    expect(r.before).toBe('gpu');
+    // The first draw: WebGPURenderer draws the object's new (CPU) geometry: the right picture, never the bind pose.
+    expect(r.firstVsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+    expect(r.vsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+  });
+
+  test.skipIf(noCesium)('gcs-skin/webgpu drawn by a WebGLRenderer without nodes handler: the CPU backend, a note naming the fix, one warning', async () => {
+    const r = await fallback('webgpu-on-webgl');
+    expectCpuFallback(r, /setNodesHandler/);
+    expect(r.before).toBe('gpu');
+    expect(r.firstCoverage).toBe(0); // the first draw shows nothing rather than the bind pose
+    expect(r.vsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+  });
+
+  test.skipIf(noCesium)('gcs-skin/webgpu drawn by a WebGLRenderer with WebGLNodesHandler: works on the GPU', async () => {
+    const r = await fallback('webgpu-on-webgl-handler');
+    console.log(`  → ${r.before} then ${r.after}; warnings ${r.warnings.length}; second frame vs CPU ${pct(r.vsCpu)}; error '${r.error}'`);
+    expect(r.error).toBe('');
+    expect(r.after).toBe('gpu');
+    expect(r.warnings).toEqual([]);
+    expect(r.firstCoverage).toBeGreaterThan(0.02);
+    expect(r.vsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+  });
+
+  test.skipIf(noCesium)('gcs-skin/webgpu with a custom ShaderMaterial: the CPU backend, a note, one warning', async () => {
+    const r = await fallback('webgpu-custom-shader');
+    expect(r.before).toBe('cpu');
+    expectCpuFallback(r, /custom shader/);
+  });
+
+  test.skipIf(noCesium)('gcs-skin/webgpu with a node material that has its own positionNode: the CPU backend, a note, one warning', async () => {
+    const r = await fallback('webgpu-node-position');
+    expect(r.before).toBe('cpu');
+    expectCpuFallback(r, /its own positionNode/);
+    expect(r.vsCpu.image).toBe(0); // both pictures are the CPU backend's
+  });
+
+  test.skipIf(noCesium)('gcs-skin/webgpu with a plain node material: extended, on the GPU, the CPU picture', async () => {
+    const r = await fallback('webgpu-node-plain');
+    console.log(`  → ${r.before} then ${r.after}; second frame vs CPU ${pct(r.vsCpu)}`);
+    expect(r.before).toBe('gpu');
+    expect(r.after).toBe('gpu');
+    expect(r.warnings).toEqual([]);
+    expect(r.vsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+  });
+
+  for (const entry of ['webgpu', 'three'] as const) {
+    test.skipIf(noCesium)(`a gcs-skin/${entry} crowd drawn by the other renderer: update() throws a GcsError naming the fix`, async () => {
+      const r = await call<{ error: string; code: string; warnings: string[] }>('crowdOnWrongRenderer', `/@fs${cesium}`, entry);
+      console.log(`  → ${r.code}: ${r.error}`);
+      expect(r.code).toBe('INVALID_ARGUMENT');
+      expect(r.error).toMatch(entry === 'webgpu' ? /setNodesHandler|WebGPURenderer/ : /gcs-skin\/webgpu/);
+      expect(r.warnings).toHaveLength(1);
+    });
+  }
+});

@@ -1,0 +1,246 @@
+/**
+ * The GCS vertex stage in GLSL, for WebGLRenderer: three.js's skinning chunks of a built-in
+ * material replaced by GCS's (patched through onBeforeCompile, webgl-materials.ts). The same maths
+ * as the TSL function (tsl.ts), from the same layout constants (layout.ts); docs/gpu.md.
+ */
+import { GcsError } from '../errors.js';
+import {
+  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JOINTS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
+  SECTION_ATTRIBUTE, TABLE_TEXELS_PER_SECTION, UNIFORM_SCALE_TOLERANCE, type GpuPath,
+} from './layout.js';
+
+/** GLSL's spelling of a float constant (always with a decimal point or exponent). */
+const f = (x: number): string => (Number.isInteger(x) ? x.toFixed(1) : String(x));
+
+/** Both paths: where instance 0's texels start, texels per instance, the static per-vertex section data. */
+const COMMON_PARS = /* glsl */ `
+uniform int gcsBase;
+uniform int gcsStride;
+#ifdef GCS_SMOOTH
+attribute vec3 ${BLEND_ATTRIBUTE};
+#else
+attribute float ${SECTION_ATTRIBUTE};
+#endif
+`;
+
+const PARS = /* glsl */ `
+uniform highp sampler2D gcsSections;${COMMON_PARS}
+void gcsRows( const in int section, out vec4 r0, out vec4 r1, out vec4 r2 ) {
+	int i = gcsBase + section * ${GPU_TEXELS_PER_SECTION};
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	int w = textureSize( gcsSections, 0 ).x;
+	r0 = texelFetch( gcsSections, ivec2( i % w, i / w ), 0 );
+	i += 1; r1 = texelFetch( gcsSections, ivec2( i % w, i / w ), 0 );
+	i += 1; r2 = texelFetch( gcsSections, ivec2( i % w, i / w ), 0 );
+}
+// Rows of the cofactor matrix of the 3×3 part (rows a, b, c), divided by its largest entry first
+// (no overflow under ×1e20 scales): the normal matrix up to a positive factor. Smooth mode blends
+// two of them, so each is brought to the CPU's scale: divided by |det|^(2/3) (a rotation times a
+// uniform scale gives back the rotation).
+void gcsNormalRows( vec4 r0, vec4 r1, vec4 r2, const in bool unitScale, out vec3 n0, out vec3 n1, out vec3 n2 ) {
+	vec3 a = r0.xyz, b = r1.xyz, c = r2.xyz;
+	vec3 m = max( max( abs( a ), abs( b ) ), abs( c ) );
+	float big = max( max( m.x, m.y ), m.z );
+	if ( big > 0.0 ) { a /= big; b /= big; c /= big; }
+	n0 = cross( b, c ); n1 = cross( c, a ); n2 = cross( a, b );
+	if ( unitScale ) {
+		float det = abs( dot( a, n0 ) );
+		if ( det > ${f(COLLAPSED)} ) { float k = 1.0 / pow( det, 2.0 / 3.0 ); n0 *= k; n1 *= k; n2 *= k; }
+	}
+}
+vec3 gcsTurn( const in vec3 v, const in vec3 n0, const in vec3 n1, const in vec3 n2 ) {
+	vec3 t = vec3( dot( n0, v ), dot( n1, v ), dot( n2, v ) );
+	float l = length( t );
+	return l > 0.0 ? t / l : v;
+}
+`;
+
+/** Per vertex, once: the blended rows of its affine 3×4 and the rows of its normal matrix. */
+const BASE = /* glsl */ `
+	vec4 gcsR0, gcsR1, gcsR2;
+	vec3 gcsN0, gcsN1, gcsN2;
+	{
+		#ifdef GCS_SMOOTH
+		vec4 a0, a1, a2, b0, b1, b2;
+		gcsRows( int( ${BLEND_ATTRIBUTE}.x + 0.5 ), a0, a1, a2 );
+		gcsRows( int( ${BLEND_ATTRIBUTE}.y + 0.5 ), b0, b1, b2 );
+		float f = ${BLEND_ATTRIBUTE}.z;
+		gcsR0 = a0 + f * ( b0 - a0 ); gcsR1 = a1 + f * ( b1 - a1 ); gcsR2 = a2 + f * ( b2 - a2 );
+		vec3 p0, p1, p2, q0, q1, q2;
+		gcsNormalRows( a0, a1, a2, true, p0, p1, p2 );
+		gcsNormalRows( b0, b1, b2, true, q0, q1, q2 );
+		gcsN0 = p0 + f * ( q0 - p0 ); gcsN1 = p1 + f * ( q1 - p1 ); gcsN2 = p2 + f * ( q2 - p2 );
+		#else
+		gcsRows( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsR0, gcsR1, gcsR2 );
+		gcsNormalRows( gcsR0, gcsR1, gcsR2, false, gcsN0, gcsN1, gcsN2 );
+		#endif
+	}
+`;
+
+/** Normals and tangents, each turned by `turn` (the GLSL call on that vector). */
+const turned = (turn: (v: string) => string) => /* glsl */ `
+	objectNormal = ${turn('objectNormal')};
+	#ifdef USE_TANGENT
+	objectTangent = ${turn('objectTangent')};
+	#endif
+`;
+
+const NORMAL = turned((v) => `gcsTurn( ${v}, gcsN0, gcsN1, gcsN2 )`);
+
+const POSITION = /* glsl */ `
+	{
+		vec4 p = vec4( transformed, 1.0 );
+		transformed = vec3( dot( gcsR0, p ), dot( gcsR1, p ), dot( gcsR2, p ) );
+	}
+`;
+
+// ------------------------------------------------------------ the joint-level path (weights criterion)
+// Matrices are GLSL's (column-major); the math is GcsDeformerImpl::sectionTransformsWeights,
+// blendPoses and normalMatrix (wasm/src), step for step.
+
+/** Declarations: joint poses (per frame), the section table (static), the per-section blend. */
+const JOINT_PARS = /* glsl */ `
+uniform highp sampler2D gcsJoints;
+uniform highp sampler2D gcsTable;${COMMON_PARS}
+vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
+	int w = textureSize( t, 0 ).x;
+	return texelFetch( t, ivec2( i % w, i / w ), 0 );
+}
+// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+void gcsJoint( const in int j, out mat3 s, out vec3 t, out vec4 q ) {
+	int i = gcsBase + j * ${GPU_TEXELS_PER_JOINT};
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	vec4 r0 = gcsTexel( gcsJoints, i ), r1 = gcsTexel( gcsJoints, i + 1 ), r2 = gcsTexel( gcsJoints, i + 2 );
+	q = gcsTexel( gcsJoints, i + 3 );
+	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	t = vec3( r0.w, r1.w, r2.w );
+}
+// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
+mat3 gcsRotation( const in vec4 q, const in float k2 ) {
+	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
+		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
+		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
+}
+// The CPU's normalMatrix: r when k is a positive uniform scale (up to 1e-4), else r · cof(k) scaled
+// to entries ≤ 1 (renormalise), r alone when k has collapsed.
+mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	bool uniformScale = s > 0.0;
+	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
+		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
+	renorm = ! uniformScale;
+	if ( uniformScale ) return r;
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return r;
+	mat3 a = k / kbig;
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	if ( ! ( big > ${f(COLLAPSED)} ) ) return r;
+	return r * ( c / big );
+}
+// Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
+// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first.
+void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+	vec4 joints = gcsTexel( gcsTable, ${TABLE_TEXELS_PER_SECTION} * s ), weights = gcsTexel( gcsTable, ${TABLE_TEXELS_PER_SECTION} * s + 1 );
+	mat3 S; vec3 t; vec4 q;
+	gcsJoint( int( joints.x ), S, t, q );
+	if ( joints.y < 0.0 ) {
+		M = S; T = t;
+		mat3 r = gcsRotation( q, 2.0 );
+		N = gcsNormalMatrix( r, transpose( r ) * S, renorm );
+		return;
+	}
+	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
+	mat3 K = mat3( 0.0 );
+	for ( int k = 0; k < ${JOINTS_PER_SECTION}; k ++ ) {
+		if ( joints[ k ] < 0.0 ) break;
+		if ( k > 0 ) gcsJoint( int( joints[ k ] ), S, t, q );
+		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+		float w = weights[ k ];
+		float sw = dot( q, pivot ) < 0.0 ? - w : w;
+		br += sw * q;
+		bd += sw * d;
+		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
+	}
+	float inv2 = 1.0 / dot( br, br );
+	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
+	mat3 rot = gcsRotation( br, 2.0 * inv2 );
+	M = rot * K;
+	N = gcsNormalMatrix( rot, K, renorm );
+}
+// A normal or tangent as the CPU turns it: blended (smooth) normals get the cubic length fix when
+// both sides are rotations less than 35° apart, else are normalised (a vanished one keeps its rest
+// direction); unblended ones are normalised only when the scale asks for it.
+vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool normalise ) {
+	vec3 n = N * v;
+	if ( near ) { float e = dot( n, n ) - 1.0; return n * ( 1.0 + e * ( ${f(LENGTH_FIX[0])} + ${f(LENGTH_FIX[1])} * e ) ); }
+	if ( normalise ) { float l = length( n ); return l > 0.0 ? n / l : v; }
+	return n;
+}
+`;
+
+/** Per vertex, once: its (blended) section transform and normal matrix. */
+const JOINT_BASE = /* glsl */ `
+	mat3 gcsM, gcsN;
+	vec3 gcsT;
+	bool gcsNear = false, gcsNormalise;
+	{
+		#ifdef GCS_SMOOTH
+		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sb = int( ${BLEND_ATTRIBUTE}.y + 0.5 );
+		gcsSectionBlend( sa, gcsM, gcsT, gcsN, gcsNormalise );
+		if ( sb != sa ) {
+			mat3 mb, nb; vec3 tb; bool rb;
+			gcsSectionBlend( sb, mb, tb, nb, rb );
+			float f = ${BLEND_ATTRIBUTE}.z;
+			bool ra = gcsNormalise;
+			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
+			gcsNear = ! ra && ! rb && trace > ${f(NEAR_TRACE)};
+			gcsNormalise = true;
+			gcsM = gcsM + f * ( mb - gcsM );
+			gcsT = gcsT + f * ( tb - gcsT );
+			gcsN = gcsN + f * ( nb - gcsN );
+		}
+		#else
+		gcsSectionBlend( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
+		#endif
+	}
+`;
+
+const JOINT_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, gcsNear, gcsNormalise )`);
+
+const JOINT_POSITION = /* glsl */ `
+	transformed = gcsM * transformed + gcsT;
+`;
+
+const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', '#include <skinning_vertex>'] as const;
+
+/**
+ * The vertex shader of a three.js built-in material (or any shader written with its chunks) with
+ * three's skinning chunks replaced by GCS's: path 'sections', the section transforms come from the
+ * `gcsSections` texture; path 'joints', each vertex's section is blended from the joint poses in
+ * `gcsJoints` and the static table `gcsTable`. Morph targets still apply first (three's order),
+ * then the section transform; normals and tangents turn with the normal matrix. Throws GcsError
+ * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
+ */
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections'): string {
+  for (const hook of HOOKS)
+    if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
+  if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+  const joints = path === 'joints';
+  let out = source
+    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? JOINT_PARS : PARS}`)
+    .replace(HOOKS[1], joints ? JOINT_BASE : BASE)
+    .replace(HOOKS[2], joints ? JOINT_POSITION : POSITION);
+  // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
+  out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
+  return `${smooth ? '#define GCS_SMOOTH\n' : ''}${out}`;
+}
+

@@ -1,0 +1,36 @@
+/**
+ * The GPU path's data layout and the constants of its maths: one source of truth for the GLSL
+ * chunk (glsl.ts, WebGLRenderer) and the TSL function (tsl.ts, WebGPURenderer), which compute the
+ * same thing from these numbers (docs/gpu.md).
+ */
+import { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION } from '../index.js';
+
+export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION };
+
+/**
+ * What the GPU gets per frame: 'joints' (joint poses, O(joints); weights criterion only) or
+ * 'sections' (section transforms, O(sections); any criterion).
+ */
+export type GpuPath = 'joints' | 'sections';
+
+/** Texels per section in the joint-level path's static table: its joints (−1 past the last), then their weights. */
+export const TABLE_TEXELS_PER_SECTION = 2;
+/** Most joints one section blends (the table's texel holds four). */
+export const JOINTS_PER_SECTION = 4;
+
+/** Per-vertex attribute, plain mode: the vertex's section (a float). */
+export const SECTION_ATTRIBUTE = 'gcsSection';
+/** Per-vertex attribute, smooth mode: (section, other section, factor towards the other). */
+export const BLEND_ATTRIBUTE = 'gcsBlend';
+
+/** The CPU's test for "the scale part K is a positive uniform scale": every entry within this × s of s·I. */
+export const UNIFORM_SCALE_TOLERANCE = 1e-4;
+/** Below this a largest entry counts as zero (a collapsed scale): the normal keeps its rotation. */
+export const COLLAPSED = 1e-30;
+/**
+ * Smooth mode: two sections' normal matrices (both rotations) are "near" when their trace exceeds
+ * 1 + 2·cos 35°; then the CPU fixes a blended normal's length by a cubic rather than normalising.
+ */
+export const NEAR_TRACE = 1 + 2 * 0.82;
+/** The cubic length fix n·(1 + e·(a + b·e)), e = |n|² − 1: a ≈ −1/2, b ≈ 3/8 (1/√(1+e) to second order). */
+export const LENGTH_FIX = [-0.5, 0.375] as const;

@@ -1,0 +1,93 @@
+/**
+ * The TSL kit (WebGPURenderer, real WebGPU or its WebGL2 fallback): each source material becomes
+ * its node equivalent (every map, colour and flag kept, as WebGPURenderer itself converts
+ * built-in materials) with GCS as its `positionNode` (tsl.ts); the shadow passes use the same
+ * node (`castShadowPositionNode`), so shadows follow the skin.
+ */
+import * as THREE from 'three/webgpu';
+import type { GpuMaterialKit, GpuMaterials } from './kit.js';
+import type { GpuSections } from './sections.js';
+import { gcsPositionNode } from './tsl.js';
+
+/** Built-in material type → its node material (the ones WebGPURenderer converts). */
+const NODE_MATERIALS: Record<string, new () => THREE.NodeMaterial> = {
+  MeshBasicMaterial: THREE.MeshBasicNodeMaterial,
+  MeshLambertMaterial: THREE.MeshLambertNodeMaterial,
+  MeshPhongMaterial: THREE.MeshPhongNodeMaterial,
+  MeshStandardMaterial: THREE.MeshStandardNodeMaterial,
+  MeshPhysicalMaterial: THREE.MeshPhysicalNodeMaterial,
+  MeshToonMaterial: THREE.MeshToonNodeMaterial,
+  MeshMatcapMaterial: THREE.MeshMatcapNodeMaterial,
+  MeshNormalMaterial: THREE.MeshNormalNodeMaterial,
+};
+
+/** Properties not carried from a built-in material to its node equivalent: identity and class flags, not look. */
+const NOT_CARRIED = (key: string) => key === 'uuid' || key === 'type' || key === 'version' || /^is[A-Z]/.test(key);
+
+/**
+ * What a WebGLRenderer without a nodes handler (which cannot run node materials) compiles in their
+ * place for the one draw before onBeforeRender moves the skin to the CPU: a program that puts every
+ * vertex beyond the far plane, so nothing is drawn rather than a crash. WebGLNodesHandler and
+ * WebGPURenderer never read these fields.
+ */
+const NOTHING = {
+  vertexShader: 'void main() { gl_Position = vec4( 0.0, 0.0, 2.0, 1.0 ); }',
+  fragmentShader: 'void main() { gl_FragColor = vec4( 0.0 ); }',
+};
+
+/** Uniforms for that program: WebGLRenderer wires its lights into whichever it asks for; the program reads none. */
+function placeholderUniforms(): Record<string, { value: unknown }> {
+  return new Proxy({} as Record<string, { value: unknown }>, { get: (target, key: string) => (target[key] ??= { value: null }) });
+}
+
+type Nodes = { positionNode?: unknown; vertexNode?: unknown; castShadowPositionNode?: unknown };
+
+/** Why `material` cannot run GCS as a node material, or null when it can. */
+export function nodeMaterialSupport(material: THREE.Material): string | null {
+  const m = material as THREE.Material & { isShaderMaterial?: boolean; isNodeMaterial?: boolean } & Nodes;
+  if (m.isShaderMaterial) return `${material.type} is a custom shader: gcs-skin/webgpu runs GCS in node materials (use a built-in or node material)`;
+  if (m.isNodeMaterial) {
+    for (const key of ['positionNode', 'vertexNode', 'castShadowPositionNode'] as const)
+      if (m[key]) return `${material.type} has its own ${key}: GCS would replace it (leave ${key} null, or deform on the CPU backend)`;
+    return null;
+  }
+  if (!NODE_MATERIALS[material.type]) return `${material.type} has no node material equivalent: gcs-skin/webgpu runs GCS in node materials`;
+  return null;
+}
+
+/** The node equivalent of a built-in material (textures shared), or a clone of a node material. */
+export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
+  if ((source as THREE.NodeMaterial).isNodeMaterial) return (source as THREE.NodeMaterial).clone();
+  const Node = NODE_MATERIALS[source.type];
+  const material = new Node();
+  const from = source as unknown as Record<string, unknown>, to = material as unknown as Record<string, unknown>;
+  for (const key in source) if (!NOT_CARRIED(key)) to[key] = from[key];
+  material.userData = { ...source.userData };
+  material.needsUpdate = true;
+  return material;
+}
+
+/** The TSL kit: what gcs-skin/webgpu draws with. */
+export const tslKit: GpuMaterialKit = {
+  entry: 'gcs-skin/webgpu',
+  support: nodeMaterialSupport,
+  build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
+    const convert = (m: THREE.Material) => {
+      const material = toNodeMaterial(m);
+      material.positionNode = gcsPositionNode(sections, instances !== null);
+      material.castShadowPositionNode = material.positionNode;
+      material.name = m.name;
+      material.userData.gcsSource = m;
+      Object.assign(material, { ...NOTHING, uniforms: placeholderUniforms() });
+      return material;
+    };
+    return { material: Array.isArray(source) ? source.map(convert) : convert(source), depth: null, distance: null };
+  },
+  mismatch(renderer: unknown, material: THREE.Material): string | null {
+    const r = renderer as { isWebGLRenderer?: boolean };
+    // WebGLNodesHandler installs its own onBeforeRender on the node materials it draws.
+    if (r?.isWebGLRenderer && material.onBeforeRender === THREE.Material.prototype.onBeforeRender)
+      return "a WebGLRenderer without a nodes handler draws this mesh, and it cannot run node materials: draw with WebGPURenderer (three/webgpu), call renderer.setNodesHandler(new WebGLNodesHandler()) (three/addons/tsl/WebGLNodesHandler.js), or import GcsCharacter / GcsCrowd from 'gcs-skin/three' for WebGLRenderer";
+    return null;
+  },
+};

@@ -1,0 +1,122 @@
+/**
+ * The GPU path's data, whichever renderer draws it: the per-frame texture of joint poses or
+ * section transforms (wasm memory viewed by a float DataTexture, no copy), the static section
+ * table, and the per-vertex section attributes (layout.ts; docs/gpu.md).
+ */
+import * as THREE from 'three';
+import { GcsError } from '../errors.js';
+import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
+import { BLEND_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath } from './layout.js';
+
+/** The uniforms a patched material reads; shared by every material of one skin. */
+export interface GcsUniforms {
+  /** Path 'sections': the section transforms (per frame). */
+  gcsSections?: { value: THREE.DataTexture };
+  /** Path 'joints': the joint poses (per frame). */
+  gcsJoints?: { value: THREE.DataTexture };
+  /** Path 'joints': each section's joints and weights (static). */
+  gcsTable?: { value: THREE.DataTexture };
+  /** Texel of instance 0's first section or joint. */
+  gcsBase: { value: number };
+  /** Texels per instance (sections × 3, or joints × 4). */
+  gcsStride: { value: number };
+  [name: string]: THREE.IUniform | undefined;
+}
+
+/**
+ * What the GPU needs per frame for `instanceCount` poses of one GCS model, as a float texture:
+ * path 'joints' (default for the weights criterion) the joint poses (JointPoses) plus a static
+ * texture of each section's joints and weights, uploaded once; path 'sections' (any criterion;
+ * the default for 'y' and 'axial') the section transforms (SectionTransforms). The per-frame
+ * buffers live in wasm memory and the DataTexture's `image.data` views them (no copy; re-pointed
+ * after wasm memory growth). Write poses into `skins` (J × 16 floats per instance), then
+ * `update()` once per frame: one wasm call, one texture upload. Asking for 'joints' on a model
+ * built with the 'y' or 'axial' criterion is GcsError 'INVALID_ARGUMENT'.
+ */
+export class GpuSections {
+  readonly path: GpuPath;
+  readonly transforms: PoseTexels;
+  /** The per-frame texture (joint poses or section transforms). */
+  readonly texture: THREE.DataTexture;
+  /** Path 'joints': the static texture of each section's joints and weights; null otherwise. */
+  readonly table: THREE.DataTexture | null;
+  readonly uniforms: GcsUniforms;
+  readonly smooth: boolean;
+
+  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath) {
+    if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+    this.path = path ?? (deformer.jointLevel ? 'joints' : 'sections');
+    this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth) : new SectionTransforms(deformer, instanceCount, maxWidth);
+    const t = this.transforms;
+    this.texture = floatTexture(t.texels, t.width, t.height);
+    const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
+    if (this.path === 'joints') {
+      const influences = deformer.sectionInfluences()!;
+      const texels = influences.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+      const data = new Float32Array(width * height * 4);
+      data.set(influences);
+      this.table = floatTexture(data, width, height);
+      this.uniforms = { gcsJoints: { value: this.texture }, gcsTable: { value: this.table }, ...base };
+    } else {
+      this.table = null;
+      this.uniforms = { gcsSections: { value: this.texture }, ...base };
+    }
+    this.smooth = deformer.blendOther() !== null;
+  }
+
+  get instanceCount(): number {
+    return this.transforms.instanceCount;
+  }
+
+  /** Every instance's skin matrices (a view on wasm memory). */
+  get skins(): Float32Array {
+    return this.transforms.skins;
+  }
+
+  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16). */
+  get bytesPerUpdate(): number {
+    return this.transforms.width * this.transforms.height * 16;
+  }
+
+  /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
+  update(): void {
+    this.transforms.compute();
+    const texels = this.transforms.texels; // re-created after memory growth
+    const image = this.texture.image as { data: Float32Array };
+    if (image.data !== texels) image.data = texels;
+    this.texture.needsUpdate = true;
+  }
+
+  dispose(): void {
+    this.texture.dispose();
+    this.table?.dispose();
+    this.transforms.dispose();
+  }
+}
+
+/** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */
+function floatTexture(data: Float32Array, width: number, height: number): THREE.DataTexture {
+  const texture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+  texture.minFilter = THREE.NearestFilter;
+  texture.magFilter = THREE.NearestFilter;
+  texture.generateMipmaps = false;
+  texture.needsUpdate = true;
+  return texture;
+}
+
+/**
+ * Static per-vertex section data of a GCS deformer's output mesh: `gcsSection` (plain mode) or
+ * `gcsBlend` = (section, other section, factor) (smooth mode), as float attributes.
+ */
+export function sectionAttributes(deformer: GcsDeformer): { name: typeof SECTION_ATTRIBUTE | typeof BLEND_ATTRIBUTE; attribute: THREE.BufferAttribute } {
+  const section = deformer.sectionOfVertex();
+  const other = deformer.blendOther(), factor = deformer.blendFactor();
+  if (!other || !factor) return { name: SECTION_ATTRIBUTE, attribute: new THREE.BufferAttribute(Float32Array.from(section), 1) };
+  const blend = new Float32Array(3 * section.length);
+  for (let o = 0; o < section.length; o++) {
+    blend[3 * o] = section[o];
+    blend[3 * o + 1] = other[o];
+    blend[3 * o + 2] = factor[o];
+  }
+  return { name: BLEND_ATTRIBUTE, attribute: new THREE.BufferAttribute(blend, 3) };
+}
