@@ -80,7 +80,7 @@ describe('GcsCharacter and GcsCrowd of gcs-skin/webgpu', () => {
       expect(material.castShadowPositionNode).toBe(material.positionNode);
       expect(skin.mesh.customDepthMaterial).toBeUndefined(); // node materials cast their shadow through castShadowPositionNode
       expect(skin.bytesPerFrame).toBe(other.bytesPerFrame);
-      expect(skin.mesh.geometry.getAttribute('gcsSection').count).toBe(other.mesh.geometry.getAttribute('gcsSection').count);
+      expect(skin.mesh.geometry.getAttribute('gcsBlend').count).toBe(other.mesh.geometry.getAttribute('gcsBlend').count);
     } finally {
       webgl.dispose();
       character.dispose();
