@@ -411,7 +411,10 @@ typedef enum GcsClassicReason {
   GCS_CLASSIC_RAYS_MISS = 4,  /* carried: over 30 % of its rays miss its own triangles (a clavicle) */
   GCS_CLASSIC_BENT = 5,       /* carried: bone turned > 45° from its resampled parent's (a foot) */
   GCS_CLASSIC_SEAM = 6,       /* carried: its boundary with the carried mesh is not one ring at an end */
-  GCS_CLASSIC_TRUNK = 7       /* resampled along the trunk; its branch region (crotch, shoulders) carried */
+  GCS_CLASSIC_TRUNK = 7,      /* resampled along the trunk; its branch region (crotch, shoulders) carried */
+  GCS_CLASSIC_OFF_SURFACE = 8 /* carried: its tube would stand off the skin it replaces (measured at build
+                                 time at the bind pose and at probe poses: p99 > 1 % or max > 2.5 % of
+                                 the height), or its end cap would cut across a non-flat end */
 } GcsClassicReason;
 /*
  * Per-part report of a classic model: partCount × 5 int32 per part, parts in joint order:

@@ -883,7 +883,7 @@ function classicSummary(ch: Character): void {
 /** Why the classic model carries a part, as the page groups it. */
 const CARRIED_WHY: Record<Exclude<ClassicReason, 'resampled' | 'trunk'>, string> = {
   leaf: 'ends', branching: 'branch regions', 'too-short': 'bones too short', 'rays-miss': 'not tube-like (rays miss)',
-  bent: 'bent off their limb', seam: 'no clean ring to the carried skin',
+  bent: 'bent off their limb', seam: 'no clean ring to the carried skin', 'off-surface': 'a tube would leave the skin',
 };
 
 /** "fingers: 30 joints · ends: Head, LeftHand, … · branch regions: Chest": carried parts grouped by reason. */

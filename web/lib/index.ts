@@ -100,16 +100,19 @@ export interface SectionInfo {
 }
 
 /**
- * Why a part of the classic model is resampled or carried rigidly (gcs_skin.h, GcsClassicReason):
+ * Why a part of the classic model is resampled or carried (gcs_skin.h, GcsClassicReason; carried
+ * skin keeps its triangles and moves by dual-quaternion skinning of its own weights):
  * `resampled` a chain part, joint to joint; `trunk` a branching trunk part (pelvis, chest)
  * resampled along the spine with its branch region (crotch, shoulders) carried; carried ones:
  * `leaf` (head, hands, feet, finger tips), `branching` (a hand with fingers), `too-short`
  * (fingers, zero-length bones), `rays-miss` (a clavicle), `bent` (a foot on a shank), `seam`
- * (its boundary with the carried mesh is not one ring around an end).
+ * (its boundary with the carried mesh is not one ring around an end), `off-surface` (measured at
+ * build time: at the bind pose or a probe pose its tube stands off the skin it replaces by more than
+ * 1 % of the height at p99 or 2.5 % at most, or its end cap would cut flat across a rounded end).
  */
-export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk';
+export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk' | 'off-surface';
 /** The reasons in the order of their codes (GcsClassicReason). */
-export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk'];
+export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk', 'off-surface'];
 
 export interface ClassicPart {
   joint: number;
