@@ -413,7 +413,7 @@ typedef enum GcsClassicReason {
   GCS_CLASSIC_SEAM = 6,       /* carried: its boundary with the carried mesh is not one ring at an end */
   GCS_CLASSIC_TRUNK = 7,      /* resampled along the trunk; its branch region (crotch, shoulders) carried */
   GCS_CLASSIC_OFF_SURFACE = 8 /* carried: its tube would stand off the skin it replaces (measured at build
-                                 time at the bind pose and at probe poses: p99 > 1 % or max > 2.5 % of
+                                 time at probe poses, every joint bent 35°: p99 > 1 % or max > 2.5 % of
                                  the height), or its end cap would cut across a non-flat end */
 } GcsClassicReason;
 /*

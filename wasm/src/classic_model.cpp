@@ -915,6 +915,13 @@ ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, flo
     {
       std::vector<float> sum(J, 0.0f);
       std::vector<uint32_t> touched;
+      std::vector<uint32_t> vertexFirst(J + 1, 0), vertexList(rig.vertexCount);  // rig vertices by part
+      for (uint32_t v = 0; v < rig.vertexCount; ++v) ++vertexFirst[partOf[v] + 1];
+      for (uint32_t j = 0; j < J; ++j) vertexFirst[j + 1] += vertexFirst[j];
+      {
+        std::vector<uint32_t> cursor(vertexFirst.begin(), vertexFirst.end() - 1);
+        for (uint32_t v = 0; v < rig.vertexCount; ++v) vertexList[cursor[partOf[v]]++] = v;
+      }
       for (ClassicContour& c : m.contours) {
         const ClassicPart& P = m.parts[c.part];
         auto near = [&](uint32_t x) {
@@ -928,8 +935,10 @@ ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, flo
         float window = 0.5f * P.length * std::max(P.tHi - P.tLo, 1e-3f) / float(std::max<uint32_t>(P.contourCount - 1, 1));
         float total = 0.0f;
         for (int attempt = 0; attempt < 4 && total <= 0.0f; ++attempt, window *= 2.0f) {
-          for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-            if (!near(partOf[v])) continue;
+          for (uint32_t x0 = 0; x0 < J; ++x0) {
+            if (!m.parts[x0].isPart || !near(x0)) continue;
+            for (uint32_t i = vertexFirst[x0]; i < vertexFirst[x0 + 1]; ++i) {
+            const uint32_t v = vertexList[i];
             glm::vec3 x = rig.positions[v] - c.centre;
             float h = glm::dot(x, c.normal);
             if (std::fabs(h) > window || glm::length(x - h * c.normal) > reach) continue;
@@ -941,6 +950,7 @@ ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, flo
               sum[jj] += f * rig.weights[v][i];
             }
             total += f;
+            }
           }
         }
         // The four largest, renormalised; none found: the part's own joint.
@@ -1199,8 +1209,8 @@ void probeSkin(const Rig& rig, const glm::vec3& axis, float angle, std::vector<g
 // Which resampled parts stand off the skin they replace (design.md §7's classic off-surface
 // target: p99 ≤ 1 %, max ≤ 2.5 % of the height). Per ring vertex: its distance from the point of
 // the input surface its ray hit, both posed — the ring by the model (bulge included), the surface
-// by dual-quaternion skinning — at the bind pose and at probe poses (every joint bent 35° forward,
-// backward, to either side, and twisted). An end cap must lie on the input's own end (a flat plate): its
+// by dual-quaternion skinning — at probe poses (every joint bent 35° forward,
+// backward, to either side, and twisted either way). An end cap must lie on the input's own end (a flat plate): its
 // centre within 1 % of the height of the input surface at the bind pose.
 std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std::vector<uint32_t>& ringTriangle) {
   const uint32_t J = rig.jointCount, T = uint32_t(rig.indices.size() / 3);
@@ -1227,28 +1237,49 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
                                                   rig.positions[rig.indices[3 * t + 2]]));
     if (best > 0.01f * m.height) failed[m.contours[cap.contour].part] = 1;
   }
-  constexpr int kProbes = 5;  // symmetric: a left limb and its mirror image get the same verdict
-  const glm::vec3 axes[kProbes] = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}};
-  const float angles[kProbes] = {0.61f, -0.61f, 0.61f, -0.61f, 0.61f};
+  constexpr int kProbes = 6;  // in pairs: a left limb and its mirror image get the same verdict
+  const glm::vec3 axes[kProbes] = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
+  const float angles[kProbes] = {0.61f, -0.61f, 0.61f, -0.61f, 0.61f, -0.61f};
+  // Only the corners of hit triangles are skinned (a compact copy of them).
+  std::vector<int32_t> slot(rig.vertexCount, -1);
+  std::vector<uint32_t> cornerOf;
+  for (uint32_t o = 0; o < m.tubeVertexCount; ++o)
+    if (ringTriangle[o] < T)
+      for (int e = 0; e < 3; ++e) {
+        uint32_t v = rig.indices[size_t(ringTriangle[o]) * 3 + e];
+        if (slot[v] < 0) slot[v] = int32_t(cornerOf.size()), cornerOf.push_back(v);
+      }
+  const uint32_t C = uint32_t(cornerOf.size());
+  std::vector<float> rest(size_t(C) * 3), restNormals(size_t(C) * 3), posed(size_t(C) * 3), posedNormals(size_t(C) * 3);
+  std::vector<glm::uvec4> joints(C);
+  std::vector<glm::vec4> weights(C);
+  for (uint32_t i = 0; i < C; ++i) {
+    const uint32_t v = cornerOf[i];
+    for (int c = 0; c < 3; ++c) rest[3 * i + c] = rig.positions[v][c], restNormals[3 * i + c] = rig.normals[v][c];
+    joints[i] = rig.joints[v], weights[i] = rig.weights[v];
+  }
   std::vector<glm::mat4> skin;
   std::vector<JointPose> poses(J);
-  std::vector<float> posed(size_t(rig.vertexCount) * 3), posedNormals(size_t(rig.vertexCount) * 3);
   std::vector<std::vector<float>> distances(J);
-  for (int probe = -1; probe < kProbes; ++probe) {
-    if (probe < 0) skin.assign(J, glm::mat4(1.0f));
-    else probeSkin(rig, axes[probe], angles[probe], skin);
+  for (int probe = 0; probe < kProbes; ++probe) {  // (at the bind pose each ring vertex is its hit)
+    probeSkin(rig, axes[probe], angles[probe], skin);
     m.deform(skin.data());
     const ScaleState scale = decomposeAll(skin.data(), J, poses.data());
-    dqsVertices(poses.data(), scale, rig.joints.data(), rig.weights.data(), &rig.positions[0].x, &rig.normals[0].x,
-                posed.data(), posedNormals.data(), rig.vertexCount);
+    dqsVertices(poses.data(), scale, joints.data(), weights.data(), rest.data(), restNormals.data(), posed.data(),
+                posedNormals.data(), C);
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
       if (!P.resampled) continue;
       for (uint32_t o = P.first; o < P.first + P.count; ++o) {
-        if (ringTriangle[o] >= T) continue;
+        // (a joint ring shared by two tubes is the method's own joint, the bisector where the skin
+        // is bound hard to each bone: that skin folds or opens there under DQS, the ring does not)
+        if (ringTriangle[o] >= T || m.contours[size_t(m.contourOfVertex[o])].proximal >= 0) continue;
         const uint32_t* t = &rig.indices[size_t(ringTriangle[o]) * 3];
         glm::vec3 hit(0.0f);
-        for (int e = 0; e < 3; ++e) hit += bary[o][e] * glm::vec3(posed[3 * t[e]], posed[3 * t[e] + 1], posed[3 * t[e] + 2]);
+        for (int e = 0; e < 3; ++e) {
+          const size_t q = 3 * size_t(slot[t[e]]);
+          hit += bary[o][e] * glm::vec3(posed[q], posed[q + 1], posed[q + 2]);
+        }
         distances[j].push_back(glm::length(glm::vec3(m.positions[3 * o], m.positions[3 * o + 1], m.positions[3 * o + 2]) - hit));
       }
     }

@@ -107,7 +107,7 @@ export interface SectionInfo {
  * `leaf` (head, hands, feet, finger tips), `branching` (a hand with fingers), `too-short`
  * (fingers, zero-length bones), `rays-miss` (a clavicle), `bent` (a foot on a shank), `seam`
  * (its boundary with the carried mesh is not one ring around an end), `off-surface` (measured at
- * build time: at the bind pose or a probe pose its tube stands off the skin it replaces by more than
+ * build time: at a probe pose (every joint bent 35°) its tube stands off the skin it replaces by more than
  * 1 % of the height at p99 or 2.5 % at most, or its end cap would cut flat across a rounded end).
  */
 export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk' | 'off-surface';
