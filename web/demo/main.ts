@@ -5,7 +5,7 @@
 //
 // Every view draws the character with its own materials: the deformed meshes share the source's
 // material (textures, colours), the classic model's resampled skin gets its texture coordinates
-// from the source surface (transfer.ts), and the parts that are not skinned (e.g. the robot's
+// from the source surface (the library does it: gcs-skin/three), and the parts that are not skinned (e.g. the robot's
 // rigid limbs, children of its bones) are drawn in every view, moved by the bones as three.js
 // moves them. One scene, one mixer: camera layers pick what each view draws.
 //
@@ -22,7 +22,7 @@ import {
 } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import { createHumanData, humanFromData, type HumanData } from '../lib/human/index.js';
-import { attributesNeeded, transferAttributes } from './transfer.js';
+import { attributesNeeded } from './material-attributes.js';
 import { crowdRequested, startCrowd } from './crowd.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -556,22 +556,6 @@ function applyColourMode(skin: SkinDeformer): void {
   }
 }
 
-/**
- * The classic model resamples the skin: its resampled vertices get the source's texture
- * coordinates (and vertex colours) from the closest point of the source surface in the bind pose,
- * its carried vertices their own source vertex's (transfer.ts).
- */
-function carrySurfaceAttributes(skin: SkinDeformer): void {
-  const names = attributesNeeded(skin.source.material);
-  if (!names.length) return;
-  const d = skin.deformer;
-  const identity = new Float32Array(16 * d.jointCount);
-  for (let j = 0; j < d.jointCount; j++) identity.set([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1], 16 * j);
-  d.deform(identity); // the bind pose; the next update() poses it again
-  const sourceOf = skin.currentMethod === 'classic' ? (d as ClassicDeformer).sourceOfVertex : undefined;
-  transferAttributes(skin.source.geometry, skin.mesh.geometry, d.positions.slice(), names, sourceOf);
-}
-
 function applyMaterials(): void {
   for (const m of [gcsMaterial, classicMaterial]) {
     m.wireframe = params.wireframe;
@@ -855,7 +839,6 @@ function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; er
       const skin = new SkinDeformer(gcs, src, { method: 'classic', classic: classicOptions(), material: src.material });
       skins.push(skin);
       skin.mesh.layers.set(LAYER.classic);
-      carrySurfaceAttributes(skin);
       classicColours(skin);
     }
     return { skins, error: null };
@@ -937,7 +920,6 @@ function rebuildClassic(ch: Character): void {
     try {
       for (const s of ch.classic) {
         s.rebuild('classic', { classic: classicOptions() });
-        carrySurfaceAttributes(s);
         classicColours(s);
       }
       ch.classicError = null;

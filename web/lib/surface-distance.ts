@@ -1,7 +1,9 @@
 /**
  * Distance from points to a triangle mesh, through a uniform grid of the triangles' boxes: what
- * `classicOffSurface` (gcs-skin/measure) asks for every output vertex of every frame. Rebuilt per
- * frame (`build`), queried per point (`distance`); the buffers are kept between frames.
+ * `classicOffSurface` (gcs-skin/measure) asks for every output vertex of every frame, and the closest
+ * point (triangle, barycentrics) from which the classic model's resampled vertices take the source's
+ * texture coordinates (`transferSurfaceAttributes`, gcs-skin/three). Rebuilt per frame (`build`),
+ * queried per point; the buffers are kept between builds.
  */
 export class TriangleGrid {
   private positions: ArrayLike<number> = [];
@@ -71,6 +73,19 @@ export class TriangleGrid {
 
   /** Distance from (x, y, z) to the nearest indexed triangle (Infinity when there is none; NaN in: NaN out). */
   distance(x: number, y: number, z: number): number {
+    return this.closest(x, y, z, this.scratch);
+  }
+
+  private readonly scratch: ClosestPoint = { triangle: -1, u: 0, v: 0, w: 0 };
+  private readonly weights: ClosestPoint = { triangle: -1, u: 0, v: 0, w: 0 };
+
+  /**
+   * The nearest indexed triangle to (x, y, z) and the barycentric weights (of its corners a, b, c)
+   * of the nearest point on it, written into `hit`; returns the distance (hit.triangle −1 and
+   * Infinity when there is no triangle, NaN for a non-finite point).
+   */
+  closest(x: number, y: number, z: number, hit: ClosestPoint): number {
+    hit.triangle = -1;
     if (!Number.isFinite(x) || !Number.isFinite(y) || !Number.isFinite(z)) return NaN;
     const [nx, ny, nz] = this.dims;
     const cx = this.clampCell(0, x), cy = this.clampCell(1, y), cz = this.clampCell(2, z);
@@ -93,8 +108,11 @@ export class TriangleGrid {
               const t = this.cellTriangles[s];
               if (this.stamp[t] === q) continue;
               this.stamp[t] = q;
-              const d = pointTriangleDistance(this.positions, this.indices, t, x, y, z);
-              if (d < best) best = d;
+              const d = closestOnTriangle(this.positions, this.indices, t, x, y, z, this.weights);
+              if (d < best) {
+                best = d;
+                hit.triangle = t; hit.u = this.weights.u; hit.v = this.weights.v; hit.w = this.weights.w;
+              }
             }
           }
         }
@@ -104,38 +122,46 @@ export class TriangleGrid {
   }
 }
 
-/** Distance from (px, py, pz) to triangle t (closest point by regions, Ericson 5.1.5), in double. */
-export function pointTriangleDistance(P: ArrayLike<number>, I: ArrayLike<number>, t: number, px: number, py: number, pz: number): number {
+/** A point on a triangle mesh: the triangle and the barycentric weights of its corners a, b, c. */
+export interface ClosestPoint {
+  triangle: number;
+  u: number;
+  v: number;
+  w: number;
+}
+
+/**
+ * Distance from (px, py, pz) to triangle t of positions P / indices I, in double, and the
+ * barycentric weights of the closest point in `out` (by Voronoi regions, Ericson, Real-Time
+ * Collision Detection 5.1.5; a degenerate triangle gives its first corner).
+ */
+export function closestOnTriangle(P: ArrayLike<number>, I: ArrayLike<number>, t: number, px: number, py: number, pz: number,
+                                  out: ClosestPoint): number {
   const a = 3 * I[3 * t], b = 3 * I[3 * t + 1], c = 3 * I[3 * t + 2];
   const ax = P[a], ay = P[a + 1], az = P[a + 2];
   const abx = P[b] - ax, aby = P[b + 1] - ay, abz = P[b + 2] - az;
   const acx = P[c] - ax, acy = P[c + 1] - ay, acz = P[c + 2] - az;
   const apx = px - ax, apy = py - ay, apz = pz - az;
   const d1 = abx * apx + aby * apy + abz * apz, d2 = acx * apx + acy * apy + acz * apz;
-  if (d1 <= 0 && d2 <= 0) return Math.hypot(apx, apy, apz);
-  const bpx = px - P[b], bpy = py - P[b + 1], bpz = pz - P[b + 2];
-  const d3 = abx * bpx + aby * bpy + abz * bpz, d4 = acx * bpx + acy * bpy + acz * bpz;
-  if (d3 >= 0 && d4 <= d3) return Math.hypot(bpx, bpy, bpz);
-  const vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const v = d1 / (d1 - d3);
-    return Math.hypot(apx - v * abx, apy - v * aby, apz - v * abz);
+  let v: number, w: number; // weights of b and c
+  if (d1 <= 0 && d2 <= 0) { v = 0; w = 0; }
+  else {
+    const bpx = px - P[b], bpy = py - P[b + 1], bpz = pz - P[b + 2];
+    const d3 = abx * bpx + aby * bpy + abz * bpz, d4 = acx * bpx + acy * bpy + acz * bpz;
+    const cpx = px - P[c], cpy = py - P[c + 1], cpz = pz - P[c + 2];
+    const d5 = abx * cpx + aby * cpy + abz * cpz, d6 = acx * cpx + acy * cpy + acz * cpz;
+    const vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+    if (d3 >= 0 && d4 <= d3) { v = 1; w = 0; }
+    else if (vc <= 0 && d1 >= 0 && d3 <= 0) { v = d1 / (d1 - d3); w = 0; }
+    else if (d6 >= 0 && d5 <= d6) { v = 0; w = 1; }
+    else if (vb <= 0 && d2 >= 0 && d6 <= 0) { v = 0; w = d2 / (d2 - d6); }
+    else if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) { w = (d4 - d3) / (d4 - d3 + (d5 - d6)); v = 1 - w; }
+    else {
+      const den = va + vb + vc;
+      if (Math.abs(den) > 0) { v = vb / den; w = vc / den; }
+      else { v = 0; w = 0; }
+    }
   }
-  const cpx = px - P[c], cpy = py - P[c + 1], cpz = pz - P[c + 2];
-  const d5 = abx * cpx + aby * cpy + abz * cpz, d6 = acx * cpx + acy * cpy + acz * cpz;
-  if (d6 >= 0 && d5 <= d6) return Math.hypot(cpx, cpy, cpz);
-  const vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const w = d2 / (d2 - d6);
-    return Math.hypot(apx - w * acx, apy - w * acy, apz - w * acz);
-  }
-  const va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-    const w = (d4 - d3) / (d4 - d3 + (d5 - d6));
-    const bcx = P[c] - P[b], bcy = P[c + 1] - P[b + 1], bcz = P[c + 2] - P[b + 2];
-    return Math.hypot(bpx - w * bcx, bpy - w * bcy, bpz - w * bcz);
-  }
-  const denom = 1 / (va + vb + vc);
-  const v = vb * denom, w = vc * denom;
+  out.u = 1 - v - w; out.v = v; out.w = w;
   return Math.hypot(apx - v * abx - w * acx, apy - v * aby - w * acy, apz - v * abz - w * acz);
 }
