@@ -149,6 +149,7 @@ export interface DemoHook {
   clip(): string;
   classicBuilds(): number;
   pause(t?: number): void;
+  hideCharacter(hidden: boolean): void;
   idle(): Promise<void>;
 }
 declare global {
