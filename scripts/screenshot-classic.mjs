@@ -8,37 +8,17 @@
 //                                                           → DIR/classic-hips-before.png, …
 // (The "before" pictures in docs/ were taken with the wasm of commit a0a4518 copied over
 // web/lib/gcs-skin.wasm: the classic model before issue 21.)
-import { existsSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { build, preview } from 'vite';
-import { chromium } from 'playwright-core';
+import { mkdirSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { openDemo, root } from './demo-browser.mjs';
 
-const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 const arg = (name, fallback) => {
   const i = process.argv.indexOf(name);
   return i > 0 ? process.argv[i + 1] : fallback;
 };
 const outDir = resolve(arg('--out', join(root, 'docs')));
 const suffix = arg('--suffix', '');
-const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-if (!existsSync(chromiumPath)) {
-  console.error(`screenshot-classic: ${chromiumPath} not found (set CHROMIUM=/path/to/chromium)`);
-  process.exit(1);
-}
-const configFile = join(root, 'web/demo/vite.config.ts');
-const dist = mkdtempSync(join(tmpdir(), 'gcs-demo-'));
-await build({ configFile, logLevel: 'error', build: { outDir: dist, emptyOutDir: true } });
-const server = await preview({ configFile, logLevel: 'error', build: { outDir: dist }, preview: { host: '127.0.0.1', port: 0 } });
-const url = server.resolvedUrls.local[0];
-const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
-  executablePath: chromiumPath,
-  headless: true,
-  viewport: { width: 1200, height: 700 },
-  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const { url, context, close } = await openDemo('screenshot-classic', 1200, 700);
 mkdirSync(outDir, { recursive: true });
 try {
   const page = await context.newPage();
@@ -63,7 +43,5 @@ try {
     console.log('wrote', join(outDir, shot.file));
   }
 } finally {
-  await context.close();
-  await server.close();
-  rmSync(dist, { recursive: true, force: true });
+  await close();
 }
