@@ -599,7 +599,7 @@ export const MAX_INSTANCES = 65536;
 
 /** The classic cross-section deformer (resampled contours). */
 export class ClassicDeformer extends Deformer {
-  /** Which parts were resampled and which are carried rigidly. */
+  /** Which parts were resampled and which are carried (by DQS of their own weights). */
   get parts(): ClassicPart[] {
     const h = this.live();
     const n = this.gcs.core.gcs_classic_part_count(h);

@@ -587,7 +587,7 @@ export interface ClassicFigures {
   contours: number;
   rays: number;
   outputVertices: number;
-  /** Parts resampled (chain parts, and trunk parts along the spine) and carried rigidly. */
+  /** Parts resampled (chain parts, and trunk parts along the spine) and carried. */
   resampled: number;
   trunk: number;
   carried: number;
