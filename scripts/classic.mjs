@@ -4,15 +4,19 @@
 // the thigh and shank at the paper's leg densities (25 contours × 20 rays on the longest bone:
 // ≈ 500 on a thigh), the resampling detail loss there and at GCS's vertex budget (GCS keeps every
 // input vertex: no loss), and the output's border beside the input's (equal: no gap where tubes
-// meet carried skin). Measurement code: web/lib/measure.ts (classicFigures, classicAtBudget).
+// meet carried skin). Then, per mesh, how far the classic output lies from the skin it replaces
+// as dual-quaternion skinning poses it (6 frames per clip, bulge at its default 0.3): p99 and max
+// over all output vertices and frames, in % of the character's height, and the parts with the
+// largest figures. Measurement code: web/lib/measure.ts (classicFigures, classicAtBudget,
+// classicOffSurface).
 import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { loadGltfFile } from '../dist/cli/gltf-node.js';
-import { classicAtBudget, classicFigures, meshBorder } from '../dist/measure.js';
+import { characterHeight, loadGltfFile, sampleClip } from '../dist/cli/gltf-node.js';
+import { classicAtBudget, classicFigures, classicOffSurface, identitySkin, meshBorder } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';
 
@@ -30,13 +34,14 @@ if (args.help) {
 const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../shared/models');
 const gcs = await initGcsSkin();
 
-const characters = [{ name: 'default human', meshes: [createHuman().mesh] }];
+const human = createHuman();
+const characters = [{ name: 'default human', meshes: [human.mesh], clips: human.clips }];
 if (args.noModels) console.error('classic: shared models skipped (--no-models)');
 else if (!existsSync(MODELS_DIR)) console.error(`classic: shared models skipped: ${MODELS_DIR} is absent`);
 else
   for (const f of readdirSync(MODELS_DIR).filter((x) => /\.glb$/i.test(x)).sort()) {
     const model = await loadGltfFile(join(MODELS_DIR, f));
-    characters.push({ name: f, meshes: model.skinnedMeshes });
+    characters.push({ name: f, meshes: model.skinnedMeshes, clips: model.clips });
   }
 
 const rows = [['character / mesh', 'input vertices (GCS)', 'resampled + trunk / carried parts', 'thigh / shank points',
@@ -61,6 +66,33 @@ for (const ch of characters)
     rig.dispose();
   }
 console.log(args.markdown ? markdownTable(rows) : table(rows));
+
+// Off the skin: each classic output vertex's distance to the DQS-posed source surface.
+const FRAMES_PER_CLIP = 6;
+const off = [['character / mesh', 'frames', 'off-surface p99 %', 'max %', 'worst parts (reason: p99 / max %)', 'carried off-surface']];
+for (const ch of characters) {
+  const heights = characterHeight(ch.meshes);
+  ch.meshes.forEach((mesh, i) => {
+    const input = rigInputFromSkinnedMesh(mesh);
+    const rig = gcs.createRig(input);
+    const d = rig.buildClassic();
+    const sampled = ch.clips.flatMap((clip) => sampleClip(mesh, clip, FRAMES_PER_CLIP));
+    const frames = sampled.length ? sampled : [identitySkin(rig.jointCount)];
+    const r = classicOffSurface(input, d, frames, { height: heights.meshUnits[i] });
+    const name = (j) => mesh.skeleton.bones[j]?.name || `#${j}`;
+    const worst = [...r.parts].sort((a, b) => b.max - a.max).filter((p) => p.max > 0.005).slice(0, 3)
+      .map((p) => `${name(p.joint)} (${p.reason}: ${num(p.p99, 2)} / ${num(p.max, 2)})`).join(', ');
+    const offParts = d.parts.filter((p) => p.reason === 'off-surface').map((p) => name(p.joint));
+    off.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}`, String(frames.length), num(r.p99, 2), num(r.max, 2),
+      worst || '— (all carried: on the skin)', offParts.length ? offParts.join(', ') : '—']);
+    d.dispose();
+    rig.dispose();
+  });
+}
+console.log('');
+console.log(args.markdown ? markdownTable(off) : table(off));
 console.log('\nLoss: distance of each input vertex the tubes and bands replace to the resampled surface, % of the mesh\'s height ' +
   '(GCS: 0, it keeps every vertex). GCS budget: the square setting contours = rays whose output is closest to the input\'s vertex ' +
-  'count. Border: welded edges used by one triangle, input / output at 25 × 20 and at the budget.');
+  'count. Border: welded edges used by one triangle, input / output at 25 × 20 and at the budget. Off-surface: distance of each ' +
+  `output vertex to the source surface as DQS poses it, ${FRAMES_PER_CLIP} frames per clip, bulge 0.3, % of the character's height ` +
+  '(targets: p99 ≤ 1, max ≤ 2.5); carried skin moves by DQS of its own weights, so it lies on that surface.');

@@ -11,37 +11,15 @@
 //   node scripts/screenshot-demo.mjs --only demo-fox.png → only that one
 //   EXTRA='?criterion=y&colour=1' node scripts/screenshot-demo.mjs → also extra.png
 // A page that shows a message (e.g. the wasm failed to load) or throws is an error: no picture.
-import { existsSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { build, preview } from 'vite';
-import { chromium } from 'playwright-core';
+import { mkdirSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { openDemo, root } from './demo-browser.mjs';
 
-const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 const outIndex = process.argv.indexOf('--out');
 const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
 const onlyIndex = process.argv.indexOf('--only');
 const only = onlyIndex > 0 ? process.argv[onlyIndex + 1] : null;
-const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-if (!existsSync(chromiumPath)) {
-  console.error(`screenshot-demo: ${chromiumPath} not found (set CHROMIUM=/path/to/chromium)`);
-  process.exit(1);
-}
-
-const configFile = join(root, 'web/demo/vite.config.ts');
-const dist = mkdtempSync(join(tmpdir(), 'gcs-demo-'));
-await build({ configFile, logLevel: 'error', build: { outDir: dist, emptyOutDir: true } });
-const server = await preview({ configFile, logLevel: 'error', build: { outDir: dist }, preview: { host: '127.0.0.1', port: 0 } });
-const url = server.resolvedUrls.local[0];
-
-const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
-  executablePath: chromiumPath,
-  headless: true,
-  viewport: { width: 1440, height: 800 },
-  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const { url, context, close } = await openDemo('screenshot-demo', 1440, 800);
 mkdirSync(outDir, { recursive: true });
 try {
   const shots = [
@@ -83,7 +61,5 @@ try {
     await page.close();
   }
 } finally {
-  await context.close();
-  await server.close();
-  rmSync(dist, { recursive: true, force: true });
+  await close();
 }

@@ -117,11 +117,11 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/GCS/);
     const classicLabel = await page.locator('.label[data-view=classic]').innerText();
     expect(classicLabel).toMatch(/Classic cross-sections/);
-    // Either the classic model runs and names the parts it carries rigidly, or it says why it cannot.
+    // Either the classic model runs and names the parts it carries, or it says why it cannot.
     if (state.classicError) expect(classicLabel).toContain(state.classicError);
     else {
       expect(state.rigid.length).toBeGreaterThan(0);
-      expect(classicLabel).toMatch(/Carried rigidly/);
+      expect(classicLabel).toMatch(/Carried \(own triangles, skinned by DQS\)/);
     }
     await expect(page.locator('.lil-gui .controller .name', { hasText: /^sections$/ }).isVisible()).resolves.toBe(true);
   });

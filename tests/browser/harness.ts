@@ -178,6 +178,7 @@ export interface DemoHook {
   clip(): string;
   classicBuilds(): number;
   pause(t?: number): void;
+  hideCharacter(hidden: boolean): void;
   idle(): Promise<void>;
 }
 declare global {

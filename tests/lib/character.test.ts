@@ -4,7 +4,7 @@
 // placement, materials and flags, moving bounds, raycasts, rebuilds and dispose.
 import { beforeAll, describe, expect, test } from 'vitest';
 import * as THREE from 'three';
-import { GcsError, initGcsSkin, type DeformerKind, type GcsSkin } from '../../web/lib/index.js';
+import { GcsError, initGcsSkin, type ClassicDeformer, type DeformerKind, type GcsSkin } from '../../web/lib/index.js';
 import { GcsCharacter, SkinDeformer } from '../../web/lib/three.js';
 import { makeTube } from '../helpers/cylinder.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
@@ -374,11 +374,65 @@ describe('GcsCharacter', () => {
     character.rebuild('classic');
     character.update();
     expect(character.skins[0].deformer.morphTargetCount).toBe(0); // the classic model skips morphs
-    expect(character.skins[0].mesh.geometry.getAttribute('uv')).toBeUndefined(); // resampled: no source vertices
     expect(character.skins[0].mesh.material).toBe(c.body.mesh.material);
+    {
+      // The source's maps on the classic output: a carried vertex copies its own source vertex's uv
+      // and colour (this two-bone body is all carried; resampled vertices: the CesiumMan test).
+      const skin = character.skins[0];
+      const d = skin.deformer as ClassicDeformer;
+      const geometry = skin.mesh.geometry;
+      const uv = geometry.getAttribute('uv'), colour = geometry.getAttribute('color');
+      const srcUv = c.body.mesh.geometry.getAttribute('uv'), srcColour = c.body.mesh.geometry.getAttribute('color');
+      expect(uv.count).toBe(d.vertexCount);
+      expect(colour.count).toBe(d.vertexCount);
+      const sourceOf = d.sourceOfVertex;
+      for (let o = 0; o < d.vertexCount; o++) {
+        if (sourceOf[o] < 0) continue;
+        expect(uv.getX(o)).toBe(srcUv.getX(sourceOf[o]));
+        expect(uv.getY(o)).toBe(srcUv.getY(sourceOf[o]));
+        expect(colour.getW(o)).toBeCloseTo(srcColour.getW(sourceOf[o]), 6);
+      }
+    }
     character.rebuild('gcs');
     character.update();
     expect(worstError(character.skins[1]).worst).toBeLessThan(1e-5);
+    character.dispose();
+  });
+
+  test.skipIf(!sharedModels().files.some((f) => f.endsWith('CesiumMan.glb')))('classic on a textured character: every resampled vertex takes the uv of the closest source point (brute force)', async () => {
+    const model = await loadGlb(sharedModels().files.find((f) => f.endsWith('CesiumMan.glb'))!);
+    const character = new GcsCharacter(gcs, model.scene, { method: 'classic' });
+    const skin = character.skins[0];
+    const d = skin.deformer as ClassicDeformer;
+    const src = skin.source.geometry;
+    const uv = skin.mesh.geometry.getAttribute('uv'), srcUv = src.getAttribute('uv');
+    expect(uv.count).toBe(d.vertexCount);
+    expect(skin.mesh.material).toBe(skin.source.material);
+    d.deform(new Float32Array(16 * d.jointCount).map((_, i) => ((i % 16) % 5 === 0 ? 1 : 0)));
+    const sourceOf = d.sourceOfVertex, P = src.getAttribute('position'), index = src.index!;
+    const tri = new THREE.Triangle(), p = new THREE.Vector3(), q = new THREE.Vector3(), bary = new THREE.Vector3();
+    const a = new THREE.Vector3(), b = new THREE.Vector3(), c = new THREE.Vector3();
+    const resampled = [...sourceOf.keys()].filter((o) => sourceOf[o] < 0);
+    expect(resampled.length).toBeGreaterThan(1000);
+    let worst = 0;
+    for (const o of resampled.filter((_, i) => i % 97 === 0)) {
+      p.fromArray(d.positions, 3 * o);
+      let best = Infinity, bu = 0, bv = 0;
+      for (let t = 0; t < index.count; t += 3) {
+        const [ia, ib, ic] = [index.getX(t), index.getX(t + 1), index.getX(t + 2)];
+        tri.set(a.fromBufferAttribute(P, ia), b.fromBufferAttribute(P, ib), c.fromBufferAttribute(P, ic));
+        tri.closestPointToPoint(p, q);
+        const dist = q.distanceTo(p);
+        if (dist < best - 1e-9) {
+          best = dist;
+          tri.getBarycoord(q, bary);
+          bu = bary.x * srcUv.getX(ia) + bary.y * srcUv.getX(ib) + bary.z * srcUv.getX(ic);
+          bv = bary.x * srcUv.getY(ia) + bary.y * srcUv.getY(ib) + bary.z * srcUv.getY(ic);
+        }
+      }
+      worst = Math.max(worst, Math.hypot(uv.getX(o) - bu, uv.getY(o) - bv));
+    }
+    expect(worst).toBeLessThan(1e-4);
     character.dispose();
   });
 

@@ -1,15 +1,16 @@
 // The classic cross-section model on characters: the default human (17,023 vertices; which parts
 // resample and why, points per limb, detail loss, a closed output whose seams never open, rebuild
 // time printed) and the shared real models (../shared/models) and a ×100 rig: every one builds,
-// keeps a closed input closed (no gap, no overlap where tubes meet carried parts), and plays its
-// clips with finite output and unit normals.
+// keeps a closed input closed (no gap, no overlap where tubes meet carried parts), plays its clips
+// with finite output and unit normals, and stays on the skin it replaces (off-surface figures).
 import { beforeAll, describe, expect, test } from 'vitest';
 import { basename } from 'node:path';
 import { initGcsSkin, type GcsSkin, type ClassicDeformer } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
 import { sampleClip } from '../../web/lib/cli/gltf-node.js';
-import { coincidentPairs, meshBorder, seamGap } from '../../web/lib/measure.js';
+import { classicOffSurface, coincidentPairs, meshBorder, seamGap } from '../../web/lib/measure.js';
+import { characterHeight } from '../../web/lib/cli/gltf-node.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
 import type * as THREE from 'three';
 
@@ -80,8 +81,11 @@ describe('classic cross-sections on the default human', () => {
     console.log(`classic human: ${d.parts.map((p) => `${names[p.joint]} ${p.reason}`).join(', ')}`);
     console.log(`classic human: thigh ${thigh.vertexCount} points, shank ${shank.vertexCount} points, output ${d.vertexCount} vertices / ${d.indices.length / 3} triangles, ${d.sectionCount} contours`);
     console.log(`classic human: detail loss RMS ${loss.rms.toFixed(3)} % / max ${loss.max.toFixed(3)} % of height`);
-    for (const limb of ['LeftUpLeg', 'LeftLeg', 'RightUpLeg', 'RightLeg', 'LeftArm', 'LeftForeArm', 'RightArm', 'RightForeArm', 'Spine'])
+    for (const limb of ['LeftUpLeg', 'LeftLeg', 'RightUpLeg', 'RightLeg', 'LeftForeArm', 'RightArm', 'RightForeArm', 'Spine'])
       expect(byName(limb).reason).toBe('resampled');
+    // The left upper arm's tube stands off its skin at the build's probe poses (p99 just over
+    // 1 %; the right one passes): carried, by measurement.
+    expect(['resampled', 'off-surface']).toContain(byName('LeftArm').reason);
     // The trunk: the pelvis is resampled along the spine above the crotch, one tube with the spine.
     expect(byName('Hips').reason).toBe('trunk');
     expect(resampled).toContain('Hips');
@@ -155,6 +159,42 @@ describe('classic cross-sections on the default human', () => {
     d.dispose();
     rig.dispose();
   });
+});
+
+/**
+ * The issue-21 targets: each classic output vertex within 1 % (p99) and 2.5 % (max) of the
+ * character's height of the source surface as DQS poses it, 6 frames per clip, bulge at its default.
+ */
+function expectOnTheSkin(label: string, meshes: THREE.SkinnedMesh[], clips: THREE.AnimationClip[]): void {
+  const heights = characterHeight(meshes);
+  meshes.forEach((mesh, i) => {
+    const input = rigInputFromSkinnedMesh(mesh);
+    const rig = gcs.createRig(input);
+    const d = rig.buildClassic();
+    const frames = clips.flatMap((clip) => sampleClip(mesh, clip, 6));
+    expect(frames.length).toBeGreaterThan(0);
+    const r = classicOffSurface(input, d, frames, { height: heights.meshUnits[i] });
+    const worst = [...r.parts].sort((a, b) => b.max - a.max)[0];
+    console.log(`classic off-surface ${label} / ${mesh.name}: p99 ${r.p99.toFixed(3)} %, max ${r.max.toFixed(3)} % (worst part: joint ${worst?.joint} ${worst?.reason}, ${worst?.max.toFixed(3)} %) over ${frames.length} frames`);
+    expect(r.p99).toBeLessThanOrEqual(1);
+    expect(r.max).toBeLessThanOrEqual(2.5);
+    // Carried skin moves by DQS of its own weights: it lies on the surface (float rounding only).
+    for (const p of r.parts) if (!p.resampled) expect(p.max).toBeLessThan(1e-3);
+    d.dispose();
+    rig.dispose();
+  });
+}
+
+describe('classic cross-sections stay on the skin (distance to the DQS-posed source surface)', () => {
+  test('default human', () => {
+    const human = createHuman();
+    expectOnTheSkin('default human', [human.mesh], human.clips);
+  });
+  for (const file of sharedModels().files)
+    test(basename(file), async () => {
+      const model = await loadGlb(file);
+      expectOnTheSkin(basename(file), model.skinnedMeshes, model.clips);
+    });
 });
 
 const { files, reason } = sharedModels();

@@ -761,7 +761,7 @@ void checkStructure(Built& b, const RigInput& in) {
       CHECK(e[0] > prevJoint && e[0] < int32_t(in.jointCount), "classic part %u joint %d", p, e[0]);
       prevJoint = e[0];
       CHECK(e[1] == 0 || e[1] == 1, "classic part %u resampled flag %d", p, e[1]);
-      CHECK(e[4] >= GCS_CLASSIC_RESAMPLED && e[4] <= GCS_CLASSIC_TRUNK &&
+      CHECK(e[4] >= GCS_CLASSIC_RESAMPLED && e[4] <= GCS_CLASSIC_OFF_SURFACE &&
                 (e[1] == 1) == (e[4] == GCS_CLASSIC_RESAMPLED || e[4] == GCS_CLASSIC_TRUNK),
             "classic part %u reason %d with resampled flag %d", p, e[4], e[1]);
       CHECK(e[2] >= 0 && e[3] >= 0 && int64_t(e[2]) + e[3] <= int64_t(N), "classic part %u range [%d, +%d) outside %u",

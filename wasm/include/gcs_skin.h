@@ -345,16 +345,22 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  *   - it has exactly one child part (a chain part: upper arm, forearm, thigh, shank, spine, neck),
  *     or it is a branching part of the trunk (GCS_CLASSIC_TRUNK, below); leaves (head, hands
  *     without fingers, feet, finger tips) and other branching parts (a hand with fingers) are
- *     carried rigidly;
+ *     carried (kept with their own triangles, moved by DQS of their own weights);
  *   - its bone (joint → child part's joint) is at least 3 % of the model height (a zero-length or
- *     tiny bone is carried rigidly);
+ *     tiny bone is carried);
  *   - at most 30 % of its rays miss its own triangles (triangles with a vertex in the part), after
  *     hits farther than 3 × the contour's median are dropped as misses (e.g. a clavicle, or a part
- *     of an open mesh with a side missing, is carried rigidly);
+ *     of an open mesh with a side missing, is carried);
  *   - its bone turns by at most 45° from its resampled parent's bone (a foot on a shank is carried);
  *   - where it meets the carried mesh, the boundary is one closed ring around its bone at an end
  *     that is not shared with a resampled neighbour (else GCS_CLASSIC_SEAM: a tube cannot join it
- *     without a gap or an overlap).
+ *     without a gap or an overlap);
+ *   - measured once built (else GCS_CLASSIC_OFF_SURFACE, and the model is built again without it):
+ *     at six probe poses (every joint turned 35° about world X, Z and Y, each way, around its bind
+ *     centre on top of its parent), each ring vertex (shared joint rings excepted) lies within 1 %
+ *     of the height at p99 and 2.5 % at most of the point of the input surface its ray hit, posed
+ *     by dual-quaternion skinning; and an end cap's centre lies within 1 % of the height of the
+ *     input surface at the bind pose.
  * The trunk (Shen et al. resample it like the limbs): a branching part is resampled along the one
  * child bone that continues the trunk — after a resampled parent, the child within 45° of the
  * parent's bone (a chest's neck); with none, the child whose siblings' joints all lie before a
@@ -369,7 +375,7 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  * neighbours. Two resampled neighbours share their joint contour (stored once, cast against both
  * parts' triangles, its plane normal the bisector of the two bones): tLo = 0 / tHi = 1 there.
  * Where a tube meets the carried mesh (every triangle with a carried vertex, kept as it is, its
- * vertices moving rigidly with their own part's S_j), the tube ends just inside the innermost point of
+ * vertices moving by dual-quaternion skinning of their own weights), the tube ends just inside the innermost point of
  * the boundary loop of those triangles (tLo = the loop's largest t + 0.02 at a proximal end, tHi
  * its smallest t − 0.02 at a distal one), and a band of triangles zips the tube's end ring to that loop: every
  * edge of the ring and of the loop is used once, so a closed input gives a closed output (no gap,
@@ -388,21 +394,23 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  * contours 25, rays 20 — 500 points on the longest bone (the thigh on a human), the shank
  * 25 · shank/thigh length · 20 (500 on the default human, whose thigh and shank are equally long).
  *
- * Deforming: contour centres lie on the posed segment between the part's posed joints; the end
- * normal is the posed bone direction, or at a shared joint the bisector N_o = normalize(N_u + N_l);
- * inner contours interpolate the end normals linearly (normalised); a contour's frame is the
- * bone's full rotation (its twist included) then the minimal rotation from the bone direction to
- * the contour normal (a shared contour takes the mean of both sides' frames: half the twist).
+ * Bind contour planes: the end normal is the bone direction, or at a shared joint the bisector
+ * N_o = normalize(N_u + N_l); inner contours interpolate the end normals linearly (normalised).
+ * Deforming: each contour moves as one rigid ring by the dual-quaternion blend (scale parts blended
+ * linearly, applied first) of its influences: the mean weights (4 largest) of the input vertices of
+ * its part and its neighbours within half a contour spacing of its plane and within 1.25 × its
+ * largest radius of its centre; a shared joint contour takes the mean of its two neighbouring
+ * contours' influences (half of each bone where each side is bound to its own: the bisector).
  * Tube normals are area-weighted from the deformed tube and band triangles, unit length whatever
- * the scale of the skin matrices; carried normals go through their S_j's normal matrix. Uniform
- * scale in S_j (mesh-node transforms) scales the radii. Nothing is allocated per frame.
+ * the scale of the skin matrices; carried vertices and normals are skinned by dual quaternions.
+ * Nothing is allocated per frame.
  * The muscle bulge applies to chain parts, not to a trunk part's tube.
  *
  * Its output mesh is its own: the rings of the tubes first (chains laid out root → leaf, so a
  * part's rings are contiguous and a shared ring ends one part and starts the next), then the
  * carried input vertices grouped by part. Triangles: tube quads (2 each, outward), bands, then the
  * carried input triangles. gcs_deformer_source_vertex is null.
- * If no part can be resampled the model still builds (every part rigid; the report says so).
+ * If no part can be resampled the model still builds (every part carried; the report says so).
  * Errors: GCS_ERR_INVALID_ARGUMENT (null rig), GCS_ERR_OUT_OF_RANGE (a count or the bulge outside
  * its limits; the message states them), GCS_ERR_OUT_OF_MEMORY.
  * Statistics: GCS_STAT_SECTIONS = contours (shared ones once), GCS_STAT_PARTS = parts.
@@ -420,7 +428,10 @@ typedef enum GcsClassicReason {
   GCS_CLASSIC_RAYS_MISS = 4,  /* carried: over 30 % of its rays miss its own triangles (a clavicle) */
   GCS_CLASSIC_BENT = 5,       /* carried: bone turned > 45° from its resampled parent's (a foot) */
   GCS_CLASSIC_SEAM = 6,       /* carried: its boundary with the carried mesh is not one ring at an end */
-  GCS_CLASSIC_TRUNK = 7       /* resampled along the trunk; its branch region (crotch, shoulders) carried */
+  GCS_CLASSIC_TRUNK = 7,      /* resampled along the trunk; its branch region (crotch, shoulders) carried */
+  GCS_CLASSIC_OFF_SURFACE = 8 /* carried: its tube would stand off the skin it replaces (measured at build
+                                 time at probe poses, every joint bent 35°: p99 > 1 % or max > 2.5 % of
+                                 the height), or its end cap would cut across a non-flat end */
 } GcsClassicReason;
 /*
  * Per-part report of a classic model: partCount × 5 int32 per part, parts in joint order:

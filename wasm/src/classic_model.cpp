@@ -4,7 +4,9 @@
 #include <cstring>
 #include <functional>
 #include <new>
+#include <glm/gtc/matrix_transform.hpp>
 #include "error.h"
+#include "reference_deformers.h"
 #include "transform.h"
 
 namespace gcs {
@@ -12,7 +14,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr float kMinBoneFraction = 0.03f;  // a cylinder-like part is at least 3 % of the height long
-constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried rigidly
+constexpr float kMaxMissShare = 0.3f;      // more missing rays than this: carried
 constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
 constexpr float kMaxExtension = 0.5f;      // a tube end passes a rigid neighbour's joint by ≤ ½ bone
 constexpr float kMaxBendCos = 0.70710678f; // a chain continues only while bones turn by ≤ 45°
@@ -46,13 +48,6 @@ glm::vec3 orthonormal(const glm::vec3& u, const glm::vec3& n) {
   return len > 1e-6f ? p / len : anyPerpendicular(n);
 }
 
-// |v| without overflow or underflow: divided by its largest component first (the posed bone and
-// the columns of a ×1e20 skin matrix square past FLT_MAX; those of a ×1e-20 one underflow).
-float lengthOf(const glm::vec3& v) {
-  float big = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
-  return big > 0.0f ? big * glm::length(v / big) : 0.0f;
-}
-
 glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
   glm::vec3 s = a + b;
   float len = glm::length(s);
@@ -62,11 +57,13 @@ glm::vec3 bisector(const glm::vec3& a, const glm::vec3& b) {
 // Casts the `k` star rays of one contour plane (origin O, normal n, frame u, w) against a triangle
 // list: each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle
 // lies in the segment's angular span are tested. radius[r] = the outermost hit distance so far
-// (−1 before any hit; the caller resets it, so several triangle lists can be cast in turn).
+// (−1 before any hit; the caller resets it, so several triangle lists can be cast in turn), and
+// hitTriangle[r] the index of the triangle it hit.
 // corners: 3 positions per triangle, contiguous (gathered once per part: the rig's vertices are
 // scattered, and every contour of the part reads every triangle).
 void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
-                 const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius) {
+                 const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius,
+                 uint32_t* hitTriangle) {
   const float step = 2.0f * kPi / float(k);
   const float planeD = glm::dot(O, n);
   for (uint32_t i = 0; i < triCount; ++i) {
@@ -102,7 +99,7 @@ void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O
       if (std::fabs(denom) < 1e-12f) continue;
       float lambda = (P.x * E.y - P.y * E.x) / denom;
       float mu = (P.x * d.y - P.y * d.x) / denom;
-      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f && lambda > radius[r]) radius[r] = lambda;
+      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f && lambda > radius[r]) radius[r] = lambda, hitTriangle[r] = i;
     }
   }
 }
@@ -177,7 +174,12 @@ float ClassicModel::stat(GcsStat which) const {
   return std::nanf("");
 }
 
-ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, float bulge) {
+namespace {
+
+// One build of the model. Parts marked in `forceCarry` (if given) are carried (GCS_CLASSIC_OFF_SURFACE).
+// ringTriangle: per ring vertex, the rig triangle its ray hit (T: a filled miss).
+ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, float bulge,
+                        const std::vector<uint8_t>* forceCarry, std::vector<uint32_t>& ringTriangle) {
   if (contourSetting < GCS_CLASSIC_MIN_CONTOURS || contourSetting > GCS_CLASSIC_MAX_CONTOURS) {
     fail(GCS_ERR_OUT_OF_RANGE, "the contour count must be between %d and %d; got %u",
          GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MAX_CONTOURS, contourSetting);
@@ -478,8 +480,12 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // part is carried (GCS_CLASSIC_SEAM); that end's contours start just inside the loop.
     // Parts are only ever removed, so this ends.
     std::vector<std::vector<float>> hits(J);
+    std::vector<std::vector<uint32_t>> hitTriangles(J);
     std::vector<uint8_t> dirty(J, 0);
     for (uint32_t j = 0; j < J; ++j) dirty[j] = m.parts[j].candidate && !m.parts[j].split;  // trunk parts: once cut
+    if (forceCarry)
+      for (uint32_t j = 0; j < J; ++j)
+        if ((*forceCarry)[j] && m.parts[j].resampled) m.parts[j].resampled = false, m.parts[j].reason = GCS_CLASSIC_OFF_SURFACE;
     std::vector<float> scratch;
     scratch.reserve(k);
     auto endNormals = [&](const ClassicPart& P, glm::vec3& nProx, glm::vec3& nDist) {
@@ -497,16 +503,23 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     // triangles; a trunk part's also its continuing child's and its carried branch children's (its
     // tube runs through their skin). Counts the hits left after outliers, and those between joints.
     std::vector<float> probe;
+    std::vector<uint32_t> probeTriangles;
     std::vector<glm::vec3> corners;
+    std::vector<uint32_t> cornerTriangle;  // the rig triangle of each gathered one
     auto castPart = [&](uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist,
-                        std::vector<float>& out, uint32_t& hitCount, uint32_t& inRangeHits, uint32_t& inRangeRays) {
+                        std::vector<float>& out, std::vector<uint32_t>& outTriangles, uint32_t& hitCount,
+                        uint32_t& inRangeHits, uint32_t& inRangeRays) {
       const ClassicPart& P = m.parts[j];
       out.assign(size_t(count) * k, -1.0f);  // no hit yet
+      outTriangles.assign(size_t(count) * k, 0);
       corners.clear();
+      cornerTriangle.clear();
       for (uint32_t x = 0; x < J; ++x) {
         if (x != j && !(P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) continue;
-        for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i)
+        for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i) {
           for (int e = 0; e < 3; ++e) corners.push_back(rig.positions[rig.indices[size_t(triList[i]) * 3 + e]]);
+          cornerTriangle.push_back(triList[i]);
+        }
       }
       const uint32_t triCount = uint32_t(corners.size() / 3);
       for (uint32_t i = 0; i < count; ++i) {
@@ -514,7 +527,9 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
         glm::vec3 O, n, u;
         contourFrame(P, t, nProx, nDist, O, n, u);
         float* rad = &out[size_t(i) * k];
-        castContour(corners.data(), triCount, O, n, u, glm::cross(n, u), k, m.cosTable.data(), m.sinTable.data(), rad);
+        uint32_t* tri = &outTriangles[size_t(i) * k];
+        castContour(corners.data(), triCount, O, n, u, glm::cross(n, u), k, m.cosTable.data(), m.sinTable.data(), rad, tri);
+        for (uint32_t r = 0; r < k; ++r) tri[r] = rad[r] > 0.0f ? cornerTriangle[tri[r]] : 0;
         uint32_t h = rejectOutliers(rad, k, scratch);
         hitCount += h;
         if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
@@ -652,7 +667,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           // The decision looks at up to kProbeContours contours (the full set is cast once, at the end).
           const uint32_t mm = std::min(P.contourCount, kProbeContours);
           uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
-          castPart(j, mm, nProx, nDist, probe, hitCount, inRangeHits, inRangeRays);
+          castPart(j, mm, nProx, nDist, probe, probeTriangles, hitCount, inRangeHits, inRangeRays);
           // The miss rule looks at the contours between the joints (past a joint, skin of the
           // carried neighbour is expected to be missing); all contours if none lies between them.
           float miss = inRangeRays ? 1.0f - float(inRangeHits) / float(inRangeRays)
@@ -817,9 +832,10 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
       glm::vec3 nProx, nDist;
       endNormals(P, nProx, nDist);
       uint32_t hitCount = 0, inRangeHits = 0, inRangeRays = 0;
-      castPart(j, P.contourCount, nProx, nDist, hits[j], hitCount, inRangeHits, inRangeRays);
+      castPart(j, P.contourCount, nProx, nDist, hits[j], hitTriangles[j], hitCount, inRangeHits, inRangeRays);
     }
 
+    ringTriangle.clear();
     // 5. Contours. Chains of resampled parts are laid out root → leaf, so that a part's rings are
     // contiguous and a shared contour is the last ring of one part and the first of the next.
     uint32_t vertex = 0;
@@ -839,7 +855,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
             ClassicContour& c = m.contours[id];
             float* rad = &m.radii[c.radii];
             const float* mine = &hits[j][0];
-            for (uint32_t r = 0; r < k; ++r) rad[r] = std::max(rad[r], mine[r]);  // union of both sides
+            for (uint32_t r = 0; r < k; ++r)  // union of both sides
+              if (mine[r] > rad[r]) rad[r] = mine[r], ringTriangle[c.first + r] = hitTriangles[j][r];
             c.part = j;
             c.proximal = P.parent;
             c.t = 0.0f;
@@ -853,6 +870,8 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
           vertex += k;
           c.radii = uint32_t(m.radii.size());
           m.radii.insert(m.radii.end(), hits[j].begin() + size_t(i) * k, hits[j].begin() + size_t(i + 1) * k);
+          for (uint32_t r = 0; r < k; ++r)
+            ringTriangle.push_back(hits[j][size_t(i) * k + r] > 0.0f ? hitTriangles[j][size_t(i) * k + r] : T);
           P.contours.push_back(uint32_t(m.contours.size()));
           m.contours.push_back(c);
         }
@@ -888,6 +907,91 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     for (size_t c = 0; c < m.contours.size(); ++c)
       if (empty[c]) std::fill(m.radii.begin() + m.contours[c].radii, m.radii.begin() + m.contours[c].radii + k, 0.0f);
 
+    // The skin each contour resamples, as influences: the mean weights of the input vertices of its
+    // part and its neighbours that lie around its plane (within half the contour spacing, widened
+    // where the mesh is coarse) and no farther from its centre than its rays reached. A ring then
+    // moves as that skin does, not as its bone's straight line (a twisting spine, a thigh whose
+    // skin the hip's weights bend).
+    {
+      std::vector<float> sum(J, 0.0f);
+      std::vector<uint32_t> touched;
+      std::vector<uint32_t> vertexFirst(J + 1, 0), vertexList(rig.vertexCount);  // rig vertices by part
+      for (uint32_t v = 0; v < rig.vertexCount; ++v) ++vertexFirst[partOf[v] + 1];
+      for (uint32_t j = 0; j < J; ++j) vertexFirst[j + 1] += vertexFirst[j];
+      {
+        std::vector<uint32_t> cursor(vertexFirst.begin(), vertexFirst.end() - 1);
+        for (uint32_t v = 0; v < rig.vertexCount; ++v) vertexList[cursor[partOf[v]]++] = v;
+      }
+      for (ClassicContour& c : m.contours) {
+        const ClassicPart& P = m.parts[c.part];
+        auto near = [&](uint32_t x) {
+          if (x == uint32_t(c.part) || int32_t(x) == P.child || int32_t(x) == P.parent || (c.proximal >= 0 && int32_t(x) == c.proximal))
+            return true;
+          return P.split && m.parts[x].isPart && member(c.part, x);
+        };
+        float reach = 0.0f;
+        for (uint32_t r = 0; r < k; ++r) reach = std::max(reach, m.radii[c.radii + r]);
+        reach = 1.25f * reach + 1e-6f * m.height;
+        float window = 0.5f * P.length * std::max(P.tHi - P.tLo, 1e-3f) / float(std::max<uint32_t>(P.contourCount - 1, 1));
+        float total = 0.0f;
+        for (int attempt = 0; attempt < 4 && total <= 0.0f; ++attempt, window *= 2.0f) {
+          for (uint32_t x0 = 0; x0 < J; ++x0) {
+            if (!m.parts[x0].isPart || !near(x0)) continue;
+            for (uint32_t i = vertexFirst[x0]; i < vertexFirst[x0 + 1]; ++i) {
+            const uint32_t v = vertexList[i];
+            glm::vec3 x = rig.positions[v] - c.centre;
+            float h = glm::dot(x, c.normal);
+            if (std::fabs(h) > window || glm::length(x - h * c.normal) > reach) continue;
+            float f = 1.0f - std::fabs(h) / window + 1e-3f;
+            for (int i = 0; i < 4; ++i) {
+              const uint32_t jj = rig.joints[v][i];
+              if (!(rig.weights[v][i] > 0.0f)) continue;
+              if (sum[jj] == 0.0f) touched.push_back(jj);
+              sum[jj] += f * rig.weights[v][i];
+            }
+            total += f;
+            }
+          }
+        }
+        // The four largest, renormalised; none found: the part's own joint.
+        c.joints = glm::uvec4(c.part, 0, 0, 0);
+        c.weights = glm::vec4(1.0f, 0.0f, 0.0f, 0.0f);
+        std::sort(touched.begin(), touched.end(), [&](uint32_t a, uint32_t b) { return sum[a] > sum[b] || (sum[a] == sum[b] && a < b); });
+        float kept = 0.0f;
+        for (size_t i = 0; i < touched.size() && i < 4; ++i) kept += sum[touched[i]];
+        if (kept > 0.0f)
+          for (size_t i = 0; i < 4; ++i) {
+            c.joints[int(i)] = i < touched.size() ? touched[i] : 0u;
+            c.weights[int(i)] = i < touched.size() ? sum[touched[i]] / kept : 0.0f;
+          }
+        for (uint32_t jj : touched) sum[jj] = 0.0f;
+        touched.clear();
+      }
+      // A joint contour shared by two tubes takes the mean of its two neighbours' influences (the
+      // paper's bisector where the skin is bound hard to each bone; the skin's own blend elsewhere).
+      for (const ClassicPart& P : m.parts) {
+        if (!P.resampled || !P.proxShared || P.contours.size() < 2) continue;
+        const ClassicPart& Q = m.parts[P.parent];
+        if (Q.contours.size() < 2) continue;
+        ClassicContour& c = m.contours[P.contours.front()];
+        for (const ClassicContour* x : {&m.contours[Q.contours[Q.contours.size() - 2]], &m.contours[P.contours[1]]})
+          for (int i = 0; i < 4; ++i)
+            if (x->weights[i] > 0.0f) {
+              if (sum[x->joints[i]] == 0.0f) touched.push_back(x->joints[i]);
+              sum[x->joints[i]] += 0.5f * x->weights[i];
+            }
+        std::sort(touched.begin(), touched.end(), [&](uint32_t a, uint32_t b) { return sum[a] > sum[b] || (sum[a] == sum[b] && a < b); });
+        float kept = 0.0f;
+        for (size_t i = 0; i < touched.size() && i < 4; ++i) kept += sum[touched[i]];
+        for (size_t i = 0; i < 4; ++i) {
+          c.joints[int(i)] = i < touched.size() ? touched[i] : 0u;
+          c.weights[int(i)] = i < touched.size() ? sum[touched[i]] / kept : 0.0f;
+        }
+        for (uint32_t jj : touched) sum[jj] = 0.0f;
+        touched.clear();
+      }
+    }
+
     // Caps: a tube end that meets neither a resampled neighbour nor the carried mesh is closed by a
     // flat fan when the part's input skin has no border (a robot's finger plate); an open input
     // (a sleeve) stays open.
@@ -914,7 +1018,7 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     }
 
     // 6. Carried triangles (those with a carried vertex): their vertices are copied and move
-    // rigidly with their own part's S_j; the copies are grouped by part (one transform run each).
+    // by dual-quaternion skinning of their own weights; the copies are grouped by part (ranges per part).
     std::vector<int64_t> outputOf(rig.vertexCount, -1);
     for (uint32_t t = 0; t < T; ++t)
       if (triCarried[t])
@@ -939,8 +1043,13 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
     const uint32_t carried = vertex - m.carriedFirst;
     m.restPositions.assign(size_t(carried) * 3 + 1, 0.0f);
     m.restNormals.assign(size_t(carried) * 3 + 1, 0.0f);
+    m.carriedJoints.resize(carried);
+    m.carriedWeights.resize(carried);
+    m.poses.resize(J);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) {
       if (outputOf[v] < 0) continue;
+      m.carriedJoints[size_t(outputOf[v] - m.carriedFirst)] = rig.joints[v];
+      m.carriedWeights[size_t(outputOf[v] - m.carriedFirst)] = rig.weights[v];
       size_t o = size_t(outputOf[v] - m.carriedFirst) * 3;
       for (int c = 0; c < 3; ++c) {
         m.restPositions[o + c] = rig.positions[v][c];
@@ -1078,93 +1187,198 @@ ClassicModel* buildClassic(const Rig& rig, uint32_t contourSetting, uint32_t k, 
   return model;
 }
 
+// The skin matrices of a probe pose: every joint turned by `angle` about `axis` around its own bind
+// centre, on top of its parent's motion (the whole body curled, bent sideways or twisted).
+void probeSkin(const Rig& rig, const glm::vec3& axis, float angle, std::vector<glm::mat4>& skin) {
+  const uint32_t J = rig.jointCount;
+  skin.assign(J, glm::mat4(1.0f));
+  std::vector<uint8_t> done(J, 0);
+  const glm::mat4 turn = glm::mat4_cast(glm::angleAxis(angle, axis));
+  std::function<void(uint32_t)> pose = [&](uint32_t j) {
+    if (done[j]) return;
+    int32_t p = rig.parents[j];
+    glm::mat4 parent(1.0f);
+    if (p >= 0 && uint32_t(p) < J) pose(uint32_t(p)), parent = skin[size_t(p)];
+    const glm::vec3 c = rig.jointCentres[j];
+    skin[j] = parent * glm::translate(glm::mat4(1.0f), c) * turn * glm::translate(glm::mat4(1.0f), -c);
+    done[j] = 1;
+  };
+  for (uint32_t j = 0; j < J; ++j) pose(j);
+}
+
+// Which resampled parts stand off the skin they replace (design.md §7's classic off-surface
+// target: p99 ≤ 1 %, max ≤ 2.5 % of the height). Per ring vertex: its distance from the point of
+// the input surface its ray hit, both posed — the ring by the model (bulge included), the surface
+// by dual-quaternion skinning — at probe poses (every joint bent 35° forward,
+// backward, to either side, and twisted either way). An end cap must lie on the input's own end (a flat plate): its
+// centre within 1 % of the height of the input surface at the bind pose.
+std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std::vector<uint32_t>& ringTriangle) {
+  const uint32_t J = rig.jointCount, T = uint32_t(rig.indices.size() / 3);
+  std::vector<uint8_t> failed(J, 0);
+  const float maxOff = 0.025f * m.height, p99Off = 0.01f * m.height;
+  // Barycentric coordinates of each ring vertex's hit in the bind pose.
+  std::vector<glm::vec3> bary(m.tubeVertexCount, glm::vec3(0.0f));
+  for (uint32_t o = 0; o < m.tubeVertexCount; ++o) {
+    if (ringTriangle[o] >= T) continue;
+    const uint32_t* t = &rig.indices[size_t(ringTriangle[o]) * 3];
+    glm::vec3 a = rig.positions[t[0]], e0 = rig.positions[t[1]] - a, e1 = rig.positions[t[2]] - a, x = m.bindPositions[o] - a;
+    float d00 = glm::dot(e0, e0), d01 = glm::dot(e0, e1), d11 = glm::dot(e1, e1), d20 = glm::dot(x, e0), d21 = glm::dot(x, e1);
+    float den = d00 * d11 - d01 * d01;
+    if (!(std::fabs(den) > 0.0f)) { bary[o] = glm::vec3(1.0f, 0.0f, 0.0f); continue; }
+    float v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+    bary[o] = glm::vec3(1.0f - v - w, v, w);
+  }
+  // Caps: the centre of a flat fan must lie on the input's end.
+  for (const ClassicCap& cap : m.caps) {
+    const glm::vec3 x = m.bindPositions[cap.first + m.rays];
+    float best = INFINITY;
+    for (uint32_t t = 0; t < T && best > 0.01f * m.height; ++t)
+      best = std::min(best, pointTriangleDistance(x, rig.positions[rig.indices[3 * t]], rig.positions[rig.indices[3 * t + 1]],
+                                                  rig.positions[rig.indices[3 * t + 2]]));
+    if (best > 0.01f * m.height) failed[m.contours[cap.contour].part] = 1;
+  }
+  constexpr int kProbes = 6;  // in pairs: a left limb and its mirror image get the same verdict
+  const glm::vec3 axes[kProbes] = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
+  const float angles[kProbes] = {0.61f, -0.61f, 0.61f, -0.61f, 0.61f, -0.61f};
+  // Only the corners of hit triangles are skinned (a compact copy of them).
+  std::vector<int32_t> slot(rig.vertexCount, -1);
+  std::vector<uint32_t> cornerOf;
+  for (uint32_t o = 0; o < m.tubeVertexCount; ++o)
+    if (ringTriangle[o] < T)
+      for (int e = 0; e < 3; ++e) {
+        uint32_t v = rig.indices[size_t(ringTriangle[o]) * 3 + e];
+        if (slot[v] < 0) slot[v] = int32_t(cornerOf.size()), cornerOf.push_back(v);
+      }
+  const uint32_t C = uint32_t(cornerOf.size());
+  std::vector<float> rest(size_t(C) * 3), restNormals(size_t(C) * 3), posed(size_t(C) * 3), posedNormals(size_t(C) * 3);
+  std::vector<glm::uvec4> joints(C);
+  std::vector<glm::vec4> weights(C);
+  for (uint32_t i = 0; i < C; ++i) {
+    const uint32_t v = cornerOf[i];
+    for (int c = 0; c < 3; ++c) rest[3 * i + c] = rig.positions[v][c], restNormals[3 * i + c] = rig.normals[v][c];
+    joints[i] = rig.joints[v], weights[i] = rig.weights[v];
+  }
+  std::vector<glm::mat4> skin;
+  std::vector<JointPose> poses(J);
+  std::vector<std::vector<float>> distances(J);
+  for (int probe = 0; probe < kProbes; ++probe) {  // (at the bind pose each ring vertex is its hit)
+    probeSkin(rig, axes[probe], angles[probe], skin);
+    m.deform(skin.data());
+    const ScaleState scale = decomposeAll(skin.data(), J, poses.data());
+    dqsVertices(poses.data(), scale, joints.data(), weights.data(), rest.data(), restNormals.data(), posed.data(),
+                posedNormals.data(), C);
+    for (uint32_t j = 0; j < J; ++j) {
+      const ClassicPart& P = m.parts[j];
+      if (!P.resampled) continue;
+      for (uint32_t o = P.first; o < P.first + P.count; ++o) {
+        // (a joint ring shared by two tubes is the method's own joint, the bisector where the skin
+        // is bound hard to each bone: that skin folds or opens there under DQS, the ring does not)
+        if (ringTriangle[o] >= T || m.contours[size_t(m.contourOfVertex[o])].proximal >= 0) continue;
+        const uint32_t* t = &rig.indices[size_t(ringTriangle[o]) * 3];
+        glm::vec3 hit(0.0f);
+        for (int e = 0; e < 3; ++e) {
+          const size_t q = 3 * size_t(slot[t[e]]);
+          hit += bary[o][e] * glm::vec3(posed[q], posed[q + 1], posed[q + 2]);
+        }
+        distances[j].push_back(glm::length(glm::vec3(m.positions[3 * o], m.positions[3 * o + 1], m.positions[3 * o + 2]) - hit));
+      }
+    }
+  }
+  for (uint32_t j = 0; j < J; ++j) {
+    std::vector<float>& d = distances[j];
+    if (d.empty()) continue;
+    size_t rank = std::min(d.size() - 1, size_t(std::ceil(0.99 * double(d.size()))) - 1);
+    std::nth_element(d.begin(), d.begin() + ptrdiff_t(rank), d.end());
+    float p99 = d[rank], worst = *std::max_element(d.begin(), d.end());
+    if (worst > maxOff || p99 > p99Off) failed[j] = 1;
+  }
+  std::vector<glm::mat4> identity(J, glm::mat4(1.0f));
+  m.deform(identity.data());
+  return failed;
+}
+
+}  // namespace
+
+ClassicModel* buildClassic(const Rig& rig, uint32_t contours, uint32_t rays, float bulge) {
+  std::vector<uint32_t> ringTriangle;
+  ClassicModel* m = buildOnce(rig, contours, rays, bulge, nullptr, ringTriangle);
+  std::vector<uint8_t> carried(rig.jointCount, 0);
+  // Parts are only ever added to the carried set, so this ends.
+  for (uint32_t round = 0; m && round < rig.jointCount; ++round) {
+    std::vector<uint8_t> failed;
+    try {
+      failed = offSurfaceParts(rig, *m, ringTriangle);
+    } catch (const std::bad_alloc&) {
+      delete m;
+      fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while testing the classic model against the skin");
+      return nullptr;
+    }
+    bool any = false;
+    for (uint32_t j = 0; j < rig.jointCount; ++j)
+      if (failed[j] && !carried[j]) carried[j] = 1, any = true;
+    if (!any) break;
+    delete m;
+    m = buildOnce(rig, contours, rays, bulge, &carried, ringTriangle);
+  }
+  return m;
+}
+
 void ClassicModel::deform(const glm::mat4* skin) {
   const uint32_t J = jointCount;
   const uint32_t k = rays;
-  // Per part: posed joints, bone direction, twisted reference direction, bend of the distal joint.
+  const ScaleState scale = decomposeAll(skin, J, poses.data());
+  // Flex of each tube's distal joint (for the bulge): the angle between the child's direction as
+  // its own joint turns it and as the part's joint alone would.
   for (uint32_t j = 0; j < J; ++j) {
     ClassicPart& P = parts[j];
     if (!P.resampled) continue;
-    glm::quat q = rotationOf(skin[j]);
-    P.rotation = glm::mat3_cast(q);
-    P.posedA = glm::vec3(skin[j] * glm::vec4(jointCentres[j], 1.0f));
-    P.posedB = glm::vec3(skin[P.child] * glm::vec4(jointCentres[P.child], 1.0f));
-    glm::vec3 d = P.posedB - P.posedA;
-    float len = lengthOf(d);  // glm::length overflowed for a 1e20-long posed bone: a zero direction, NaN contours
-    P.posedDir = len > 1e-6f * height ? d / len : glm::normalize(P.rotation * P.axis);
-    P.posedU = P.rotation * P.u;
-    P.scale = (lengthOf(glm::vec3(skin[j][0])) + lengthOf(glm::vec3(skin[j][1])) +  // ×1e20 columns: no overflow
-               lengthOf(glm::vec3(skin[j][2]))) / 3.0f;
     const glm::vec3 cd = parts[P.child].direction;
-    glm::vec3 straight = P.rotation * cd;
-    glm::vec3 actual = glm::mat3_cast(rotationOf(skin[P.child])) * cd;
+    glm::vec3 straight = poses[j].rotation * cd, actual = poses[P.child].rotation * cd;
     float c = glm::clamp(glm::dot(straight, actual) / (glm::length(straight) * glm::length(actual)), -1.0f, 1.0f);
     P.flex = std::acos(c) / kPi;
   }
-  for (uint32_t j = 0; j < J; ++j) {
-    ClassicPart& P = parts[j];
-    if (!P.resampled) continue;
-    P.nProx = P.proxShared ? bisector(parts[P.parent].posedDir, P.posedDir) : P.posedDir;
-    P.nDist = P.distShared ? bisector(P.posedDir, parts[P.child].posedDir) : P.posedDir;
-  }
-  // Contours.
-  for (const ClassicContour& c : contours) {
+  // Contours: each ring moves as one rigid (scaled) section, by the dual-quaternion blend of the
+  // weights of the skin it resamples, and swells by the muscle bulge in its own plane.
+  const JointPose* blend[4];
+  float w4[4];
+  glm::mat4 pm, nm;
+  for (ClassicContour& c : contours) {
     const ClassicPart& P = parts[c.part];
-    glm::vec3 centre, n, u;
-    float scale = 1.0f;
-    if (c.proximal >= 0) {  // shared joint contour: bisector normal, half of the twist of each side
-      const ClassicPart& Q = parts[c.proximal];
-      centre = P.posedA;
-      n = P.nProx;
-      glm::vec3 uq = minRotate(Q.posedDir, n, Q.posedU), up = minRotate(P.posedDir, n, P.posedU);
-      glm::vec3 s = uq + up;
-      u = orthonormal(glm::dot(s, s) > 1e-8f ? s : uq, n);
-      scale = 0.5f * (P.scale + Q.scale);
-    } else {
-      centre = P.posedA + c.t * (P.posedB - P.posedA);
-      float tc = glm::clamp(c.t, 0.0f, 1.0f);  // past a joint: the end normal, no bulge
-      n = (1.0f - tc) * P.nProx + tc * P.nDist;
-      float len = glm::length(n);
-      n = len > 1e-6f ? n / len : P.posedDir;
-      u = orthonormal(minRotate(P.posedDir, n, P.posedU), n);
-      // Muscle bulge on the limbs; a trunk part's tube does not swell when its neck turns.
-      scale = P.scale * (1.0f + (P.split ? 0.0f : bulge) * P.flex * std::sin(kPi * tc));
-    }
-    glm::vec3 w = glm::cross(n, u);
+    uint32_t count = 0;
+    for (int i = 0; i < 4; ++i)
+      if (c.weights[i] > 0.0f) blend[count] = &poses[c.joints[i]], w4[count++] = c.weights[i];
+    bool renormalise = false;
+    blendPoses(blend, w4, count, scale, pm, nm, renormalise);
+    float tc = glm::clamp(c.t, 0.0f, 1.0f);  // past a joint (or at a shared one): no bulge
+    float swell = c.proximal >= 0 ? 1.0f : 1.0f + (P.split ? 0.0f : bulge) * P.flex * std::sin(kPi * tc);
+    const glm::vec3 w = glm::cross(c.normal, c.u);
     const float* rad = &radii[c.radii];
     float* out = &positions[size_t(c.first) * 3];
     for (uint32_t r = 0; r < k; ++r) {
-      float s = scale * rad[r];
-      glm::vec3 p = centre + s * (cosTable[r] * u + sinTable[r] * w);
+      glm::vec3 p(pm * glm::vec4(c.centre + swell * rad[r] * (cosTable[r] * c.u + sinTable[r] * w), 1.0f));
       out[3 * r] = p.x, out[3 * r + 1] = p.y, out[3 * r + 2] = p.z;
     }
+    c.posedCentre = glm::vec3(pm * glm::vec4(c.centre, 1.0f));
+    c.posedNormal = unitOr(glm::vec3(nm * glm::vec4(c.normal, 0.0f)), glm::vec3(0.0f, 1.0f, 0.0f));
   }
   // Caps: rim copies and the centre, normal along the contour normal (outward).
   for (const ClassicCap& cap : caps) {
     const ClassicContour& c = contours[cap.contour];
-    const ClassicPart& P = parts[c.part];
-    float tc = glm::clamp(c.t, 0.0f, 1.0f);
-    glm::vec3 n = cap.sign * unitOr((1.0f - tc) * P.nProx + tc * P.nDist, P.posedDir);
-    glm::vec3 centre = P.posedA + c.t * (P.posedB - P.posedA);
+    glm::vec3 n = cap.sign * c.posedNormal;
     std::memcpy(&positions[size_t(cap.first) * 3], &positions[size_t(c.first) * 3], size_t(k) * 3 * sizeof(float));
     for (uint32_t r = 0; r <= k; ++r) {
       float* nn = &normals[size_t(cap.first + r) * 3];
       nn[0] = n.x, nn[1] = n.y, nn[2] = n.z;
     }
     float* pc = &positions[size_t(cap.first + k) * 3];
-    pc[0] = centre.x, pc[1] = centre.y, pc[2] = centre.z;
+    pc[0] = c.posedCentre.x, pc[1] = c.posedCentre.y, pc[2] = c.posedCentre.z;
   }
-  // Carried vertices: rigid, by their own part's S_j (runs in increasing output order: the SIMD
-  // store of a run's last vertex spills one float into the next run, which is written after).
-  for (uint32_t j = 0; j < J; ++j) {
-    const ClassicPart& P = parts[j];
-    if (!P.runCount) continue;
-    size_t o = size_t(P.runFirst - carriedFirst) * 3;
-    JointPose pose;
-    decompose(skin[j], pose);  // its normal matrix keeps normals unit whatever the scale
-    transformRun(skin[j], pose.normal, pose.renormalise, &restPositions[o], &restNormals[o], &positions[size_t(P.runFirst) * 3],
-                 &normals[size_t(P.runFirst) * 3], P.runCount);
-  }
+  // Carried vertices: dual-quaternion skinning of their own weights, so that carried skin bends
+  // with the skin around it (one rigid bone per part left it standing off the skin at every joint
+  // it spans) and the bands zipped to it follow.
+  if (carriedFirst < vertexCount)
+    dqsVertices(poses.data(), scale, carriedJoints.data(), carriedWeights.data(), restPositions.data(), restNormals.data(),
+                &positions[size_t(carriedFirst) * 3], &normals[size_t(carriedFirst) * 3], vertexCount - carriedFirst);
   // Tube normals: area-weighted from the deformed tube and band triangles (the bands after the
   // carried vertices have moved). Edges are divided by the tube's extent first: the cross products
   // of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.

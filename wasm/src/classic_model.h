@@ -1,12 +1,14 @@
 // The classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; the paper's section 2;
 // design.md §4): cylinder-like parts are resampled into contours × star rays and deformed contour by
-// contour; the other parts are carried rigidly with their original triangles.
+// contour; the other parts keep their original triangles, carried by dual-quaternion skinning of
+// their own weights (so they follow the skin the tubes meet instead of standing off it).
 #pragma once
 #include <cstdint>
 #include <vector>
 #include <glm/glm.hpp>
 #include "deformer.h"
 #include "rig.h"
+#include "transform.h"
 
 namespace gcs {
 
@@ -18,6 +20,10 @@ struct ClassicContour {
   int32_t proximal = -1;     // shared contour: the proximal part (whose distal end it is); else -1
   float t = 0.0f;            // 0 at the part's proximal joint … 1 at its distal joint
   glm::vec3 centre{0.0f}, normal{0.0f, 1.0f, 0.0f}, u{1.0f, 0.0f, 0.0f};  // bind pose
+  // The skin it resamples: the mean influences of the input vertices around its plane (≤ 4 joints).
+  glm::uvec4 joints{0u};
+  glm::vec4 weights{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 posedCentre{0.0f}, posedNormal{0.0f, 1.0f, 0.0f};  // per-frame scratch (caps)
 };
 
 // A tube end that meets the carried mesh: a band of triangles zipping the tube's end ring to the
@@ -62,13 +68,8 @@ struct ClassicPart {
   bool proxShared = false, distShared = false;
   std::vector<uint32_t> contours;    // contour ids, proximal → distal
   uint32_t first = 0, count = 0;     // reported output range
-  uint32_t runFirst = 0, runCount = 0;  // carried rig vertices moved rigidly by S_joint
-  // Per-frame scratch (no allocation per frame).
-  glm::mat3 rotation{1.0f};
-  glm::vec3 posedA{0.0f}, posedB{0.0f}, posedDir{0.0f, 1.0f, 0.0f}, posedU{1.0f, 0.0f, 0.0f};
-  glm::vec3 nProx{0.0f, 1.0f, 0.0f}, nDist{0.0f, 1.0f, 0.0f};
-  float flex = 0.0f;
-  float scale = 1.0f;        // uniform scale of S_joint (mesh-node transforms), applied to radii
+  uint32_t runFirst = 0, runCount = 0;  // the part's carried rig vertices (output range)
+  float flex = 0.0f;          // per-frame scratch: bend of its distal joint, 0 … 1 (π)
 };
 
 
@@ -94,6 +95,9 @@ class ClassicModel final : public Deformer {
   uint32_t tubeVertexCount = 0;            // ring vertices come first in the output (caps follow)
   uint32_t carriedFirst = 0;               // carried rig vertices: [carriedFirst, vertexCount)
   std::vector<float> restPositions, restNormals;  // carried vertices, interleaved (+1 spare)
+  std::vector<glm::uvec4> carriedJoints;   // carried vertices' own influences (skinned by DQS)
+  std::vector<glm::vec4> carriedWeights;
+  std::vector<JointPose> poses;            // per-frame scratch: every S_j decomposed
   std::vector<int32_t> report;             // partCount × 5 (see gcs_classic_parts)
   std::vector<int32_t> contourOfVertex;    // per output vertex: its contour, −1 for carried vertices
   std::vector<int32_t> sourceOfVertex;     // per output vertex: the rig vertex it copies, −1 if resampled

@@ -67,8 +67,14 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
     }
     return;
   }
-  // Dual quaternions (Kavan et al. 2007) for the rigid part of each S_j; its scale blended
-  // linearly and applied first (so rigs with scaled matrices work).
+  dqsVertices(poses.data(), scale, joints.data(), weights.data(), restPositions.data(), restNormals.data(),
+              positions.data(), normals.data(), n);
+}
+
+// Dual quaternions (Kavan et al. 2007) for the rigid part of each S_j; its scale blended linearly
+// and applied first (so rigs with scaled matrices work).
+void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uvec4* joints, const glm::vec4* weights,
+                 const float* restPositions, const float* restNormals, float* positions, float* normals, uint32_t n) {
   const JointPose* blend[4];
   float w4[4];
   glm::mat4 pm, nm;

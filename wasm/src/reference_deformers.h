@@ -28,4 +28,10 @@ class SkinningDeformer final : public Deformer {
 
 SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind);
 
+// Dual-quaternion skinning of n vertices (rest positions and normals xyz-interleaved, with their
+// joints and weights) under one frame's decomposed joint poses (decomposeAll): what the DQS deformer
+// does to every vertex and the classic model to its carried skin.
+void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uvec4* joints, const glm::vec4* weights,
+                 const float* restPositions, const float* restNormals, float* positions, float* normals, uint32_t n);
+
 }  // namespace gcs

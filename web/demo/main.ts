@@ -5,7 +5,7 @@
 //
 // Every view draws the character with its own materials: the deformed meshes share the source's
 // material (textures, colours), the classic model's resampled skin gets its texture coordinates
-// from the source surface (transfer.ts), and the parts that are not skinned (e.g. the robot's
+// from the source surface (the library does it: gcs-skin/three), and the parts that are not skinned (e.g. the robot's
 // rigid limbs, children of its bones) are drawn in every view, moved by the bones as three.js
 // moves them. One scene, one mixer: camera layers pick what each view draws.
 //
@@ -22,7 +22,7 @@ import {
 } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import { createHumanData, humanFromData, type HumanData } from '../lib/human/index.js';
-import { attributesNeeded, transferAttributes } from './transfer.js';
+import { attributesNeeded } from './material-attributes.js';
 import { crowdRequested, startCrowd } from './crowd.js';
 import { measureSettingCost, type SettingCost } from './cost.js';
 import { addRendererSwitch, createRenderer, rendererKind, rendererLabel, type DemoRenderer } from './renderer.js';
@@ -303,7 +303,7 @@ async function init(): Promise<void> {
   stats.dom.style.cssText = 'position:relative;margin:0 8px 10px;opacity:0.85;cursor:pointer';
   (gui as unknown as { $children: HTMLElement }).$children.appendChild(stats.dom);
   initDrop();
-  window.addEventListener('resize', onWindowResize);
+  window.addEventListener('resize', () => { onWindowResize(); if (current) frameCharacter(current); });
   window.addEventListener('keydown', (e) => {
     if ((e.target as HTMLElement).tagName === 'INPUT') return;
     if (e.code === 'Space') { e.preventDefault(); pausedController.setValue(!params.paused); }
@@ -368,7 +368,7 @@ function initGui(): void {
   v.add(params, 'wireframe').onChange(applyMaterials);
   v.add(params, 'colourBySection').name('colour by section').onChange(applyMaterials);
   v.add(params, 'showSkeleton').name('show skeleton').onChange(() => { if (current) current.skeletonHelper.visible = params.showSkeleton; });
-  v.add(params, 'lbsView').name('three.js LBS view').onChange(onWindowResize);
+  v.add(params, 'lbsView').name('three.js LBS view').onChange(() => { onWindowResize(); if (current) frameCharacter(current); });
   addRendererSwitch(v, rendererKind());
   (gui as unknown as { $children: HTMLElement }).$children.appendChild($('hint'));
 }
@@ -563,22 +563,6 @@ function applyColourMode(skin: SkinDeformer): void {
   }
 }
 
-/**
- * The classic model resamples the skin: its resampled vertices get the source's texture
- * coordinates (and vertex colours) from the closest point of the source surface in the bind pose,
- * its carried vertices their own source vertex's (transfer.ts).
- */
-function carrySurfaceAttributes(skin: SkinDeformer): void {
-  const names = attributesNeeded(skin.source.material);
-  if (!names.length) return;
-  const d = skin.deformer;
-  const identity = new Float32Array(16 * d.jointCount);
-  for (let j = 0; j < d.jointCount; j++) identity.set([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1], 16 * j);
-  d.deform(identity); // the bind pose; the next update() poses it again
-  const sourceOf = skin.currentMethod === 'classic' ? (d as ClassicDeformer).sourceOfVertex : undefined;
-  transferAttributes(skin.source.geometry, skin.mesh.geometry, d.positions.slice(), names, sourceOf);
-}
-
 function applyMaterials(): void {
   for (const m of [gcsMaterial, classicMaterial]) {
     m.wireframe = params.wireframe;
@@ -704,20 +688,47 @@ const VIEW_DIRECTION = new THREE.Vector3(1.9, 0.55, 4.9).normalize();
 const KEY_OFFSET = new THREE.Vector3(2.2, 3.3, 3.0);
 
 /**
- * Points the shared camera at the character and backs off until its bounding box fits the first
- * view (about two thirds of its height, below the labels and above the readouts); the key light's
- * shadow camera is fitted to it too. Sizes differ a lot (glTF files are scaled to 1.8 units, but a
- * fox is long and low, a human tall and thin).
+ * Rows of the window free for the character: below every view's label (title, settings, the
+ * classic model's carried parts) and above every readout, measured on the page (px from the top).
+ */
+function freeBand(): { top: number; bottom: number } {
+  const h = window.innerHeight;
+  let top = 0, bottom = h;
+  for (const el of labelsEl.querySelectorAll('.label')) top = Math.max(top, el.getBoundingClientRect().bottom);
+  for (const el of readoutsEl.querySelectorAll('.readout')) bottom = Math.min(bottom, el.getBoundingClientRect().top);
+  // Keep at least half the height for the character, whatever the text (a tiny window).
+  if (bottom - top < 0.5 * h) {
+    const lack = 0.5 * h - (bottom - top);
+    top = Math.max(0, top - lack / 2);
+    bottom = Math.min(h, top + 0.5 * h);
+  }
+  return { top: top + 6, bottom: bottom - 6 };
+}
+
+/** Pixels the picture is moved down in every view so that the character's centre sits in the free band. */
+let viewShift = 0;
+
+/**
+ * Points the shared camera at the character and backs off until its bounding box fits every view
+ * between the labels and the readouts (freeBand), the picture moved so that it is centred in that
+ * band; the key light's shadow camera is fitted to it too. Sizes differ a lot (glTF files are
+ * scaled to 1.8 units, but a fox is long and low, a human tall and thin). Called again when the
+ * views change (LBS view, window size, the labels' text).
  */
 function frameCharacter(ch: Character): void {
+  updateLabels();
+  updateReadouts();
   ch.holder.updateMatrixWorld(true);
   const box = new THREE.Box3().setFromObject(ch.holder);
   if (box.isEmpty() || !Number.isFinite(box.min.x + box.max.x)) return;
   const centre = box.getCenter(new THREE.Vector3());
-  const rect = viewRects()[0];
+  const h = window.innerHeight;
+  const band = freeBand();
+  const width = Math.min(...viewRects().map((r) => r.width));
   const tanHalf = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
-  const tanV = tanHalf * 0.66;
-  const tanH = tanHalf * (rect.width / window.innerHeight) * 0.82;
+  const tanV = tanHalf * 0.94 * (band.bottom - band.top) / h;
+  const tanH = tanHalf * (width / h) * 0.88;
+  viewShift = (band.top + band.bottom) / 2 - h / 2;
   const z = VIEW_DIRECTION;
   const x = new THREE.Vector3(0, 1, 0).cross(z).normalize();
   const y = new THREE.Vector3().crossVectors(z, x);
@@ -842,12 +853,10 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     playClip();
     applyMaterials();
     if (old) disposeCharacter(old);
-    frameCharacter(next);
     clearMessage();
     syncModelMenu();
     updateCredit();
-    updateLabels();
-    updateReadouts();
+    frameCharacter(next); // after the labels' text is known: it frames below them
   } catch (e) {
     for (const s of built) s.dispose();
     disposeObject(holder);
@@ -863,7 +872,6 @@ function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; er
       const skin = new Skin(gcs, src, { method: 'classic', classic: classicOptions(), material: src.material });
       skins.push(skin);
       skin.mesh.layers.set(LAYER.classic);
-      carrySurfaceAttributes(skin);
       classicColours(skin);
     }
     return { skins, error: null };
@@ -891,7 +899,7 @@ function classicSummary(ch: Character): void {
 /** Why the classic model carries a part, as the page groups it. */
 const CARRIED_WHY: Record<Exclude<ClassicReason, 'resampled' | 'trunk'>, string> = {
   leaf: 'ends', branching: 'branch regions', 'too-short': 'bones too short', 'rays-miss': 'not tube-like (rays miss)',
-  bent: 'bent off their limb', seam: 'no clean ring to the carried skin',
+  bent: 'bent off their limb', seam: 'no clean ring to the carried skin', 'off-surface': 'a tube would leave the skin',
 };
 
 /** "fingers: 30 joints · ends: Head, LeftHand, … · branch regions: Chest": carried parts grouped by reason. */
@@ -958,7 +966,6 @@ function rebuildClassic(ch: Character): void {
     try {
       for (const s of ch.classic) {
         s.rebuild('classic', { classic: classicOptions() });
-        carrySurfaceAttributes(s);
         classicColours(s);
       }
       ch.classicError = null;
@@ -1032,7 +1039,7 @@ function updateLabels(): void {
       if (ch?.classicError) body += `<div class="err">Not available: ${esc(ch.classicError)}</div>`;
       else {
         if (ch?.trunkParts.length) body += `<div class="sub">trunk resampled along the spine through ${esc(summariseBones(ch.trunkParts))} (crotch and shoulders carried)</div>`;
-        if (ch?.rigidParts.length) body += `<div class="warn">Carried rigidly — ${esc(groupCarried(ch.rigidParts))}</div>`;
+        if (ch?.rigidParts.length) body += `<div class="warn">Carried (own triangles, skinned by DQS) — ${esc(groupCarried(ch.rigidParts))}</div>`;
       }
       if (params.colourBySection && !ch?.classicError)
         body += '<div class="sub">colour = contour (bands alternate along each limb) · grey = carried skin</div>';
@@ -1215,7 +1222,8 @@ function render(): void {
     renderer.setViewport(r.x, 0, r.width, h);
     renderer.setScissor(r.x, 0, r.width, h);
     camera.aspect = r.width / h;
-    camera.updateProjectionMatrix();
+    // The picture moved down by viewShift px (its centre in the band between labels and readouts).
+    camera.setViewOffset(r.width, h, 0, -viewShift, r.width, h);
     camera.layers.set(0);
     camera.layers.enable(LAYER[r.kind]);
     renderer.render(scene, camera);
@@ -1283,6 +1291,10 @@ Object.assign(window, {
       camera.position.set(...eye);
       controls.target.set(...target);
       controls.update();
+    },
+    /** Hides (or shows again) the character in every view: screenshots of the empty scene, to find its pixels. */
+    hideCharacter: (hidden: boolean) => {
+      for (const o of [gcsGroup, classicGroup, current?.holder]) if (o) o.visible = !hidden;
     },
     /** Settles when every queued load has finished. */
     idle: () => queue.then(() => undefined),

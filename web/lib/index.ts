@@ -105,16 +105,19 @@ export interface SectionInfo {
 }
 
 /**
- * Why a part of the classic model is resampled or carried rigidly (gcs_skin.h, GcsClassicReason):
+ * Why a part of the classic model is resampled or carried (gcs_skin.h, GcsClassicReason; carried
+ * skin keeps its triangles and moves by dual-quaternion skinning of its own weights):
  * `resampled` a chain part, joint to joint; `trunk` a branching trunk part (pelvis, chest)
  * resampled along the spine with its branch region (crotch, shoulders) carried; carried ones:
  * `leaf` (head, hands, feet, finger tips), `branching` (a hand with fingers), `too-short`
  * (fingers, zero-length bones), `rays-miss` (a clavicle), `bent` (a foot on a shank), `seam`
- * (its boundary with the carried mesh is not one ring around an end).
+ * (its boundary with the carried mesh is not one ring around an end), `off-surface` (measured at
+ * build time: at a probe pose (every joint bent 35°) its tube stands off the skin it replaces by more than
+ * 1 % of the height at p99 or 2.5 % at most, or its end cap would cut flat across a rounded end).
  */
-export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk';
+export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk' | 'off-surface';
 /** The reasons in the order of their codes (GcsClassicReason). */
-export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk'];
+export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk', 'off-surface'];
 
 export interface ClassicPart {
   joint: number;
@@ -601,7 +604,7 @@ export const MAX_INSTANCES = 65536;
 
 /** The classic cross-section deformer (resampled contours). */
 export class ClassicDeformer extends Deformer {
-  /** Which parts were resampled and which are carried rigidly. */
+  /** Which parts were resampled and which are carried (by DQS of their own weights). */
   get parts(): ClassicPart[] {
     const h = this.live();
     const n = this.gcs.core.gcs_classic_part_count(h);

@@ -11,8 +11,9 @@
  *
  * Plain TypeScript over typed arrays; no three.js.
  */
-import type { Deformer, Rig, RigInput } from './index.js';
+import type { ClassicDeformer, ClassicReason, Deformer, Rig, RigInput } from './index.js';
 import { GcsError } from './errors.js';
+import { TriangleGrid } from './surface-distance.js';
 
 // ------------------------------------------------------------------------------------ statistics
 
@@ -672,7 +673,7 @@ export interface ClassicFigures {
   contours: number;
   rays: number;
   outputVertices: number;
-  /** Parts resampled (chain parts, and trunk parts along the spine) and carried rigidly. */
+  /** Parts resampled (chain parts, and trunk parts along the spine) and carried. */
   resampled: number;
   trunk: number;
   carried: number;
@@ -722,4 +723,82 @@ export function classicAtBudget(rig: Rig): ClassicFigures {
   }
   const best = Math.abs(size(lo) - rig.vertexCount) <= Math.abs(size(hi) - rig.vertexCount) ? lo : hi;
   return classicFigures(rig, best, best);
+}
+
+/** How far one part of a classic model's output lies from the DQS-posed source surface (% of height). */
+export interface OffSurfacePart {
+  joint: number;
+  resampled: boolean;
+  reason: ClassicReason;
+  /** Output vertices of the part (a shared joint ring counts for both parts). */
+  vertices: number;
+  p99: number;
+  max: number;
+  /** Where the max is: the frame (index into the frames given) and the output vertex. */
+  worstFrame: number;
+  worstVertex: number;
+}
+
+/** The classic model against the skin it replaces (design.md §7, "classic off-surface"). */
+export interface ClassicOffSurface {
+  frames: number;
+  /** Over every output vertex and frame, % of height. */
+  p99: number;
+  max: number;
+  /** Per part, in the order of `deformer.parts`. */
+  parts: OffSurfacePart[];
+}
+
+/**
+ * Each classic output vertex's distance to the source surface as dual-quaternion skinning poses it
+ * (point to nearest triangle of the DQS-posed input mesh), over `frames` (skin matrices J × 16
+ * each), in % of `options.height` (default: the rig's bind-pose height): what resampling loses
+ * (detail, bulge at the deformer's current setting) and anything that stands off the skin (flaps,
+ * cuts, carried parts that do not follow it). Leaves the deformer in the last frame's pose.
+ */
+export function classicOffSurface(input: RigInput, deformer: ClassicDeformer, frames: readonly Float32Array[],
+                                  options: FidelityOptions = {}): ClassicOffSurface {
+  const height = options.height ?? boundsHeight(input.positions);
+  const nOut = deformer.vertexCount;
+  const parts = deformer.parts;
+  // Each output vertex's part: ring and carried vertices by the parts' ranges, a cap's vertices
+  // by the part of their contour's ring.
+  const partOf = new Int32Array(nOut).fill(-1);
+  parts.forEach((p, i) => partOf.fill(i, p.firstVertex, p.firstVertex + p.vertexCount));
+  const contourOf = deformer.contourOfVertex;
+  const partOfContour = new Map<number, number>();
+  for (let o = 0; o < nOut; o++) if (contourOf[o] >= 0 && partOf[o] >= 0) partOfContour.set(contourOf[o], partOf[o]);
+  for (let o = 0; o < nOut; o++) if (partOf[o] < 0 && contourOf[o] >= 0) partOf[o] = partOfContour.get(contourOf[o]) ?? -1;
+  const posed = new Float64Array(input.positions.length);
+  const grid = new TriangleGrid();
+  const distances = new Float32Array(nOut * frames.length);
+  frames.forEach((skin, f) => {
+    referenceDqs(input, skin, posed);
+    deformer.deform(skin);
+    const out = deformer.positions;
+    grid.build(posed, input.indices, out);
+    for (let o = 0; o < nOut; o++) {
+      const d = grid.distance(out[3 * o], out[3 * o + 1], out[3 * o + 2]);
+      distances[f * nOut + o] = Number.isNaN(d) ? Infinity : d;
+    }
+  });
+  const scale = 100 / height;
+  const byPart = parts.map(() => [] as number[]);
+  const worst = parts.map(() => ({ d: -1, frame: 0, vertex: 0 }));
+  for (let f = 0; f < frames.length; f++)
+    for (let o = 0; o < nOut; o++) {
+      const i = partOf[o];
+      if (i < 0) continue;
+      const d = distances[f * nOut + o];
+      byPart[i].push(d);
+      if (d > worst[i].d) worst[i] = { d, frame: f, vertex: o };
+    }
+  return {
+    frames: frames.length, p99: percentile(distances, 99) * scale, max: maxOf(distances) * scale,
+    parts: parts.map((p, i) => ({
+      joint: p.joint, resampled: p.resampled, reason: p.reason, vertices: p.vertexCount,
+      p99: byPart[i].length ? percentile(byPart[i], 99) * scale : 0, max: byPart[i].length ? maxOf(byPart[i]) * scale : 0,
+      worstFrame: worst[i].frame, worstVertex: worst[i].vertex,
+    })),
+  };
 }

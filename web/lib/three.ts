@@ -18,13 +18,13 @@
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
-import { CLASSIC_LIMITS, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
+import { CLASSIC_LIMITS, ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
+import { transferSurfaceAttributes } from './surface-attributes.js';
 import { bindGeometry, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
 import type { GpuPath } from './gpu/layout.js';
 import { GpuSections } from './gpu/sections.js';
 import { glslKit } from './gpu/webgl-materials.js';
-
 
 /** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
 export type Backend = 'cpu' | 'gpu';
@@ -308,7 +308,9 @@ interface GpuBuild {
  * - Frustum culling stays on: the bounds follow the animation (see update()).
  * - Morph targets (`geometry.morphAttributes.position`) are applied before skinning, as three.js
  *   does, with the source's `morphTargetInfluences` each frame. The classic model resamples the
- *   mesh, so it has no morphs, no carried attributes and no tangents.
+ *   mesh, so it has no morphs and no tangents; its resampled vertices take the source's attributes
+ *   (uv, colours…) at the closest point of the source surface in the bind pose, its carried ones
+ *   their own source vertex's, so it wears the source's material (textures smear across UV seams).
  *
  * `dispose()` frees the wasm memory and the output geometry, removes `mesh` from its parent and,
  * in place, gives the source back its layers. Materials are never disposed (they are shared).
@@ -641,6 +643,10 @@ export class SkinDeformer {
           geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
         }
       }
+    } else if (deformer instanceof ClassicDeformer) {
+      // Resampled: the source's uv, colours and custom attributes from the closest source point.
+      deformer.deform(this.identity());
+      transferSurfaceAttributes(src, geometry, deformer.positions, deformer.sourceOfVertex, SKINNING_ATTRIBUTES);
     }
     // Groups (multi-material) and the draw range count index entries: they carry over when the
     // deformer kept the triangles in order (GCS, LBS, DQS remap vertex ids only; checked here).

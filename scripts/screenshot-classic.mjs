@@ -1,0 +1,47 @@
+#!/usr/bin/env node
+// Close-ups of the classic model against GCS for docs/classic.md: the demo with Cesium Man paused
+// in a stride, coloured by section / contour (carried skin pale grey), the shared camera moved close
+// to the hips and legs, then to the shoulder and arm (GCS left, classic right).
+//
+//   node scripts/screenshot-classic.mjs                     → docs/classic-hips.png, docs/classic-arm.png
+//   node scripts/screenshot-classic.mjs --out DIR --suffix -before
+//                                                           → DIR/classic-hips-before.png, …
+// (The "before" pictures in docs/ were taken with the wasm of commit a0a4518 copied over
+// web/lib/gcs-skin.wasm: the classic model before issue 21.)
+import { mkdirSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { openDemo, root } from './demo-browser.mjs';
+
+const arg = (name, fallback) => {
+  const i = process.argv.indexOf(name);
+  return i > 0 ? process.argv[i + 1] : fallback;
+};
+const outDir = resolve(arg('--out', join(root, 'docs')));
+const suffix = arg('--suffix', '');
+const { url, context, close } = await openDemo('screenshot-classic', 1200, 700);
+mkdirSync(outDir, { recursive: true });
+try {
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(`${url}?model=cesiumman&colour=1&paused=1`);
+  await page.waitForFunction(() => window.__demo !== undefined);
+  await page.evaluate(() => window.__demo.ready);
+  await page.evaluate(() => window.__demo.idle());
+  const message = await page.evaluate(() => window.__demo.error());
+  if (message) throw new Error(`the page says: ${message}`);
+  await page.evaluate(() => window.__demo.pause(0.9));
+  const shots = [
+    { file: `classic-hips${suffix}.png`, eye: [0.75, 1.05, 1.25], target: [0, 0.78, 0] },
+    { file: `classic-arm${suffix}.png`, eye: [1.5, 1.2, 0.9], target: [0.15, 0.95, 0] },
+  ];
+  for (const shot of shots) {
+    await page.evaluate(([eye, target]) => window.__demo.lookAt(eye, target), [shot.eye, shot.target]);
+    await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
+    if (errors.length) throw new Error(`page errors: ${errors.join('; ')}`);
+    await page.screenshot({ path: join(outDir, shot.file) });
+    console.log('wrote', join(outDir, shot.file));
+  }
+} finally {
+  await close();
+}
