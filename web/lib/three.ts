@@ -20,7 +20,7 @@ import * as THREE from 'three';
 import { GcsError } from './errors.js';
 import { CLASSIC_LIMITS, ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig, type RigInput } from './index.js';
 import { transferSurfaceAttributes } from './surface-attributes.js';
-import { bindGeometry, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
+import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from './gpu/bind.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
 import type { GpuPath } from './gpu/layout.js';
 import { GpuSections } from './gpu/sections.js';
@@ -642,11 +642,11 @@ export class SkinDeformer {
           for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = this.tangentW[sourceVertex[o]];
           geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
         }
+      } else if (deformer instanceof ClassicDeformer) {
+        // Resampled: the source's uv, colours and custom attributes from the closest source point.
+        deformer.deform(identitySkin(this.rig.jointCount));
+        transferSurfaceAttributes(src, geometry, deformer.positions, deformer.sourceOfVertex, SKINNING_ATTRIBUTES);
       }
-    } else if (deformer instanceof ClassicDeformer) {
-      // Resampled: the source's uv, colours and custom attributes from the closest source point.
-      deformer.deform(this.identity());
-      transferSurfaceAttributes(src, geometry, deformer.positions, deformer.sourceOfVertex, SKINNING_ATTRIBUTES);
     }
     // Groups (multi-material) and the draw range count index entries: they carry over when the
     // deformer kept the triangles in order (GCS, LBS, DQS remap vertex ids only; checked here).
