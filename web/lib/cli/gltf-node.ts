@@ -7,8 +7,8 @@
 // back into plain float attributes (more than 4 influences per vertex: the 4 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
 // gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
-import { readFile } from 'node:fs/promises';
-import { dirname, resolve } from 'node:path';
+import { open, readFile, realpath, stat } from 'node:fs/promises';
+import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { GltfError, n, parseGltfContainer, validateGltfJson, type BufferData, type GltfJson } from './gltf-validate.js';
@@ -39,11 +39,83 @@ function reason(e: unknown): string {
   return String(err?.message ?? e).replace(/\s*\n\s*/g, ' ');
 }
 
-/** The bytes of a data: URI (base64 or percent-encoded), or null if it is not one. */
-function dataUri(uri: string): Uint8Array | null {
-  const m = /^data:[^,]*?(;base64)?,(.*)$/s.exec(uri);
-  if (!m) return null;
-  return m[1] ? new Uint8Array(Buffer.from(m[2], 'base64')) : new TextEncoder().encode(decodeURIComponent(m[2]));
+/**
+ * The bytes of a data: URI (base64 or percent-encoded), or null if `uri` is not one. A malformed
+ * one (no comma, bad base64 or %-escape) is a BAD_URI GltfError, not the engine's URIError.
+ */
+function dataUri(uri: string, file: string, i: number): Uint8Array | null {
+  if (!/^data:/i.test(uri)) return null;
+  const where = `/buffers/${i}/uri`;
+  const comma = uri.indexOf(',');
+  if (comma < 0) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI has no comma before its data`);
+  const body = uri.slice(comma + 1);
+  if (/;base64$/i.test(uri.slice(0, comma))) {
+    const base64 = body.replace(/\s+/g, '');
+    if (!/^[A-Za-z0-9+/]*={0,2}$/.test(base64) || base64.length % 4 === 1)
+      throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI says base64 but its data is not base64`);
+    return new Uint8Array(Buffer.from(base64, 'base64'));
+  }
+  const bad = /%(?![0-9a-fA-F]{2})/.exec(body);
+  if (bad) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI has a bad %-escape at character ${comma + 1 + bad.index}`);
+  // Percent-decoding to bytes (not to text: decodeURIComponent would refuse bytes that are not UTF-8).
+  const text = Buffer.from(body, 'utf8');
+  const out = new Uint8Array(text.length);
+  let length = 0;
+  for (let k = 0; k < text.length; k++) {
+    if (text[k] === 0x25) { out[length++] = parseInt(String.fromCharCode(text[k + 1], text[k + 2]), 16); k += 2; }
+    else out[length++] = text[k];
+  }
+  return out.slice(0, length);
+}
+
+/**
+ * The bytes of buffer `i`'s external file: only a regular file inside the glTF's folder `baseDir`
+ * (after %-decoding and following links), and at most its declared `byteLength` bytes of it (a
+ * shorter file is reported TRUNCATED by the validator). URLs, absolute paths, '..' out of the
+ * folder, links leading out of it, devices and pipes are refused before anything is opened.
+ */
+async function readBufferFile(baseDir: string, uri: string, byteLength: unknown, file: string, i: number): Promise<Uint8Array> {
+  const where = `/buffers/${i}/uri`;
+  const outside = (why: string) =>
+    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${uri}' ${why}: a buffer is read only from a file in the glTF's own folder`);
+  let path: string;
+  try {
+    path = decodeURIComponent(uri);
+  } catch {
+    throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s uri '${uri}' has a bad %-escape`);
+  }
+  if (path.includes('\0')) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s uri has a NUL character`);
+  if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
+  if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');
+  const folder = resolve(baseDir);
+  const within = (root: string, p: string) => { const r = relative(root, p); return r !== '' && !r.startsWith(`..${sep}`) && r !== '..' && !isAbsolute(r); };
+  if (!within(folder, resolve(folder, path))) throw outside("leads out of the glTF's folder");
+  let real: string;
+  try {
+    real = await realpath(resolve(folder, path));
+    if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
+    // stat before opening: opening a FIFO would wait for a writer.
+    if (!(await stat(real)).isFile()) throw outside('is not a regular file');
+  } catch (e) {
+    if (e instanceof GltfError) throw e;
+    throw new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
+  }
+  const handle = await open(real, 'r').catch((e) => {
+    throw new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
+  });
+  try {
+    const size = (await handle.stat()).size;
+    const wanted = Number.isInteger(byteLength) && (byteLength as number) >= 0 ? Math.min(byteLength as number, size) : 0;
+    const bytes = new Uint8Array(wanted);
+    for (let at = 0; at < wanted;) {
+      const { bytesRead } = await handle.read(bytes, at, wanted - at, at);
+      if (!bytesRead) return bytes.subarray(0, at); // the file shrank meanwhile: TRUNCATED
+      at += bytesRead;
+    }
+    return bytes;
+  } finally {
+    await handle.close();
+  }
 }
 
 /**
@@ -78,7 +150,7 @@ export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: st
     if (uri === undefined) {
       if (glb && i === 0 && bin) {
         resources[GLB_BUFFER] = bin;
-        data.push({ byteLength: bin.byteLength, source: "the GLB's BIN chunk" });
+        data.push({ byteLength: bin.byteLength, bytes: bin, source: "the GLB's BIN chunk" });
       } else if (b.extensions) {
         data.push(undefined); // an extension's buffer (e.g. a meshopt fallback): no data to check
       } else {
@@ -89,31 +161,29 @@ export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: st
       continue;
     }
     if (typeof uri !== 'string') throw new GltfError('BAD_STRUCTURE', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri is not a string`);
-    const inline = dataUri(uri);
+    const inline = dataUri(uri, file, i);
     if (inline) {
-      data.push({ byteLength: inline.byteLength, source: 'its data: URI' });
+      // Decoded once, here: gltf-transform gets the bytes under a key of their own.
+      const key = `gcs-skin-data-uri-${i}.bin`;
+      b.uri = key;
+      resources[key] = inline;
+      data.push({ byteLength: inline.byteLength, bytes: inline, source: 'its data: URI' });
       continue;
     }
     if (baseDir === null)
       throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
         `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
-    let path: string;
-    try {
-      path = resolve(baseDir, decodeURIComponent(uri));
-    } catch {
-      path = resolve(baseDir, uri);
-    }
-    try {
-      resources[uri] = await readFile(path);
-    } catch (e) {
-      throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
-    }
-    data.push({ byteLength: resources[uri].byteLength, source: `its file '${uri}'` });
+    resources[uri] = await readBufferFile(baseDir, uri, b.byteLength, file, i);
+    data.push({ byteLength: resources[uri].byteLength, bytes: resources[uri], source: `its file '${uri}'` });
   }
   validateGltfJson(json, file, data);
-  // External images are not read: textures are dropped (node has no image decoder).
+  // Images are not read, nor their data: URIs decoded: textures are dropped (node has no image decoder).
   const images = Array.isArray(json.images) ? json.images : [];
-  for (const im of images) if (typeof im.uri === 'string' && !im.uri.startsWith('data:')) resources[im.uri] = new Uint8Array(0);
+  images.forEach((im, i) => {
+    if (typeof im?.uri !== 'string') return;
+    im.uri = `gcs-skin-image-${i}`;
+    resources[im.uri] = new Uint8Array(0);
+  });
   return { json, resources };
 }
 

@@ -21,7 +21,13 @@
 // - the node graph: no node its own child, no cycle, one parent at most, scene roots are roots;
 // - skins: joints non-empty, unique, existing nodes (their hierarchy is the node graph's, acyclic
 //   by the above); inverse bind matrices MAT4 FLOAT, one per joint; a skinned node has a mesh whose
-//   every primitive has JOINTS_0 and WEIGHTS_0.
+//   every primitive has JOINTS_0 and WEIGHTS_0;
+// - animations: samplers' times SCALAR FLOAT and finite, interpolation and target paths known;
+// - the limits (LIMITS), before anything is allocated: counts of objects, vertices, hierarchy and
+//   JSON depth, and the bytes the loaders would allocate against the bytes the file has;
+// - sparse indices below their accessor's count, increasing (read from the data: gltf-accessors.ts).
+
+import { accessorReader, sparseReader } from './gltf-accessors.js';
 
 /** What is wrong with a glTF file (docs/report-json.md, "Errors"). */
 export type GltfErrorCode =
@@ -37,6 +43,10 @@ export type GltfErrorCode =
   | 'NODE_HIERARCHY'  // a node with two parents, a scene root that is someone's child
   | 'BAD_SKIN'        // a skin or skinned node that cannot be skinned
   | 'UNSUPPORTED'     // a required extension the loader does not read (all but READ_EXTENSIONS)
+  | 'TOO_LARGE'       // a count past its limit (LIMITS), or more data declared than the file's bytes can hold
+  | 'BAD_URI'         // a buffer uri that does not decode (bad %-escape, malformed data: URI)
+  | 'OUTSIDE_FOLDER'  // a buffer uri that leads out of the glTF's folder, or to something not a regular file
+  | 'BAD_DATA'        // values that cannot be used: non-finite key times, sparse indices past the count
   | 'LOAD_FAILED'     // passed these checks but the loaders still failed (their message follows)
   | 'NO_SKINNED_MESH'; // loadCharacter (gcs-skin/gltf): the file has no skinned mesh
 
@@ -60,6 +70,7 @@ export class GltfError extends Error {
 // eslint-disable-next-line @typescript-eslint/no-explicit-any
 export type GltfJson = Record<string, any>;
 
+
 /** A split glTF file: the JSON, and the GLB's BIN chunk if any. */
 export interface GltfContainer {
   json: GltfJson;
@@ -74,6 +85,44 @@ export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT
 const GLB_MAGIC = 0x46546c67; // 'glTF'
 const CHUNK_JSON = 0x4e4f534a;
 const CHUNK_BIN = 0x004e4942;
+
+/**
+ * What a file may declare, checked on the JSON before a loader allocates or loops over anything:
+ * work and memory then grow with the bytes a file has, not with the counts its header claims.
+ */
+export const LIMITS = {
+  /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
+  vertices: 16_777_216,
+  /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */
+  nodes: 65_536,
+  /** Entries of any other top-level array (accessors, meshes, animations, …) and of a mesh's primitives or an animation's channels. */
+  items: 262_144,
+  /** Depth of the node hierarchy: the loaders walk it recursively. */
+  nodeDepth: 1_024,
+  /** Nesting of the JSON (extras included): deeper would overflow the loaders' recursive copies. */
+  jsonDepth: 128,
+  /**
+   * Bytes the loaders allocate for accessors and meshopt-decoded views: at most this floor plus
+   * `expansion` × the bytes of buffer data the file has (accessors sharing a view, zero-filled
+   * and sparse accessors, decompression: real files stay well under 4×).
+   */
+  expandedFloor: 64 * 2 ** 20,
+  expansion: 16,
+} as const;
+
+/** Nesting depth of a JSON value, counted iteratively up to `limit` + 1 (then it stops looking). */
+export function nestingDepth(value: unknown, limit: number): number {
+  let deepest = 0;
+  const stack: [unknown, number][] = [[value, 1]];
+  while (stack.length) {
+    const [v, depth] = stack.pop()!;
+    if (!v || typeof v !== 'object') continue;
+    if (depth > deepest) deepest = depth;
+    if (deepest > limit) return deepest;
+    for (const child of Array.isArray(v) ? v : Object.values(v)) if (child && typeof child === 'object') stack.push([child, depth + 1]);
+  }
+  return deepest;
+}
 
 /** 1,234,567 */
 export const n = (x: number) => x.toLocaleString('en-US');
@@ -108,6 +157,9 @@ function parseJsonText(bytes: Uint8Array, file: string, where: string, what: str
   }
   if (!json || typeof json !== 'object' || Array.isArray(json))
     throw new GltfError('NOT_GLTF', file, where, `${what} is not a JSON object, so not glTF`);
+  const depth = nestingDepth(json, LIMITS.jsonDepth);
+  if (depth > LIMITS.jsonDepth)
+    throw new GltfError('TOO_LARGE', file, where, `${what} nests objects or arrays more than ${LIMITS.jsonDepth} deep, past any glTF (loaders would overflow their stack)`);
   return json as GltfJson;
 }
 
@@ -169,6 +221,8 @@ export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContain
 /** How a buffer's data is had: its length, and where it came from for messages. */
 export interface BufferData {
   byteLength: number;
+  /** The data itself, when the values some checks read (key times, sparse indices) can be read. */
+  bytes?: Uint8Array;
   /** e.g. "the GLB's BIN chunk", "its file 'model.bin'", "its data: URI". */
   source: string;
 }
@@ -187,6 +241,9 @@ function elementBytes(type: string, size: number): number {
   return TYPE_COMPONENTS[type] * size;
 }
 
+const INTERPOLATIONS = ['LINEAR', 'STEP', 'CUBICSPLINE'];
+const TARGET_PATHS = ['translation', 'rotation', 'scale', 'weights'];
+
 const isIndex = (x: unknown): x is number => Number.isInteger(x) && (x as number) >= 0;
 const isObject = (x: unknown): x is GltfJson => !!x && typeof x === 'object' && !Array.isArray(x);
 
@@ -203,6 +260,8 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     const a = json[name];
     if (a === undefined) return [];
     if (!Array.isArray(a)) fail('BAD_STRUCTURE', `/${name}`, `'${name}' is not an array`);
+    const limit = name === 'nodes' ? LIMITS.nodes : LIMITS.items;
+    if (a.length > limit) fail('TOO_LARGE', `/${name}`, `it has ${n(a.length)} ${name}, more than the ${n(limit)} this loader reads`);
     a.forEach((x: unknown, i: number) => { if (!isObject(x)) fail('BAD_STRUCTURE', `/${name}/${i}`, `${name}[${i}] is not an object`); });
     return a;
   };
@@ -352,10 +411,43 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     }
   });
 
+  // What the loaders will allocate (accessors, sparse parts, meshopt-decoded views), against the data the file has.
+  let present = 0;
+  bufferDefs.forEach((b, i) => { if (buffers[i]) present += Math.min(b.byteLength, buffers[i]!.byteLength); });
+  let expanded = 0, largest = -1, largestBytes = 0;
+  accessors.forEach((a, i) => {
+    const size = elementBytes(a.type, COMPONENT[a.componentType].size);
+    const bytes = a.count * size + (a.sparse ? a.sparse.count * (size + COMPONENT[a.sparse.indices.componentType].size) : 0);
+    expanded += bytes;
+    if (bytes > largestBytes) { largest = i; largestBytes = bytes; }
+  });
+  for (const v of bufferViews) if (v.extensions?.EXT_meshopt_compression) expanded += v.byteLength;
+  const allowed = LIMITS.expandedFloor + LIMITS.expansion * present;
+  if (expanded > allowed)
+    fail('TOO_LARGE', largest >= 0 ? `/accessors/${largest}` : '/bufferViews',
+      `its accessors declare ${n(expanded)} bytes of data${largest >= 0 ? ` (the largest, ${accessorName(largest)}, ${plural(accessors[largest].count, 'element')})` : ''}` +
+      ` but the file has ${n(present)} bytes of buffer data: more than ${n(LIMITS.expandedFloor)} + ${LIMITS.expansion} × its data, refused before loading`);
+
+  // Sparse indices: below the accessor's count and increasing (else the loaders write past their arrays or skip values).
+  accessors.forEach((a, i) => {
+    const sparse = sparseReader(json, buffers, a);
+    if (!sparse) return;
+    for (let k = 0, previous = -1; k < sparse.count; k++) {
+      const index = sparse.index(k);
+      if (index >= a.count)
+        fail('BAD_DATA', `/accessors/${i}/sparse/indices`, `sparse index ${k} of ${accessorName(i)} is ${n(index)}, past its count ${n(a.count)}`);
+      if (index <= previous)
+        fail('BAD_DATA', `/accessors/${i}/sparse/indices`, `the sparse indices of ${accessorName(i)} do not increase: index ${k} is ${n(index)} after ${n(previous)}`);
+      previous = index;
+    }
+  });
+
   // meshes
   meshes.forEach((m, mi) => {
     const mesh = named('mesh', mi, m);
     if (!Array.isArray(m.primitives) || !m.primitives.length) fail('BAD_STRUCTURE', `/meshes/${mi}/primitives`, `${mesh} has no primitives`);
+    if (m.primitives.length > LIMITS.items)
+      fail('TOO_LARGE', `/meshes/${mi}/primitives`, `${mesh} has ${n(m.primitives.length)} primitives, more than the ${n(LIMITS.items)} this loader reads`);
     m.primitives.forEach((p: GltfJson, pi: number) => {
       const where = `/meshes/${mi}/primitives/${pi}`;
       const prim = `${mesh} primitive ${pi}`;
@@ -364,7 +456,11 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       for (const [k, a] of Object.entries(p.attributes)) {
         ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${k}`, true);
         const count = accessors[a as number].count;
-        if (!first) first = [k, count];
+        if (!first) {
+          first = [k, count];
+          if (count > LIMITS.vertices)
+            fail('TOO_LARGE', `${where}/attributes/${k}`, `${prim} has ${plural(count, 'vertex', 'vertices')}, more than the ${n(LIMITS.vertices)} gcs-skin takes`);
+        }
         else if (count !== first[1])
           fail('BAD_STRUCTURE', `${where}/attributes/${k}`,
             `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
@@ -440,6 +536,20 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     parent[c] = i;
   }));
 
+  // Depth of the hierarchy (acyclic by now): each node's is its parent's + 1, walked from each root down.
+  const depth = new Int32Array(nodes.length);
+  for (let r = 0; r < nodes.length; r++) {
+    if (parent[r] >= 0) continue;
+    const stack = [r];
+    depth[r] = 1;
+    while (stack.length) {
+      const v = stack.pop()!;
+      if (depth[v] > LIMITS.nodeDepth)
+        fail('TOO_LARGE', `/nodes/${v}`, `the node hierarchy is more than ${n(LIMITS.nodeDepth)} levels deep (at ${nodeName(v)}), past what the loaders walk`);
+      for (const c of children[v]) { depth[c] = depth[v] + 1; stack.push(c); }
+    }
+  }
+
   // scenes
   ref(json.scene, scenes, 'scene', '/scene', 'the file');
   scenes.forEach((s, si) => {
@@ -490,21 +600,43 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     });
   });
 
+  /** Key times (accessor `ai`, FLOAT) all finite, in its buffer view and its sparse values, where readable. */
+  const checkTimes = (ai: number, where: string, what: string) => {
+    const a = accessors[ai];
+    const dense = accessorReader(json, buffers, a), sparse = sparseReader(json, buffers, a);
+    const bad = (k: number, t: number) =>
+      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${t}: key times are finite seconds`);
+    if (dense) for (let k = 0; k < a.count; k++) { const t = dense(k, 0); if (!Number.isFinite(t)) bad(k, t); }
+    if (sparse) for (let k = 0; k < sparse.count; k++) { const t = sparse.value(k, 0); if (!Number.isFinite(t)) bad(sparse.index(k), t); }
+  };
+
   // animations
   animations.forEach((a, ai) => {
     const where = `/animations/${ai}`;
     const anim = named('animation', ai, a);
     const ss = Array.isArray(a.samplers) ? a.samplers : fail('BAD_STRUCTURE', `${where}/samplers`, `${anim} has no samplers array`);
-    ss.forEach((s: GltfJson, i: number) => {
-      if (!isObject(s)) fail('BAD_STRUCTURE', `${where}/samplers/${i}`, `sampler ${i} of ${anim} is not an object`);
-      ref(s.input, accessors, 'accessor', `${where}/samplers/${i}/input`, `the input of sampler ${i} of ${anim}`, true);
-      ref(s.output, accessors, 'accessor', `${where}/samplers/${i}/output`, `the output of sampler ${i} of ${anim}`, true);
-    });
     if (!Array.isArray(a.channels)) fail('BAD_STRUCTURE', `${where}/channels`, `${anim} has no channels array`);
+    for (const [key, length] of [['samplers', ss.length], ['channels', a.channels.length]] as const)
+      if (length > LIMITS.items) fail('TOO_LARGE', `${where}/${key}`, `${anim} has ${n(length)} ${key}, more than the ${n(LIMITS.items)} this loader reads`);
+    ss.forEach((s: GltfJson, i: number) => {
+      const sw = `${where}/samplers/${i}`;
+      if (!isObject(s)) fail('BAD_STRUCTURE', sw, `sampler ${i} of ${anim} is not an object`);
+      ref(s.input, accessors, 'accessor', `${sw}/input`, `the input of sampler ${i} of ${anim}`, true);
+      ref(s.output, accessors, 'accessor', `${sw}/output`, `the output of sampler ${i} of ${anim}`, true);
+      if (s.interpolation !== undefined && !INTERPOLATIONS.includes(s.interpolation))
+        fail('BAD_STRUCTURE', `${sw}/interpolation`, `sampler ${i} of ${anim} has interpolation ${JSON.stringify(s.interpolation)}, not ${INTERPOLATIONS.join(', ')}`);
+      const input = accessors[s.input];
+      if (input.type !== 'SCALAR' || input.componentType !== 5126)
+        fail('BAD_STRUCTURE', `${sw}/input`, `the key times of sampler ${i} of ${anim} (accessor ${s.input}) are ${input.type} of ${COMPONENT[input.componentType].name}, not SCALAR of FLOAT`);
+      checkTimes(s.input, `${sw}/input`, `sampler ${i} of ${anim}`);
+    });
     a.channels.forEach((c: GltfJson, i: number) => {
       if (!isObject(c) || !isObject(c.target)) fail('BAD_STRUCTURE', `${where}/channels/${i}`, `channel ${i} of ${anim} has no target`);
       ref(c.sampler, ss, 'sampler', `${where}/channels/${i}/sampler`, `channel ${i} of ${anim}`, true);
       ref(c.target.node, nodes, 'node', `${where}/channels/${i}/target/node`, `channel ${i} of ${anim}`);
+      if (!TARGET_PATHS.includes(c.target.path))
+        fail('BAD_STRUCTURE', `${where}/channels/${i}/target/path`,
+          `channel ${i} of ${anim} animates ${JSON.stringify(c.target.path) ?? 'nothing'}, not ${TARGET_PATHS.join(', ')}`);
     });
   });
 
