@@ -173,8 +173,11 @@ export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: st
     if (baseDir === null)
       throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
         `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
-    resources[uri] = await readBufferFile(baseDir, uri, b.byteLength, file, i);
-    data.push({ byteLength: resources[uri].byteLength, bytes: resources[uri], source: `its file '${uri}'` });
+    // Each buffer its own key: two buffers may name one file with different byteLengths.
+    const key = `gcs-skin-buffer-${i}.bin`;
+    resources[key] = await readBufferFile(baseDir, uri, b.byteLength, file, i);
+    b.uri = key;
+    data.push({ byteLength: resources[key].byteLength, bytes: resources[key], source: `its file '${uri}'` });
   }
   validateGltfJson(json, file, data);
   // Images are not read, nor their data: URIs decoded: textures are dropped (node has no image decoder).
@@ -379,8 +382,10 @@ export async function parseGlb(
   } finally {
     console.warn = warn;
   }
+  // A file with no scene is valid glTF (a library of meshes): GLTFLoader then gives no scene.
+  const scene: THREE.Object3D = gltf.scene ?? new THREE.Group();
   const skinnedMeshes: THREE.SkinnedMesh[] = [];
-  gltf.scene.traverse((o) => {
+  scene.traverse((o) => {
     if ((o as THREE.SkinnedMesh).isSkinnedMesh) skinnedMeshes.push(o as THREE.SkinnedMesh);
   });
   if (options.zeroWeights?.size)
@@ -390,8 +395,8 @@ export async function parseGlb(
       const weights = mesh.geometry.getAttribute('skinWeight');
       if (zero && weights) for (const v of zero) weights.setXYZW(v, 0, 0, 0, 0);
     }
-  gltf.scene.updateMatrixWorld(true);
-  return { scene: gltf.scene, skinnedMeshes, clips: gltf.animations, warnings };
+  scene.updateMatrixWorld(true);
+  return { scene, skinnedMeshes, clips: gltf.animations, warnings };
 }
 
 /**

@@ -94,7 +94,7 @@ export const LIMITS = {
   /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
   vertices: 16_777_216,
   /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */
-  nodes: 65_536,
+  nodes: 16_384,
   /** Entries of any other top-level array (accessors, meshes, animations, …) and of a mesh's primitives or an animation's channels. */
   items: 262_144,
   /** Depth of the node hierarchy: the loaders walk it recursively. */
@@ -106,7 +106,7 @@ export const LIMITS = {
    * `expansion` × the bytes of buffer data the file has (accessors sharing a view, zero-filled
    * and sparse accessors, decompression: real files stay well under 4×).
    */
-  expandedFloor: 64 * 2 ** 20,
+  expandedFloor: 32 * 2 ** 20,
   expansion: 16,
 } as const;
 
