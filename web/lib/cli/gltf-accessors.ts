@@ -3,6 +3,7 @@
 // decoding: an accessor in a meshopt-compressed or Draco buffer view, or in a buffer whose bytes
 // are not at hand, is not readable here (null), and those checks then leave it to the loaders.
 // Browser-safe: no node module, so the demo validates with the same code as the CLI.
+import type * as THREE from 'three';
 import type { BufferData, GltfJson } from './gltf-validate.js';
 
 /** Component i of element e. */
@@ -84,4 +85,22 @@ export function zeroWeightVertices(json: GltfJson, buffers: readonly (BufferData
     });
   }
   return out;
+}
+
+/**
+ * Gives the vertices of `zeroWeights` (zeroWeightVertices, or computed after decoding) back their
+ * all-zero weights after three's GLTFLoader bound them to the first joint, so that createRig
+ * reports them (BAD_WEIGHTS) instead of deforming them with a joint they do not have.
+ * `associations`: the GLTFLoader parser's map from objects to their glTF mesh and primitive.
+ */
+export function restoreZeroWeights(
+  meshes: readonly THREE.SkinnedMesh[], associations: Map<object, { meshes?: number; primitives?: number }>, zeroWeights: Map<string, number[]>,
+): void {
+  if (!zeroWeights.size) return;
+  for (const mesh of meshes) {
+    const at = associations.get(mesh);
+    const zero = at && zeroWeights.get(`${at.meshes}/${at.primitives ?? 0}`);
+    const weights = mesh.geometry.getAttribute('skinWeight');
+    if (zero && weights) for (const v of zero) weights.setXYZW(v, 0, 0, 0, 0);
+  }
 }

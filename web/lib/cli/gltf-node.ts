@@ -11,7 +11,9 @@ import { open, readFile, realpath, stat } from 'node:fs/promises';
 import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { GltfError, n, parseGltfContainer, validateGltfJson, type BufferData, type GltfJson } from './gltf-validate.js';
+import { decodeBufferPath, readValidatedGltf } from './gltf-buffers.js';
+import { restoreZeroWeights } from './gltf-accessors.js';
+import { GltfError, n, type BufferData, type GltfJson } from './gltf-validate.js';
 
 export { GltfError, type GltfErrorCode } from './gltf-validate.js';
 
@@ -27,6 +29,8 @@ export interface LoadedModel {
 export interface GltfFile {
   json: GltfJson;
   resources: Record<string, Uint8Array>;
+  /** Each buffer's bytes and source, as validated. */
+  data: (BufferData | undefined)[];
 }
 
 const GLB_BUFFER = '@glb.bin'; // gltf-transform's key for the GLB's BIN chunk
@@ -40,51 +44,16 @@ function reason(e: unknown): string {
 }
 
 /**
- * The bytes of a data: URI (base64 or percent-encoded), or null if `uri` is not one. A malformed
- * one (no comma, bad base64 or %-escape) is a BAD_URI GltfError, not the engine's URIError.
- */
-function dataUri(uri: string, file: string, i: number): Uint8Array | null {
-  if (!/^data:/i.test(uri)) return null;
-  const where = `/buffers/${i}/uri`;
-  const comma = uri.indexOf(',');
-  if (comma < 0) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI has no comma before its data`);
-  const body = uri.slice(comma + 1);
-  if (/;base64$/i.test(uri.slice(0, comma))) {
-    const base64 = body.replace(/\s+/g, '');
-    if (!/^[A-Za-z0-9+/]*={0,2}$/.test(base64) || base64.length % 4 === 1)
-      throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI says base64 but its data is not base64`);
-    return new Uint8Array(Buffer.from(base64, 'base64'));
-  }
-  const bad = /%(?![0-9a-fA-F]{2})/.exec(body);
-  if (bad) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s data: URI has a bad %-escape at character ${comma + 1 + bad.index}`);
-  // Percent-decoding to bytes (not to text: decodeURIComponent would refuse bytes that are not UTF-8).
-  const text = Buffer.from(body, 'utf8');
-  const out = new Uint8Array(text.length);
-  let length = 0;
-  for (let k = 0; k < text.length; k++) {
-    if (text[k] === 0x25) { out[length++] = parseInt(String.fromCharCode(text[k + 1], text[k + 2]), 16); k += 2; }
-    else out[length++] = text[k];
-  }
-  return out.slice(0, length);
-}
-
-/**
  * The bytes of buffer `i`'s external file: only a regular file inside the glTF's folder `baseDir`
  * (after %-decoding and following links), and at most its declared `byteLength` bytes of it (a
  * shorter file is reported TRUNCATED by the validator). URLs, absolute paths, '..' out of the
  * folder, links leading out of it, devices and pipes are refused before anything is opened.
  */
-async function readBufferFile(baseDir: string, uri: string, byteLength: unknown, file: string, i: number): Promise<Uint8Array> {
+async function readBufferFile(baseDir: string, uri: string, maxBytes: number, file: string, i: number): Promise<Uint8Array> {
   const where = `/buffers/${i}/uri`;
   const outside = (why: string) =>
     new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${uri}' ${why}: a buffer is read only from a file in the glTF's own folder`);
-  let path: string;
-  try {
-    path = decodeURIComponent(uri);
-  } catch {
-    throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s uri '${uri}' has a bad %-escape`);
-  }
-  if (path.includes('\0')) throw new GltfError('BAD_URI', file, where, `${file}: buffer ${i}'s uri has a NUL character`);
+  const path = decodeBufferPath(uri, file, i);
   if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
   if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');
   const folder = resolve(baseDir);
@@ -105,7 +74,7 @@ async function readBufferFile(baseDir: string, uri: string, byteLength: unknown,
   });
   try {
     const size = (await handle.stat()).size;
-    const wanted = Number.isInteger(byteLength) && (byteLength as number) >= 0 ? Math.min(byteLength as number, size) : 0;
+    const wanted = Math.min(maxBytes, size);
     const bytes = new Uint8Array(wanted);
     for (let at = 0; at < wanted;) {
       const { bytesRead } = await handle.read(bytes, at, wanted - at, at);
@@ -138,48 +107,17 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
  * an UNREADABLE error). Throws a GltfError for anything wrong.
  */
 export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: string | null): Promise<GltfFile> {
-  const file = name;
-  const { json, bin, glb } = parseGltfContainer(bytes, file);
+  const external = baseDir === null ? null : (uri: string, i: number, maxBytes: number) => readBufferFile(baseDir, uri, maxBytes, name, i);
+  const { json, buffers, glbBin, data } = await readValidatedGltf(bytes, name, external);
+  // gltf-transform reads each buffer's bytes under a key of its own (decoded once, here: data: URIs
+  // included; two buffers may name one file with different byteLengths).
   const resources: Record<string, Uint8Array> = {};
-  const data: (BufferData | undefined)[] = [];
-  const buffers = Array.isArray(json.buffers) ? json.buffers : [];
-  for (let i = 0; i < buffers.length; i++) {
-    const b = buffers[i];
-    if (!b || typeof b !== 'object') continue; // validateGltfJson reports it
-    const uri = b.uri;
-    if (uri === undefined) {
-      if (glb && i === 0 && bin) {
-        resources[GLB_BUFFER] = bin;
-        data.push({ byteLength: bin.byteLength, bytes: bin, source: "the GLB's BIN chunk" });
-      } else if (b.extensions) {
-        data.push(undefined); // an extension's buffer (e.g. a meshopt fallback): no data to check
-      } else {
-        throw new GltfError('BAD_REFERENCE', file, `/buffers/${i}`,
-          glb && i === 0 ? `${file}: buffer 0 has no uri and the file has no BIN chunk: its ${n(b.byteLength ?? 0)} bytes are nowhere`
-            : `${file}: buffer ${i} has no uri${glb ? ' and only buffer 0 can be the GLB\'s BIN chunk' : ''}: its data is nowhere`);
-      }
-      continue;
-    }
-    if (typeof uri !== 'string') throw new GltfError('BAD_STRUCTURE', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri is not a string`);
-    const inline = dataUri(uri, file, i);
-    if (inline) {
-      // Decoded once, here: gltf-transform gets the bytes under a key of their own.
-      const key = `gcs-skin-data-uri-${i}.bin`;
-      b.uri = key;
-      resources[key] = inline;
-      data.push({ byteLength: inline.byteLength, bytes: inline, source: 'its data: URI' });
-      continue;
-    }
-    if (baseDir === null)
-      throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
-        `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
-    // Each buffer its own key: two buffers may name one file with different byteLengths.
-    const key = `gcs-skin-buffer-${i}.bin`;
-    resources[key] = await readBufferFile(baseDir, uri, b.byteLength, file, i);
-    b.uri = key;
-    data.push({ byteLength: resources[key].byteLength, bytes: resources[key], source: `its file '${uri}'` });
-  }
-  validateGltfJson(json, file, data);
+  buffers.forEach((b, i) => {
+    if (!b) return;
+    if (glbBin[i]) { resources[GLB_BUFFER] = b; return; }
+    json.buffers[i].uri = `gcs-skin-buffer-${i}.bin`;
+    resources[json.buffers[i].uri] = b;
+  });
   // Images are not read, nor their data: URIs decoded: textures are dropped (node has no image decoder).
   const images = Array.isArray(json.images) ? json.images : [];
   images.forEach((im, i) => {
@@ -187,7 +125,7 @@ export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: st
     im.uri = `gcs-skin-image-${i}`;
     resources[im.uri] = new Uint8Array(0);
   });
-  return { json, resources };
+  return { json, resources, data };
 }
 
 /** The compression extensions read (and removed after decoding); gltf-validate.ts rejects every other required one. */
@@ -388,13 +326,7 @@ export async function parseGlb(
   scene.traverse((o) => {
     if ((o as THREE.SkinnedMesh).isSkinnedMesh) skinnedMeshes.push(o as THREE.SkinnedMesh);
   });
-  if (options.zeroWeights?.size)
-    for (const mesh of skinnedMeshes) {
-      const at = gltf.parser.associations.get(mesh);
-      const zero = at && options.zeroWeights.get(`${at.meshes}/${at.primitives ?? 0}`);
-      const weights = mesh.geometry.getAttribute('skinWeight');
-      if (zero && weights) for (const v of zero) weights.setXYZW(v, 0, 0, 0, 0);
-    }
+  if (options.zeroWeights) restoreZeroWeights(skinnedMeshes, gltf.parser.associations, options.zeroWeights);
   scene.updateMatrixWorld(true);
   return { scene, skinnedMeshes, clips: gltf.animations, warnings };
 }
