@@ -274,6 +274,29 @@ describe('values the loaders would take silently', () => {
     expect(line).toMatch(/sparse index 0 of accessor 0 .* is 5,000, past its count 2,005/);
   });
 
+  it('key times that go back or start below 0, a NaN animated value: BAD_DATA', () => {
+    const times = (json: Json) => json.accessors[json.animations[0].samplers[0].input];
+    const at = (json: Json, k: number) => { const a = times(json); return json.bufferViews[a.bufferView].byteOffset + a.byteOffset + 4 * k; };
+    expect(expectRefused(humanVariant('times-back.glb', (json, bin) => { bin.setFloat32(at(json, 5), 0.0625, true); }), 'BAD_DATA'))
+      .toMatch(/key 5 of sampler 0 .* is at time 0.0625: before key 4 at .*: key times never go back/);
+    expect(expectRefused(humanVariant('time-negative.glb', (json, bin) => { bin.setFloat32(at(json, 0), -1e30, true); }), 'BAD_DATA'))
+      .toMatch(/key 0 .* key times start at 0 or later/);
+    expect(expectRefused(humanVariant('nan-value.glb', (json, bin) => {
+      const values = json.accessors[json.animations[0].samplers[0].output];
+      bin.setFloat32(json.bufferViews[values.bufferView].byteOffset + values.byteOffset + 4, NaN, true);
+    }), 'BAD_DATA')).toMatch(/value 0 of sampler 0 .* is NaN/);
+  });
+
+  it('a rotation fed 3-vectors (three\'s mixer then looped forever) and too few values for the keys: BAD_STRUCTURE', () => {
+    expect(expectRefused(humanVariant('rotation-vec3.glb', (json) => { json.animations[0].channels[1].sampler = 0; }), 'BAD_STRUCTURE'))
+      .toMatch(/animates rotation with VEC3 values \(accessor \d+\), not VEC4/);
+    expect(expectRefused(humanVariant('values-short.glb', (json) => {
+      const s = json.animations[0].samplers[0];
+      json.accessors.push({ ...json.accessors[s.output], count: json.accessors[s.output].count - 1 });
+      s.output = json.accessors.length - 1;
+    }), 'BAD_STRUCTURE')).toMatch(/has 121 keys but 120 values/);
+  });
+
   it('an unknown animation path is one line (BAD_STRUCTURE), not a warning per frame', () => {
     expectRefused(humanVariant('bad-path.glb', (json) => { json.animations[0].channels[0].target.path = 'pointer'; }), 'BAD_STRUCTURE');
   });

@@ -1,6 +1,8 @@
 // Loads a glTF skinned character in node (no DOM, no image decoder). The file is first checked by
-// gltf-validate.ts (GLB container, JSON structure, buffer ranges, node graph, skins): a bad file is
-// a GltfError with a code and one sentence, before any loader sees it. Then @gltf-transform/core
+// gltf-validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
+// animations): a bad file is a GltfError with a code and one sentence, before any loader sees it.
+// External buffers are read only from regular files inside the glTF's folder, up to their
+// declared byteLength (readBufferFile). Then @gltf-transform/core
 // reads it, with the decoders of the three compression extensions the field uses
 // (KHR_mesh_quantization, EXT_meshopt_compression with meshoptimizer's MeshoptDecoder,
 // KHR_draco_mesh_compression with draco3dgltf's decoder), drops the textures, turns the geometry

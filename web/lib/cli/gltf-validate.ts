@@ -1,5 +1,6 @@
 // A small validator of glTF 2.0 files, run on the bytes before @gltf-transform/core and three's
-// GLTFLoader see them (web/lib/cli/gltf-node.ts). It is not the Khronos validator: it checks what
+// GLTFLoader see them: by the CLI and the node API (gltf-node.ts) and by the demo page
+// (web/demo/load-gltf.ts), through gltf-buffers.ts. Browser-safe: no node module. It is not the Khronos validator: it checks what
 // would otherwise crash those loaders with a message about their internals ("Invalid typed array
 // length", "Offset is outside the bounds of the DataView", "Maximum call stack size exceeded"),
 // be read as something else (a wrong magic read as JSON), or be silently repaired (a node with two
@@ -22,7 +23,8 @@
 // - skins: joints non-empty, unique, existing nodes (their hierarchy is the node graph's, acyclic
 //   by the above); inverse bind matrices MAT4 FLOAT, one per joint; a skinned node has a mesh whose
 //   every primitive has JOINTS_0 and WEIGHTS_0;
-// - animations: samplers' times SCALAR FLOAT and finite, interpolation and target paths known;
+// - animations: samplers' times SCALAR FLOAT, finite, from 0, never going back; values finite, of
+//   the path's type, one per key; interpolation and target paths known;
 // - the limits (LIMITS), before anything is allocated: counts of objects, vertices, hierarchy and
 //   JSON depth, and the bytes the loaders would allocate against the bytes the file has;
 // - sparse indices below their accessor's count, increasing (read from the data: gltf-accessors.ts).
@@ -242,7 +244,8 @@ function elementBytes(type: string, size: number): number {
 }
 
 const INTERPOLATIONS = ['LINEAR', 'STEP', 'CUBICSPLINE'];
-const TARGET_PATHS = ['translation', 'rotation', 'scale', 'weights'];
+const PATH_TYPES: Record<string, string> = { translation: 'VEC3', rotation: 'VEC4', scale: 'VEC3', weights: 'SCALAR' };
+const TARGET_PATHS = Object.keys(PATH_TYPES);
 
 const isIndex = (x: unknown): x is number => Number.isInteger(x) && (x as number) >= 0;
 const isObject = (x: unknown): x is GltfJson => !!x && typeof x === 'object' && !Array.isArray(x);
@@ -600,14 +603,36 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     });
   });
 
-  /** Key times (accessor `ai`, FLOAT) all finite, in its buffer view and its sparse values, where readable. */
+  /**
+   * Key times (accessor `ai`, FLOAT) finite, from 0 on and never decreasing (three's interpolants
+   * search them in order: a time going back plays wrong poses silently), where readable.
+   */
   const checkTimes = (ai: number, where: string, what: string) => {
     const a = accessors[ai];
     const dense = accessorReader(json, buffers, a), sparse = sparseReader(json, buffers, a);
-    const bad = (k: number, t: number) =>
-      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${t}: key times are finite seconds`);
-    if (dense) for (let k = 0; k < a.count; k++) { const t = dense(k, 0); if (!Number.isFinite(t)) bad(k, t); }
-    if (sparse) for (let k = 0; k < sparse.count; k++) { const t = sparse.value(k, 0); if (!Number.isFinite(t)) bad(sparse.index(k), t); }
+    const bad = (k: number, t: number, why: string) =>
+      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${t}: ${why}`);
+    if (sparse) for (let k = 0; k < sparse.count; k++) { const t = sparse.value(k, 0); if (!Number.isFinite(t)) bad(sparse.index(k), t, 'key times are finite seconds'); }
+    if (!dense || sparse) return; // the order of sparse-patched times is left to the loaders
+    let previous = 0;
+    for (let k = 0; k < a.count; k++) {
+      const t = dense(k, 0);
+      if (!Number.isFinite(t)) bad(k, t, 'key times are finite seconds');
+      if (t < previous) bad(k, t, k ? `before key ${n(k - 1)} at ${previous}: key times never go back` : 'key times start at 0 or later');
+      previous = t;
+    }
+  };
+  /** Animated values (accessor `ai`) all finite where they are floats and readable. */
+  const checkValues = (ai: number, where: string, what: string) => {
+    const a = accessors[ai];
+    const read = a.componentType === 5126 && !a.sparse ? accessorReader(json, buffers, a) : null;
+    if (!read) return;
+    const size = TYPE_COMPONENTS[a.type];
+    for (let k = 0; k < a.count; k++)
+      for (let c = 0; c < size; c++) {
+        const v = read(k, c);
+        if (!Number.isFinite(v)) fail('BAD_DATA', where, `value ${n(k)} of ${what} (accessor ${ai}) is ${v}: animated values are finite`);
+      }
   };
 
   // animations
@@ -629,6 +654,7 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       if (input.type !== 'SCALAR' || input.componentType !== 5126)
         fail('BAD_STRUCTURE', `${sw}/input`, `the key times of sampler ${i} of ${anim} (accessor ${s.input}) are ${input.type} of ${COMPONENT[input.componentType].name}, not SCALAR of FLOAT`);
       checkTimes(s.input, `${sw}/input`, `sampler ${i} of ${anim}`);
+      checkValues(s.output, `${sw}/output`, `sampler ${i} of ${anim}`);
     });
     a.channels.forEach((c: GltfJson, i: number) => {
       if (!isObject(c) || !isObject(c.target)) fail('BAD_STRUCTURE', `${where}/channels/${i}`, `channel ${i} of ${anim} has no target`);
@@ -637,6 +663,20 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       if (!TARGET_PATHS.includes(c.target.path))
         fail('BAD_STRUCTURE', `${where}/channels/${i}/target/path`,
           `channel ${i} of ${anim} animates ${JSON.stringify(c.target.path) ?? 'nothing'}, not ${TARGET_PATHS.join(', ')}`);
+      // The values must be what the path takes, one per key (three per key for CUBICSPLINE: in-tangent,
+      // value, out-tangent; weights: one per morph target): three's interpolants read them by stride, and
+      // a rotation fed 3-vectors makes its mixer loop forever.
+      const sampler = ss[c.sampler], input = accessors[sampler.input], output = accessors[sampler.output];
+      const perKey = sampler.interpolation === 'CUBICSPLINE' ? 3 : 1;
+      const type = PATH_TYPES[c.target.path as string];
+      const sw = `${where}/samplers/${c.sampler}/output`;
+      if (output.type !== type)
+        fail('BAD_STRUCTURE', sw, `channel ${i} of ${anim} animates ${c.target.path} with ${output.type} values (accessor ${sampler.output}), not ${type}`);
+      const keys = input.count * perKey;
+      if (c.target.path === 'weights' ? output.count % keys !== 0 : output.count !== keys)
+        fail('BAD_STRUCTURE', sw,
+          `channel ${i} of ${anim} has ${plural(input.count, 'key')} but ${plural(output.count, 'value')} (accessor ${sampler.output}): ` +
+          `${c.target.path === 'weights' ? 'a multiple of ' : ''}${n(keys)} expected${perKey > 1 ? ' (CUBICSPLINE: 3 per key)' : ''}`);
     });
   });
 
