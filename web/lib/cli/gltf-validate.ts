@@ -96,7 +96,7 @@ export const LIMITS = {
   /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
   vertices: 16_777_216,
   /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */
-  nodes: 16_384,
+  nodes: 8_192,
   /** Entries of any other top-level array (accessors, meshes, animations, …) and of a mesh's primitives or an animation's channels. */
   items: 262_144,
   /** Depth of the node hierarchy: the loaders walk it recursively. */
@@ -110,6 +110,13 @@ export const LIMITS = {
    */
   expandedFloor: 32 * 2 ** 20,
   expansion: 16,
+  /**
+   * Vertices the nodes instance (a mesh used by several nodes counts once per node): at most this
+   * many uses per vertex of the meshes used (skinned meshes), or `instancedFloor` in all (others:
+   * a prop repeated many times).
+   */
+  instancing: 4,
+  instancedFloor: 1_048_576,
 } as const;
 
 /** Nesting depth of a JSON value, counted iteratively up to `limit` + 1 (then it stops looking). */
@@ -507,6 +514,28 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       if (d[key] !== undefined && !numbers(d[key], length))
         fail('BAD_STRUCTURE', `${where}/${key}`, `the ${key} of ${node} is not ${length} finite numbers`);
   });
+
+  // Instances: every node using a mesh repeats its work in the loaders (an object per node and
+  // primitive) and, skinned, in whatever builds deformers on it (the report, the demo).
+  const meshVertices = meshes.map((m) => (m.primitives as GltfJson[]).reduce((sum, p) => {
+    const first = Object.values(p.attributes)[0];
+    return sum + (first === undefined ? 0 : accessors[first as number].count);
+  }, 0));
+  const used = new Set<number>(), skinnedUsed = new Set<number>();
+  let instanced = 0, skinnedInstanced = 0;
+  for (const d of nodes) {
+    if (d.mesh === undefined) continue;
+    used.add(d.mesh);
+    instanced += meshVertices[d.mesh];
+    if (d.skin !== undefined) { skinnedUsed.add(d.mesh); skinnedInstanced += meshVertices[d.mesh]; }
+  }
+  const distinct = (set: Set<number>) => [...set].reduce((sum, m) => sum + meshVertices[m], 0);
+  if (skinnedInstanced > LIMITS.instancing * distinct(skinnedUsed))
+    fail('TOO_LARGE', '/nodes',
+      `its skinned nodes instance ${n(skinnedInstanced)} vertices from meshes of ${n(distinct(skinnedUsed))}: more than ${LIMITS.instancing} uses per skinned mesh vertex`);
+  if (instanced > Math.max(LIMITS.instancing * distinct(used), LIMITS.instancedFloor))
+    fail('TOO_LARGE', '/nodes',
+      `its nodes instance ${n(instanced)} vertices from meshes of ${n(distinct(used))}: more than ${LIMITS.instancing} uses per vertex (or ${n(LIMITS.instancedFloor)} in all)`);
 
   // the node graph
   const nodeName = (i: number) => named('node', i, nodes[i]);
