@@ -9,7 +9,8 @@
 // back into plain float attributes (more than 4 influences per vertex: the 4 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
 // gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
-import { open, readFile, realpath, stat } from 'node:fs/promises';
+import { constants as fs } from 'node:fs';
+import { open, readFile, realpath } from 'node:fs/promises';
 import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -59,21 +60,22 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
   if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
   if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');
   const folder = resolve(baseDir);
-  const within = (root: string, p: string) => { const r = relative(root, p); return r !== '' && !r.startsWith(`..${sep}`) && r !== '..' && !isAbsolute(r); };
+  const within = (root: string, p: string) => { const r = relative(root, p); return r !== '..' && !r.startsWith(`..${sep}`) && !isAbsolute(r); };
   if (!within(folder, resolve(folder, path))) throw outside("leads out of the glTF's folder");
+  const unreadable = (e: unknown) => new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
   let real: string;
   try {
     real = await realpath(resolve(folder, path));
-    if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
-    // stat before opening: opening a FIFO would wait for a writer.
-    if (!(await stat(real)).isFile()) throw outside('is not a regular file');
   } catch (e) {
-    if (e instanceof GltfError) throw e;
-    throw new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
+    throw unreadable(e);
   }
-  const handle = await open(real, 'r').catch((e) => {
-    throw new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
-  });
+  if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
+  // Non-blocking: opening a FIFO must not wait for a writer; what is open is then checked, not a name.
+  const handle = await open(real, fs.O_RDONLY | fs.O_NONBLOCK | fs.O_NOFOLLOW).catch((e) => { throw unreadable(e); });
+  if (!(await handle.stat()).isFile()) {
+    await handle.close();
+    throw outside('is not a regular file');
+  }
   try {
     const size = (await handle.stat()).size;
     const wanted = Math.min(maxBytes, size);
