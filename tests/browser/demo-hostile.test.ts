@@ -123,6 +123,7 @@ describe.skipIf(!!reason)('demo page: hostile names and files (headless Chromium
         bin.setFloat32(json.bufferViews[times.bufferView].byteOffset + times.byteOffset, NaN, true);
       }), 'BAD_DATA'],
       ['bad-data-uri.gltf', new TextEncoder().encode(JSON.stringify({ asset: { version: '2.0' }, buffers: [{ byteLength: 4, uri: 'data:application/octet-stream;base64,@@' }] })), 'BAD_URI'],
+      ['no-skin.glb', humanGlb((json) => { for (const d of json.nodes) delete d.skin; delete json.skins; }), 'NO_SKINNED_MESH'],
       ['zero-weights.glb', humanGlb((json, bin) => {
         const w = json.accessors[json.meshes[0].primitives[0].attributes.WEIGHTS_0];
         const view = json.bufferViews[w.bufferView];

@@ -631,7 +631,10 @@ function humanDataInWorker(options: { vertices?: number }): Promise<HumanData> {
 
 async function loadFiles(files: File[]): Promise<void> {
   const main = files.find((f) => /\.glb$/i.test(f.name)) ?? files.find((f) => /\.gltf$/i.test(f.name));
-  if (!main) throw new DemoError(`${files.map((f) => f.name).join(', ') || 'That'} is not a glTF file: drop a skinned .glb or .gltf.`);
+  if (!main) {
+    const names = files.map((f) => f.name).join(', ') || 'That';
+    throw new GltfError('NOT_GLTF', names, '', `${names} is not a glTF file: drop a skinned .glb or .gltf`);
+  }
   showStatus(`building… reading ${main.name}`);
   await yieldToPage();
   // Validated as the CLI validates (a GltfError: one sentence and a code), then parsed.
@@ -724,13 +727,14 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
   object.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) sources.push(o as THREE.SkinnedMesh); });
   const built: SkinDeformer[] = [];
   try {
-    if (!sources.length) throw new DemoError(`${name} has no skinned mesh (no skeleton and skin weights), so there is nothing to deform. Drop a rigged character.`);
+    if (!sources.length)
+      throw new GltfError('NO_SKINNED_MESH', name, '', `${name} has no skinned mesh (no skeleton and skin weights), so there is nothing to deform: drop a rigged character`);
 
     if (normalise) {
       const box = new THREE.Box3().setFromObject(object);
       const size = box.getSize(new THREE.Vector3());
       const extent = Math.max(size.x, size.y, size.z);
-      if (!(extent > 0) || !Number.isFinite(extent)) throw new DemoError(`${name}: the skinned mesh has no extent (empty or non-finite positions).`);
+      if (!(extent > 0) || !Number.isFinite(extent)) throw new GcsError('DEGENERATE', `${name}: the skinned mesh has no extent (empty or non-finite positions)`);
       const s = 1.8 / extent;
       const centre = box.getCenter(new THREE.Vector3());
       holder.scale.setScalar(s);
@@ -804,8 +808,8 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     for (const s of built) s.dispose();
     disposeObject(holder);
     // The core's code and sentence after the file's name, as `gcs-skin report` prints them.
-    if (e instanceof GcsError) throw new GcsError(e.code, `${name}: ${e.message}`);
-    throw e instanceof DemoError ? e : new DemoError(`${name}: ${describeError(e)}`);
+    if (e instanceof GcsError) throw e.message.startsWith(`${name}: `) ? e : new GcsError(e.code, `${name}: ${e.message}`);
+    throw e instanceof DemoError || e instanceof GltfError ? e : new DemoError(`${name}: ${describeError(e)}`);
   }
 }
 
