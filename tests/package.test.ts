@@ -40,7 +40,7 @@ beforeAll(() => {
   // Pack from a copy of the package sources: `prepack` rebuilds dist/ there, never under the
   // feet of other test files that use this checkout's dist/.
   const src = join(dir, 'src');
-  for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'bin', 'docs/node.md', 'docs/report-json.md', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
+  for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
     cpSync(join(root, entry), join(src, entry), { recursive: true });
   symlinkSync(join(root, 'node_modules'), join(src, 'node_modules'));
   execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: src, stdio: ['ignore', 'pipe', 'pipe'] });
@@ -63,6 +63,9 @@ describe('the npm tarball, alone in an empty folder', () => {
     // three: installed by npm as gcs-skin's peer, at the top, once.
     expect(existsSync(join(a, 'node_modules/three/package.json'))).toBe(true);
     expect(existsSync(join(a, 'node_modules/gcs-skin/node_modules/three'))).toBe(false);
+    // The MIT licence its package.json names, as a file.
+    expect(installed.license).toBe('MIT');
+    expect(readFileSync(join(a, 'node_modules/gcs-skin/LICENSE'), 'utf8')).toMatch(/^MIT License\n[\s\S]*Permission is hereby granted, free of charge/);
     // The types carry no @internal members.
     expect(readFileSync(join(a, 'node_modules/gcs-skin/dist/index.d.ts'), 'utf8')).not.toMatch(/@internal|refreshViews|copyIn/);
     // gcs-skin/gltf's types show nothing of three.

@@ -94,6 +94,35 @@ describe('model settings', () => {
     flat.dispose();
   });
 
+  test('options of the wrong type are refused, quoting the value as given (a string is not read as a number or a flag)', () => {
+    const rig = gcs.createRig(makeTube().input);
+    type Loose = Record<string, unknown>;
+    const gcsWith = (o: Loose) => () => rig.buildGcs(o as never);
+    const classicWith = (o: Loose) => () => rig.buildClassic(o as never);
+    expectGcsError(gcsWith({ smooth: 'no' }), 'INVALID_ARGUMENT', /smooth must be true or false; got 'no'$/);
+    expectGcsError(gcsWith({ smooth: 1 }), 'INVALID_ARGUMENT', /smooth must be true or false; got 1$/);
+    expectGcsError(gcsWith({ twistSpread: 'false' }), 'INVALID_ARGUMENT', /twistSpread must be true or false; got 'false'$/);
+    expectGcsError(gcsWith({ influenceWidth: '0.5' }), 'INVALID_ARGUMENT', /influence width must be a number in \(0, 1\]; got '0.5'$/);
+    expectGcsError(gcsWith({ sections: '6' }), 'SECTION_COUNT', /got '6'$/);
+    expectGcsError(gcsWith({ sections: 4.5 }), 'SECTION_COUNT', /got 4.5$/);
+    expectGcsError(gcsWith({ criterion: 7 }), 'INVALID_ARGUMENT', /got 7$/);
+    expectGcsError(() => rig.buildGcs('smooth' as never), 'INVALID_ARGUMENT', /buildGcs takes an options object; got 'smooth'$/);
+    expectGcsError(classicWith({ contours: '12' }), 'OUT_OF_RANGE', /contours .*; got '12'$/);
+    expectGcsError(classicWith({ bulge: '0.5' }), 'INVALID_ARGUMENT', /bulge must be a number .*; got '0.5'$/);
+    // Booleans and numbers as documented still build.
+    const d = rig.buildGcs({ smooth: false, twistSpread: false, influenceWidth: 0.5, sections: 6 });
+    expect(d.sectionCount).toBeGreaterThan(0);
+    d.dispose();
+    rig.dispose();
+  });
+
+  test('fractional or negative joint ids are reported as given, not as their u32 wrap (4294967295)', () => {
+    const withJoint = (value: number) => tubeWith((i) => { i.joints = Array.from(i.joints as Uint32Array, (v, k) => (k === 9 ? value : v)); });
+    expectGcsError(() => gcs.createRig(withJoint(-1)), 'JOINT_OUT_OF_RANGE', /^vertex 2 has joint id -1 \(joints\[9\]\): joint ids are whole numbers from 0 to 2$/);
+    expectGcsError(() => gcs.createRig(withJoint(1.5)), 'JOINT_OUT_OF_RANGE', /joint id 1.5 \(joints\[9\]\)/);
+    expectGcsError(() => gcs.createRig(tubeWith((i) => { i.joints = Float32Array.from(i.joints as Uint32Array, (v, k) => (k === 9 ? -0.5 : v)); })), 'JOINT_OUT_OF_RANGE', /joint id -0.5/);
+  });
+
   test('the core also rejects what bypasses the TypeScript checks', () => {
     const rig = gcs.createRig(makeTube().input);
     const core = gcs.core;

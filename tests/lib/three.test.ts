@@ -1,6 +1,6 @@
 // The three.js adapter: the geometry's attributes are the wasm views (no copy), they follow
 // memory growth, and the output matches three's own skinning at the joints' rigid parts.
-import { beforeAll, describe, expect, test } from 'vitest';
+import { beforeAll, describe, expect, test, vi } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { SkinDeformer, rigInputFromSkinnedMesh } from '../../web/lib/three.js';
@@ -42,6 +42,29 @@ describe('three.js adapter', () => {
     expect(Array.from(input.parents)).toEqual([-1, 0, 1]);
     expect(input.positions.length).toBe(mesh.geometry.getAttribute('position').count * 3);
     expect(() => rigInputFromSkinnedMesh(new THREE.Mesh() as unknown as THREE.SkinnedMesh)).toThrow(GcsError);
+  });
+
+  test('a SkinnedMesh with 8 influences (joints_1/weights_1, as GLTFLoader keeps them) warns once that 4 are used', () => {
+    const { mesh } = tubeSkinnedMesh();
+    const count = mesh.geometry.getAttribute('position').count;
+    const extra = new Float32Array(4 * count);
+    for (let v = 0; v < count; v += 3) extra[4 * v] = 0.1; // a third of the vertices have a fifth influence
+    mesh.geometry.setAttribute('joints_1', new THREE.Uint16BufferAttribute(new Uint16Array(4 * count), 4));
+    mesh.geometry.setAttribute('weights_1', new THREE.Float32BufferAttribute(extra, 4));
+    const warn = vi.spyOn(console, 'warn').mockImplementation(() => {});
+    try {
+      rigInputFromSkinnedMesh(mesh);
+      rigInputFromSkinnedMesh(mesh); // a rebuild reads the same geometry: no second warning
+      expect(warn).toHaveBeenCalledTimes(1);
+      expect(String(warn.mock.calls[0][0])).toMatch(new RegExp(`8 joint influences .* only the first 4 are used: ${Math.ceil(count / 3)} of ${count} vertices lose weight`));
+      // Without weight in the extra set there is nothing to say.
+      const { mesh: plain } = tubeSkinnedMesh();
+      plain.geometry.setAttribute('weights_1', new THREE.Float32BufferAttribute(new Float32Array(4 * count), 4));
+      rigInputFromSkinnedMesh(plain);
+      expect(warn).toHaveBeenCalledTimes(1);
+    } finally {
+      warn.mockRestore();
+    }
   });
 
   test('attributes are views on wasm memory and match three.js skinning', () => {

@@ -13,7 +13,6 @@
 // renderer.setAnimationLoop. A small hook on window.__demo lets browser tests drive the page.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import Stats from 'three/addons/libs/stats.module.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
 import {
@@ -26,6 +25,8 @@ import { attributesNeeded } from './material-attributes.js';
 import { crowdRequested, startCrowd } from './crowd.js';
 import { measureSettingCost, type SettingCost } from './cost.js';
 import { addRendererSwitch, createRenderer, rendererKind, rendererLabel, type DemoRenderer } from './renderer.js';
+import { escapeHtml as esc, textOptions } from './gui-text.js';
+import { basename, GltfError, loadDroppedGltf, loadGltfUrl } from './load-gltf.js';
 
 // ---------------------------------------------------------------------------------------------
 // State
@@ -210,7 +211,7 @@ function showStatus(text: string): void {
   statusEl.hidden = false;
 }
 function describeError(e: unknown): string {
-  if (e instanceof GcsError) return `${e.message} (${e.code})`;
+  if (e instanceof GcsError || e instanceof GltfError) return `${e.message} (${e.code})`;
   if (e instanceof Error) return e.message;
   return String(e);
 }
@@ -336,7 +337,8 @@ function initGui(): void {
   gui = new GUI({ title: 'gcs-skin', width: 270 });
 
   const m = gui.addFolder('Character');
-  modelController = m.add(params, 'model', modelMenu(null)) as unknown as OptionsCtl;
+  // Labels from files and URLs reach lil-gui (innerHTML) escaped: textOptions.
+  modelController = m.add(params, 'model', textOptions(modelMenu(null))) as unknown as OptionsCtl;
   modelController.name('character').onChange(onModelMenu);
   m.add(params, 'loadFile').name('load file… (.glb / .gltf)');
   // The attribution line of the character on screen, under the menu.
@@ -359,7 +361,7 @@ function initGui(): void {
   c.add(params, 'bulge', 0, CLASSIC_LIMITS.maxBulge, 0.05).name('muscle bulge').onChange(setBulge);
 
   const a = gui.addFolder('Animation');
-  clipController = a.add(params, 'clip', [params.clip]) as unknown as OptionsCtl;
+  clipController = a.add(params, 'clip', textOptions([params.clip])) as unknown as OptionsCtl;
   a.add(params, 'speed', 0, 2, 0.05);
   pausedController = a.add(params, 'paused').name('pause');
   a.add(params, 'stepFrame').name('step one frame');
@@ -401,7 +403,7 @@ function syncModelMenu(): void {
     return;
   }
   // lil-gui's options() re-adds the controller at the end of its folder: put it back first.
-  modelController = modelController.options(modelMenu(fileName)).name('character').onChange(onModelMenu);
+  modelController = modelController.options(textOptions(modelMenu(fileName))).name('character').onChange(onModelMenu);
   const fresh = (modelController as unknown as { domElement: HTMLElement }).domElement;
   fresh.parentElement?.prepend(fresh);
 }
@@ -429,7 +431,7 @@ function updatePaperOnlyControls(): void {
 
 function setClipOptions(names: string[]): void {
   // lil-gui's options() re-adds the controller at the end of its folder: put it back first.
-  clipController = clipController.options(names.length ? names : ['(none)']).name('clip').onChange(playClip);
+  clipController = clipController.options(textOptions(names.length ? names : ['(none)'])).name('clip').onChange(playClip);
   const el = (clipController as unknown as { domElement: HTMLElement }).domElement;
   el.parentElement?.prepend(el);
 }
@@ -618,63 +620,24 @@ function humanDataInWorker(options: { vertices?: number }): Promise<HumanData> {
   });
 }
 
-const basename = (path: string) => decodeURIComponent(path.split(/[\\/]/).pop() ?? path);
-
 async function loadFiles(files: File[]): Promise<void> {
   const main = files.find((f) => /\.glb$/i.test(f.name)) ?? files.find((f) => /\.gltf$/i.test(f.name));
-  if (!main) throw new DemoError(`${files.map((f) => f.name).join(', ') || 'That'} is not a glTF file: drop a skinned .glb or .gltf.`);
+  if (!main) {
+    const names = files.map((f) => f.name).join(', ') || 'That';
+    throw new GltfError('NOT_GLTF', names, '', `${names} is not a glTF file: drop a skinned .glb or .gltf`);
+  }
   showStatus(`building… reading ${main.name}`);
   await yieldToPage();
-  const manager = new THREE.LoadingManager();
-  const loader = new GLTFLoader(manager);
-  const objectUrls: string[] = [];
-  let gltf: GLTF;
-  try {
-    if (/\.glb$/i.test(main.name)) {
-      gltf = await loader.parseAsync(await main.arrayBuffer(), '');
-    } else {
-      const text = await main.text();
-      let json: { buffers?: { uri?: string }[] };
-      try {
-        json = JSON.parse(text);
-      } catch (e) {
-        throw new DemoError(`Could not read ${main.name}: it is not valid glTF JSON (${(e as Error).message}).`);
-      }
-      const byName = new Map(files.map((f) => [f.name, f]));
-      const external = (json.buffers ?? []).map((b) => b.uri).filter((u): u is string => !!u && !u.startsWith('data:'));
-      const missing = external.filter((u) => !byName.has(basename(u)));
-      if (missing.length) {
-        throw new DemoError(`${main.name} keeps its data in external files (${missing.join(', ')}), which a dropped .gltf cannot reach. ` +
-          'Drop the .gltf together with those files (select them all), or use a .glb or a .gltf with embedded buffers.');
-      }
-      manager.setURLModifier((url) => {
-        const file = byName.get(basename(url));
-        if (!file) return url;
-        const objectUrl = URL.createObjectURL(file);
-        objectUrls.push(objectUrl);
-        return objectUrl;
-      });
-      gltf = await loader.parseAsync(text, '');
-    }
-  } catch (e) {
-    if (e instanceof DemoError) throw e;
-    throw new DemoError(`Could not read ${main.name}: ${describeError(e)}`);
-  } finally {
-    setTimeout(() => objectUrls.forEach((u) => URL.revokeObjectURL(u)), 10000);
-  }
+  // Validated as the CLI validates (a GltfError: one sentence and a code), then parsed.
+  const gltf = await loadDroppedGltf(main, files.filter((f) => f !== main));
   await install(main.name, gltf.scene, gltf.animations, { normalise: true, key: 'file', credit: null });
 }
 
 async function loadUrl(url: string, shipped?: Shipped): Promise<void> {
-  showStatus(`building… loading ${shipped?.label ?? basename(url)}`);
-  let gltf: GLTF;
-  try {
-    gltf = await new GLTFLoader().loadAsync(url);
-  } catch (e) {
-    throw new DemoError(`Could not load ${url}: ${describeError(e)}`);
-  }
-  await install(shipped?.label ?? basename(url), gltf.scene, gltf.animations,
-    { normalise: true, key: shipped?.key ?? 'file', credit: shipped?.credit ?? null });
+  const name = shipped?.label ?? basename(url);
+  showStatus(`building… loading ${name}`);
+  const gltf = await loadGltfUrl(url, shipped ? name : url);
+  await install(name, gltf.scene, gltf.animations, { normalise: true, key: shipped?.key ?? 'file', credit: shipped?.credit ?? null });
 }
 
 /** A character shipped in public/ (served beside the page). */
@@ -782,13 +745,14 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
   object.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) sources.push(o as THREE.SkinnedMesh); });
   const built: SkinDeformer[] = [];
   try {
-    if (!sources.length) throw new DemoError(`${name} has no skinned mesh (no skeleton and skin weights), so there is nothing to deform. Drop a rigged character.`);
+    if (!sources.length)
+      throw new GltfError('NO_SKINNED_MESH', name, '', `${name} has no skinned mesh (no skeleton and skin weights), so there is nothing to deform: drop a rigged character`);
 
     if (normalise) {
       const box = new THREE.Box3().setFromObject(object);
       const size = box.getSize(new THREE.Vector3());
       const extent = Math.max(size.x, size.y, size.z);
-      if (!(extent > 0) || !Number.isFinite(extent)) throw new DemoError(`${name}: the skinned mesh has no extent (empty or non-finite positions).`);
+      if (!(extent > 0) || !Number.isFinite(extent)) throw new GcsError('DEGENERATE', `${name}: the skinned mesh has no extent (empty or non-finite positions)`);
       const s = 1.8 / extent;
       const centre = box.getCenter(new THREE.Vector3());
       holder.scale.setScalar(s);
@@ -860,7 +824,9 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
   } catch (e) {
     for (const s of built) s.dispose();
     disposeObject(holder);
-    throw e instanceof DemoError || e instanceof GcsError ? e : new DemoError(`${name}: ${describeError(e)}`);
+    // The core's code and sentence after the file's name, as `gcs-skin report` prints them.
+    if (e instanceof GcsError) throw e.message.startsWith(`${name}: `) ? e : new GcsError(e.code, `${name}: ${e.message}`);
+    throw e instanceof DemoError || e instanceof GltfError ? e : new DemoError(`${name}: ${describeError(e)}`);
   }
 }
 
@@ -1011,7 +977,6 @@ function onWindowResize(): void {
   updateReadouts();
 }
 
-const esc = (s: string) => s.replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' })[c]!);
 
 function updateLabels(): void {
   const rects = viewRects();

@@ -230,6 +230,13 @@ export class GcsSkin {
       if (!Number.isInteger(v) || v < 0 || v >= vertexCount)
         throw new GcsError('INDEX_OUT_OF_RANGE', `triangle index ${v} (at position ${i}) is out of range: the mesh has ${vertexCount} vertices`);
     }
+    if (!(joints instanceof Uint8Array || joints instanceof Uint16Array || joints instanceof Uint32Array))
+      for (let i = 0; i < joints.length; i++) {
+        const j = joints[i];
+        // Copied into wasm as u32, -1 would become 4294967295 and 1.5 would become 1: refuse them as given.
+        if (!Number.isInteger(j) || j < 0)
+          throw new GcsError('JOINT_OUT_OF_RANGE', `vertex ${(i - (i % 4)) / 4} has joint id ${asGiven(j)} (joints[${i}]): joint ids are whole numbers from 0 to ${jointCount - 1}`);
+      }
     const ptrs: number[] = [];
     try {
       const p = this.copyIn(positions, 'f32'); ptrs.push(p);
@@ -264,6 +271,28 @@ export async function initGcsSkin(options: { wasm?: WasmSource } = {}): Promise<
   return new GcsSkin(core);
 }
 
+/** A value as the caller gave it, for messages: strings in quotes ('6'), so a string is told from a number. */
+export function asGiven(value: unknown): string {
+  if (typeof value === 'string') return `'${value}'`;
+  if (typeof value === 'bigint') return `${value}n`;
+  if (Array.isArray(value)) return 'an array';
+  if (value !== null && typeof value === 'object') return 'an object';
+  return String(value);
+}
+
+/** Options must be an object (or undefined): a number or string there is a mistake, not "no options". */
+function checkOptions(options: unknown, method: string): void {
+  if (options === undefined) return;
+  if (options === null || typeof options !== 'object' || Array.isArray(options))
+    throw new GcsError('INVALID_ARGUMENT', `${method} takes an options object; got ${asGiven(options)}`);
+}
+
+/** A boolean option: true, false or absent; 'no', 0 or 'false' are refused rather than read as truthy or falsy. */
+function checkFlag(value: unknown, name: string): void {
+  if (value !== undefined && typeof value !== 'boolean')
+    throw new GcsError('INVALID_ARGUMENT', `${name} must be true or false; got ${asGiven(value)}`);
+}
+
 /** A validated skinned mesh in wasm memory: the input every deformer is built from. */
 export class Rig {
   readonly vertexCount: number;
@@ -287,15 +316,18 @@ export class Rig {
 
   /** Builds a generalized cross-section model (design.md §2). */
   buildGcs(options: GcsOptions = {}): GcsDeformer {
+    checkOptions(options, 'buildGcs');
     const sections = options.sections ?? 6;
     const criterion = options.criterion ?? 'weights';
     const width = options.influenceWidth ?? 1;
     if (!Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
-      throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${sections}`);
+      throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${asGiven(sections)}`);
     if (!CRITERIA.includes(criterion))
-      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'weights', 'y' or 'axial'; got '${String(criterion)}'`);
-    if (!(width > 0 && width <= 1))
-      throw new GcsError('OUT_OF_RANGE', `the influence width must be in (0, 1]; got ${width}`);
+      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'weights', 'y' or 'axial'; got ${asGiven(criterion)}`);
+    if (typeof width !== 'number' || !(width > 0 && width <= 1))
+      throw new GcsError(typeof width === 'number' ? 'OUT_OF_RANGE' : 'INVALID_ARGUMENT', `the influence width must be a number in (0, 1]; got ${asGiven(width)}`);
+    checkFlag(options.smooth, 'smooth');
+    checkFlag(options.twistSpread, 'twistSpread');
     const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
       (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0);
     if (!h) this.gcs.raise('the GCS model could not be built');
@@ -304,16 +336,17 @@ export class Rig {
 
   /** Builds the classic cross-section model (design.md §4). */
   buildClassic(options: ClassicOptions = {}): ClassicDeformer {
+    checkOptions(options, 'buildClassic');
     const contours = options.contours ?? 25;
     const rays = options.rays ?? 20;
     const bulge = options.bulge ?? 0.3;
     const L = CLASSIC_LIMITS;
     if (!Number.isInteger(contours) || contours < L.minContours || contours > L.maxContours)
-      throw new GcsError('OUT_OF_RANGE', `contours must be a whole number between ${L.minContours} and ${L.maxContours}; got ${contours}`);
+      throw new GcsError('OUT_OF_RANGE', `contours must be a whole number between ${L.minContours} and ${L.maxContours}; got ${asGiven(contours)}`);
     if (!Number.isInteger(rays) || rays < L.minRays || rays > L.maxRays)
-      throw new GcsError('OUT_OF_RANGE', `rays must be a whole number between ${L.minRays} and ${L.maxRays}; got ${rays}`);
-    if (!(bulge >= 0 && bulge <= L.maxBulge))
-      throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${L.maxBulge}; got ${bulge}`);
+      throw new GcsError('OUT_OF_RANGE', `rays must be a whole number between ${L.minRays} and ${L.maxRays}; got ${asGiven(rays)}`);
+    if (typeof bulge !== 'number' || !(bulge >= 0 && bulge <= L.maxBulge))
+      throw new GcsError(typeof bulge === 'number' ? 'OUT_OF_RANGE' : 'INVALID_ARGUMENT', `bulge must be a number between 0 and ${L.maxBulge}; got ${asGiven(bulge)}`);
     const h = this.gcs.core.gcs_build_classic(this.live(), contours, rays, bulge);
     if (!h) this.gcs.raise('the classic cross-section model could not be built');
     return new ClassicDeformer(this.gcs, h, this.jointCount);

@@ -97,6 +97,29 @@ export function writeSkinMatrices(source: THREE.SkinnedMesh, out: Float32Array, 
   }
 }
 
+/** Geometries already warned about (a rebuild with other options reads the same geometry again). */
+const warnedInfluences = new WeakSet<THREE.BufferGeometry>();
+
+/**
+ * GLTFLoader keeps JOINTS_1/WEIGHTS_1 as `joints_1`/`weights_1`; the core (like three's own
+ * skinning) takes the first 4 influences, so weight there is lost: say so once per geometry
+ * (gltf-node's loader instead keeps the 4 largest and renormalises, with its own warning).
+ */
+function warnExtraInfluences(geometry: THREE.BufferGeometry): void {
+  const extra = geometry.getAttribute('weights_1');
+  if (!extra || warnedInfluences.has(geometry)) return;
+  let vertices = 0;
+  for (let i = 0; i < extra.count; i++) {
+    for (let k = 0; k < extra.itemSize; k++) {
+      if (extra.getComponent(i, k) > 0) { vertices++; break; }
+    }
+  }
+  if (!vertices) return;
+  warnedInfluences.add(geometry);
+  console.warn(`gcs-skin: the skinned mesh has 8 joint influences per vertex (joints_1/weights_1); only the first 4 are used: ` +
+    `${vertices.toLocaleString('en-US')} of ${extra.count.toLocaleString('en-US')} vertices lose weight (renormalise to 4 influences before loading to keep their sum)`);
+}
+
 /** Reads the rig (bind-pose mesh, skin, skeleton) out of a SkinnedMesh as GLTFLoader gives it. */
 export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
   if (!source || !(source as THREE.SkinnedMesh).isSkinnedMesh || !source.skeleton)
@@ -108,6 +131,7 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
   if (!position) throw new GcsError('NO_SKIN', 'the skinned mesh has no position attribute');
   if (!skinIndex || !skinWeight)
     throw new GcsError('NO_SKIN', 'the mesh has no skin weights (skinIndex/skinWeight attributes): it cannot be deformed by bones');
+  warnExtraInfluences(geometry);
   const n = position.count;
   const positions = new Float32Array(n * 3);
   const joints = new Uint32Array(n * 4);

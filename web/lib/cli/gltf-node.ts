@@ -1,17 +1,22 @@
 // Loads a glTF skinned character in node (no DOM, no image decoder). The file is first checked by
-// gltf-validate.ts (GLB container, JSON structure, buffer ranges, node graph, skins): a bad file is
-// a GltfError with a code and one sentence, before any loader sees it. Then @gltf-transform/core
+// gltf-validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
+// animations): a bad file is a GltfError with a code and one sentence, before any loader sees it.
+// External buffers are read only from regular files inside the glTF's folder, up to their
+// declared byteLength (readBufferFile). Then @gltf-transform/core
 // reads it, with the decoders of the three compression extensions the field uses
 // (KHR_mesh_quantization, EXT_meshopt_compression with meshoptimizer's MeshoptDecoder,
 // KHR_draco_mesh_compression with draco3dgltf's decoder), drops the textures, turns the geometry
 // back into plain float attributes (more than 4 influences per vertex: the 4 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
 // gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
-import { readFile } from 'node:fs/promises';
-import { dirname, resolve } from 'node:path';
+import { constants as fs } from 'node:fs';
+import { open, readFile, realpath } from 'node:fs/promises';
+import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { GltfError, n, parseGltfContainer, validateGltfJson, type BufferData, type GltfJson } from './gltf-validate.js';
+import { decodeBufferPath, readValidatedGltf } from './gltf-buffers.js';
+import { restoreZeroWeights } from './gltf-accessors.js';
+import { GltfError, n, type BufferData, type GltfJson } from './gltf-validate.js';
 
 export { GltfError, type GltfErrorCode } from './gltf-validate.js';
 
@@ -27,6 +32,8 @@ export interface LoadedModel {
 export interface GltfFile {
   json: GltfJson;
   resources: Record<string, Uint8Array>;
+  /** Each buffer's bytes and source, as validated. */
+  data: (BufferData | undefined)[];
 }
 
 const GLB_BUFFER = '@glb.bin'; // gltf-transform's key for the GLB's BIN chunk
@@ -39,11 +46,49 @@ function reason(e: unknown): string {
   return String(err?.message ?? e).replace(/\s*\n\s*/g, ' ');
 }
 
-/** The bytes of a data: URI (base64 or percent-encoded), or null if it is not one. */
-function dataUri(uri: string): Uint8Array | null {
-  const m = /^data:[^,]*?(;base64)?,(.*)$/s.exec(uri);
-  if (!m) return null;
-  return m[1] ? new Uint8Array(Buffer.from(m[2], 'base64')) : new TextEncoder().encode(decodeURIComponent(m[2]));
+/**
+ * The bytes of buffer `i`'s external file: only a regular file inside the glTF's folder `baseDir`
+ * (after %-decoding and following links), and at most its declared `byteLength` bytes of it (a
+ * shorter file is reported TRUNCATED by the validator). URLs, absolute paths, '..' out of the
+ * folder, links leading out of it, devices and pipes are refused before anything is opened.
+ */
+async function readBufferFile(baseDir: string, uri: string, maxBytes: number, file: string, i: number): Promise<Uint8Array> {
+  const where = `/buffers/${i}/uri`;
+  const outside = (why: string) =>
+    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${uri}' ${why}: a buffer is read only from a file in the glTF's own folder`);
+  const path = decodeBufferPath(uri, file, i);
+  if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
+  if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');
+  const folder = resolve(baseDir);
+  const within = (root: string, p: string) => { const r = relative(root, p); return r !== '..' && !r.startsWith(`..${sep}`) && !isAbsolute(r); };
+  if (!within(folder, resolve(folder, path))) throw outside("leads out of the glTF's folder");
+  const unreadable = (e: unknown) => new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
+  let real: string;
+  try {
+    real = await realpath(resolve(folder, path));
+  } catch (e) {
+    throw unreadable(e);
+  }
+  if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
+  // Non-blocking: opening a FIFO must not wait for a writer; what is open is then checked, not a name.
+  const handle = await open(real, fs.O_RDONLY | fs.O_NONBLOCK | fs.O_NOFOLLOW).catch((e) => { throw unreadable(e); });
+  if (!(await handle.stat()).isFile()) {
+    await handle.close();
+    throw outside('is not a regular file');
+  }
+  try {
+    const size = (await handle.stat()).size;
+    const wanted = Math.min(maxBytes, size);
+    const bytes = new Uint8Array(wanted);
+    for (let at = 0; at < wanted;) {
+      const { bytesRead } = await handle.read(bytes, at, wanted - at, at);
+      if (!bytesRead) return bytes.subarray(0, at); // the file shrank meanwhile: TRUNCATED
+      at += bytesRead;
+    }
+    return bytes;
+  } finally {
+    await handle.close();
+  }
 }
 
 /**
@@ -66,55 +111,25 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
  * an UNREADABLE error). Throws a GltfError for anything wrong.
  */
 export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: string | null): Promise<GltfFile> {
-  const file = name;
-  const { json, bin, glb } = parseGltfContainer(bytes, file);
+  const external = baseDir === null ? null : (uri: string, i: number, maxBytes: number) => readBufferFile(baseDir, uri, maxBytes, name, i);
+  const { json, buffers, glbBin, data } = await readValidatedGltf(bytes, name, external);
+  // gltf-transform reads each buffer's bytes under a key of its own (decoded once, here: data: URIs
+  // included; two buffers may name one file with different byteLengths).
   const resources: Record<string, Uint8Array> = {};
-  const data: (BufferData | undefined)[] = [];
-  const buffers = Array.isArray(json.buffers) ? json.buffers : [];
-  for (let i = 0; i < buffers.length; i++) {
-    const b = buffers[i];
-    if (!b || typeof b !== 'object') continue; // validateGltfJson reports it
-    const uri = b.uri;
-    if (uri === undefined) {
-      if (glb && i === 0 && bin) {
-        resources[GLB_BUFFER] = bin;
-        data.push({ byteLength: bin.byteLength, source: "the GLB's BIN chunk" });
-      } else if (b.extensions) {
-        data.push(undefined); // an extension's buffer (e.g. a meshopt fallback): no data to check
-      } else {
-        throw new GltfError('BAD_REFERENCE', file, `/buffers/${i}`,
-          glb && i === 0 ? `${file}: buffer 0 has no uri and the file has no BIN chunk: its ${n(b.byteLength ?? 0)} bytes are nowhere`
-            : `${file}: buffer ${i} has no uri${glb ? ' and only buffer 0 can be the GLB\'s BIN chunk' : ''}: its data is nowhere`);
-      }
-      continue;
-    }
-    if (typeof uri !== 'string') throw new GltfError('BAD_STRUCTURE', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri is not a string`);
-    const inline = dataUri(uri);
-    if (inline) {
-      data.push({ byteLength: inline.byteLength, source: 'its data: URI' });
-      continue;
-    }
-    if (baseDir === null)
-      throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
-        `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
-    let path: string;
-    try {
-      path = resolve(baseDir, decodeURIComponent(uri));
-    } catch {
-      path = resolve(baseDir, uri);
-    }
-    try {
-      resources[uri] = await readFile(path);
-    } catch (e) {
-      throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
-    }
-    data.push({ byteLength: resources[uri].byteLength, source: `its file '${uri}'` });
-  }
-  validateGltfJson(json, file, data);
-  // External images are not read: textures are dropped (node has no image decoder).
+  buffers.forEach((b, i) => {
+    if (!b) return;
+    if (glbBin[i]) { resources[GLB_BUFFER] = b; return; }
+    json.buffers[i].uri = `gcs-skin-buffer-${i}.bin`;
+    resources[json.buffers[i].uri] = b;
+  });
+  // Images are not read, nor their data: URIs decoded: textures are dropped (node has no image decoder).
   const images = Array.isArray(json.images) ? json.images : [];
-  for (const im of images) if (typeof im.uri === 'string' && !im.uri.startsWith('data:')) resources[im.uri] = new Uint8Array(0);
-  return { json, resources };
+  images.forEach((im, i) => {
+    if (typeof im?.uri !== 'string') return;
+    im.uri = `gcs-skin-image-${i}`;
+    resources[im.uri] = new Uint8Array(0);
+  });
+  return { json, resources, data };
 }
 
 /** The compression extensions read (and removed after decoding); gltf-validate.ts rejects every other required one. */
@@ -309,19 +324,15 @@ export async function parseGlb(
   } finally {
     console.warn = warn;
   }
+  // A file with no scene is valid glTF (a library of meshes): GLTFLoader then gives no scene.
+  const scene: THREE.Object3D = gltf.scene ?? new THREE.Group();
   const skinnedMeshes: THREE.SkinnedMesh[] = [];
-  gltf.scene.traverse((o) => {
+  scene.traverse((o) => {
     if ((o as THREE.SkinnedMesh).isSkinnedMesh) skinnedMeshes.push(o as THREE.SkinnedMesh);
   });
-  if (options.zeroWeights?.size)
-    for (const mesh of skinnedMeshes) {
-      const at = gltf.parser.associations.get(mesh);
-      const zero = at && options.zeroWeights.get(`${at.meshes}/${at.primitives ?? 0}`);
-      const weights = mesh.geometry.getAttribute('skinWeight');
-      if (zero && weights) for (const v of zero) weights.setXYZW(v, 0, 0, 0, 0);
-    }
-  gltf.scene.updateMatrixWorld(true);
-  return { scene: gltf.scene, skinnedMeshes, clips: gltf.animations, warnings };
+  if (options.zeroWeights) restoreZeroWeights(skinnedMeshes, gltf.parser.associations, options.zeroWeights);
+  scene.updateMatrixWorld(true);
+  return { scene, skinnedMeshes, clips: gltf.animations, warnings };
 }
 
 /**

@@ -1,5 +1,6 @@
 // A small validator of glTF 2.0 files, run on the bytes before @gltf-transform/core and three's
-// GLTFLoader see them (web/lib/cli/gltf-node.ts). It is not the Khronos validator: it checks what
+// GLTFLoader see them: by the CLI and the node API (gltf-node.ts) and by the demo page
+// (web/demo/load-gltf.ts), through gltf-buffers.ts. Browser-safe: no node module. It is not the Khronos validator: it checks what
 // would otherwise crash those loaders with a message about their internals ("Invalid typed array
 // length", "Offset is outside the bounds of the DataView", "Maximum call stack size exceeded"),
 // be read as something else (a wrong magic read as JSON), or be silently repaired (a node with two
@@ -21,7 +22,14 @@
 // - the node graph: no node its own child, no cycle, one parent at most, scene roots are roots;
 // - skins: joints non-empty, unique, existing nodes (their hierarchy is the node graph's, acyclic
 //   by the above); inverse bind matrices MAT4 FLOAT, one per joint; a skinned node has a mesh whose
-//   every primitive has JOINTS_0 and WEIGHTS_0.
+//   every primitive has JOINTS_0 and WEIGHTS_0;
+// - animations: samplers' times SCALAR FLOAT, finite, from 0, never going back; values finite, of
+//   the path's type, one per key; interpolation and target paths known;
+// - the limits (LIMITS), before anything is allocated: counts of objects, vertices, hierarchy and
+//   JSON depth, and the bytes the loaders would allocate against the bytes the file has;
+// - sparse indices below their accessor's count, increasing (read from the data: gltf-accessors.ts).
+
+import { accessorReader, sparseReader } from './gltf-accessors.js';
 
 /** What is wrong with a glTF file (docs/report-json.md, "Errors"). */
 export type GltfErrorCode =
@@ -37,6 +45,10 @@ export type GltfErrorCode =
   | 'NODE_HIERARCHY'  // a node with two parents, a scene root that is someone's child
   | 'BAD_SKIN'        // a skin or skinned node that cannot be skinned
   | 'UNSUPPORTED'     // a required extension the loader does not read (all but READ_EXTENSIONS)
+  | 'TOO_LARGE'       // a count past its limit (LIMITS), or more data declared than the file's bytes can hold
+  | 'BAD_URI'         // a buffer uri that does not decode (bad %-escape, malformed data: URI)
+  | 'OUTSIDE_FOLDER'  // a buffer uri that leads out of the glTF's folder, or to something not a regular file
+  | 'BAD_DATA'        // values that cannot be used: non-finite key times, sparse indices past the count
   | 'LOAD_FAILED'     // passed these checks but the loaders still failed (their message follows)
   | 'NO_SKINNED_MESH'; // loadCharacter (gcs-skin/gltf): the file has no skinned mesh
 
@@ -60,6 +72,7 @@ export class GltfError extends Error {
 // eslint-disable-next-line @typescript-eslint/no-explicit-any
 export type GltfJson = Record<string, any>;
 
+
 /** A split glTF file: the JSON, and the GLB's BIN chunk if any. */
 export interface GltfContainer {
   json: GltfJson;
@@ -74,6 +87,51 @@ export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT
 const GLB_MAGIC = 0x46546c67; // 'glTF'
 const CHUNK_JSON = 0x4e4f534a;
 const CHUNK_BIN = 0x004e4942;
+
+/**
+ * What a file may declare, checked on the JSON before a loader allocates or loops over anything:
+ * work and memory then grow with the bytes a file has, not with the counts its header claims.
+ */
+export const LIMITS = {
+  /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
+  vertices: 16_777_216,
+  /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */
+  nodes: 8_192,
+  /** Entries of any other top-level array (accessors, meshes, animations, …) and of a mesh's primitives or an animation's channels. */
+  items: 262_144,
+  /** Depth of the node hierarchy: the loaders walk it recursively. */
+  nodeDepth: 1_024,
+  /** Nesting of the JSON (extras included): deeper would overflow the loaders' recursive copies. */
+  jsonDepth: 128,
+  /**
+   * Bytes the loaders allocate for accessors and meshopt-decoded views: at most this floor plus
+   * `expansion` × the bytes of buffer data the file has (accessors sharing a view, zero-filled
+   * and sparse accessors, decompression: real files stay well under 4×).
+   */
+  expandedFloor: 32 * 2 ** 20,
+  expansion: 16,
+  /**
+   * Vertices the nodes instance (a mesh used by several nodes counts once per node): at most this
+   * many uses per vertex of the meshes used (skinned meshes), or `instancedFloor` in all (others:
+   * a prop repeated many times).
+   */
+  instancing: 4,
+  instancedFloor: 1_048_576,
+} as const;
+
+/** Nesting depth of a JSON value, counted iteratively up to `limit` + 1 (then it stops looking). */
+export function nestingDepth(value: unknown, limit: number): number {
+  let deepest = 0;
+  const stack: [unknown, number][] = [[value, 1]];
+  while (stack.length) {
+    const [v, depth] = stack.pop()!;
+    if (!v || typeof v !== 'object') continue;
+    if (depth > deepest) deepest = depth;
+    if (deepest > limit) return deepest;
+    for (const child of Array.isArray(v) ? v : Object.values(v)) if (child && typeof child === 'object') stack.push([child, depth + 1]);
+  }
+  return deepest;
+}
 
 /** 1,234,567 */
 export const n = (x: number) => x.toLocaleString('en-US');
@@ -108,6 +166,9 @@ function parseJsonText(bytes: Uint8Array, file: string, where: string, what: str
   }
   if (!json || typeof json !== 'object' || Array.isArray(json))
     throw new GltfError('NOT_GLTF', file, where, `${what} is not a JSON object, so not glTF`);
+  const depth = nestingDepth(json, LIMITS.jsonDepth);
+  if (depth > LIMITS.jsonDepth)
+    throw new GltfError('TOO_LARGE', file, where, `${what} nests objects or arrays more than ${LIMITS.jsonDepth} deep, past any glTF (loaders would overflow their stack)`);
   return json as GltfJson;
 }
 
@@ -169,6 +230,8 @@ export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContain
 /** How a buffer's data is had: its length, and where it came from for messages. */
 export interface BufferData {
   byteLength: number;
+  /** The data itself, when the values some checks read (key times, sparse indices) can be read. */
+  bytes?: Uint8Array;
   /** e.g. "the GLB's BIN chunk", "its file 'model.bin'", "its data: URI". */
   source: string;
 }
@@ -187,6 +250,10 @@ function elementBytes(type: string, size: number): number {
   return TYPE_COMPONENTS[type] * size;
 }
 
+const INTERPOLATIONS = ['LINEAR', 'STEP', 'CUBICSPLINE'];
+const PATH_TYPES: Record<string, string> = { translation: 'VEC3', rotation: 'VEC4', scale: 'VEC3', weights: 'SCALAR' };
+const TARGET_PATHS = Object.keys(PATH_TYPES);
+
 const isIndex = (x: unknown): x is number => Number.isInteger(x) && (x as number) >= 0;
 const isObject = (x: unknown): x is GltfJson => !!x && typeof x === 'object' && !Array.isArray(x);
 
@@ -203,6 +270,8 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     const a = json[name];
     if (a === undefined) return [];
     if (!Array.isArray(a)) fail('BAD_STRUCTURE', `/${name}`, `'${name}' is not an array`);
+    const limit = name === 'nodes' ? LIMITS.nodes : LIMITS.items;
+    if (a.length > limit) fail('TOO_LARGE', `/${name}`, `it has ${n(a.length)} ${name}, more than the ${n(limit)} this loader reads`);
     a.forEach((x: unknown, i: number) => { if (!isObject(x)) fail('BAD_STRUCTURE', `/${name}/${i}`, `${name}[${i}] is not an object`); });
     return a;
   };
@@ -352,10 +421,43 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     }
   });
 
+  // What the loaders will allocate (accessors, sparse parts, meshopt-decoded views), against the data the file has.
+  let present = 0;
+  bufferDefs.forEach((b, i) => { if (buffers[i]) present += Math.min(b.byteLength, buffers[i]!.byteLength); });
+  let expanded = 0, largest = -1, largestBytes = 0;
+  accessors.forEach((a, i) => {
+    const size = elementBytes(a.type, COMPONENT[a.componentType].size);
+    const bytes = a.count * size + (a.sparse ? a.sparse.count * (size + COMPONENT[a.sparse.indices.componentType].size) : 0);
+    expanded += bytes;
+    if (bytes > largestBytes) { largest = i; largestBytes = bytes; }
+  });
+  for (const v of bufferViews) if (v.extensions?.EXT_meshopt_compression) expanded += v.byteLength;
+  const allowed = LIMITS.expandedFloor + LIMITS.expansion * present;
+  if (expanded > allowed)
+    fail('TOO_LARGE', largest >= 0 ? `/accessors/${largest}` : '/bufferViews',
+      `its accessors declare ${n(expanded)} bytes of data${largest >= 0 ? ` (the largest, ${accessorName(largest)}, ${plural(accessors[largest].count, 'element')})` : ''}` +
+      ` but the file has ${n(present)} bytes of buffer data: more than ${n(LIMITS.expandedFloor)} + ${LIMITS.expansion} × its data, refused before loading`);
+
+  // Sparse indices: below the accessor's count and increasing (else the loaders write past their arrays or skip values).
+  accessors.forEach((a, i) => {
+    const sparse = sparseReader(json, buffers, a);
+    if (!sparse) return;
+    for (let k = 0, previous = -1; k < sparse.count; k++) {
+      const index = sparse.index(k);
+      if (index >= a.count)
+        fail('BAD_DATA', `/accessors/${i}/sparse/indices`, `sparse index ${k} of ${accessorName(i)} is ${n(index)}, past its count ${n(a.count)}`);
+      if (index <= previous)
+        fail('BAD_DATA', `/accessors/${i}/sparse/indices`, `the sparse indices of ${accessorName(i)} do not increase: index ${k} is ${n(index)} after ${n(previous)}`);
+      previous = index;
+    }
+  });
+
   // meshes
   meshes.forEach((m, mi) => {
     const mesh = named('mesh', mi, m);
     if (!Array.isArray(m.primitives) || !m.primitives.length) fail('BAD_STRUCTURE', `/meshes/${mi}/primitives`, `${mesh} has no primitives`);
+    if (m.primitives.length > LIMITS.items)
+      fail('TOO_LARGE', `/meshes/${mi}/primitives`, `${mesh} has ${n(m.primitives.length)} primitives, more than the ${n(LIMITS.items)} this loader reads`);
     m.primitives.forEach((p: GltfJson, pi: number) => {
       const where = `/meshes/${mi}/primitives/${pi}`;
       const prim = `${mesh} primitive ${pi}`;
@@ -364,7 +466,11 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
       for (const [k, a] of Object.entries(p.attributes)) {
         ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${k}`, true);
         const count = accessors[a as number].count;
-        if (!first) first = [k, count];
+        if (!first) {
+          first = [k, count];
+          if (count > LIMITS.vertices)
+            fail('TOO_LARGE', `${where}/attributes/${k}`, `${prim} has ${plural(count, 'vertex', 'vertices')}, more than the ${n(LIMITS.vertices)} gcs-skin takes`);
+        }
         else if (count !== first[1])
           fail('BAD_STRUCTURE', `${where}/attributes/${k}`,
             `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
@@ -409,6 +515,28 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
         fail('BAD_STRUCTURE', `${where}/${key}`, `the ${key} of ${node} is not ${length} finite numbers`);
   });
 
+  // Instances: every node using a mesh repeats its work in the loaders (an object per node and
+  // primitive) and, skinned, in whatever builds deformers on it (the report, the demo).
+  const meshVertices = meshes.map((m) => (m.primitives as GltfJson[]).reduce((sum, p) => {
+    const first = Object.values(p.attributes)[0];
+    return sum + (first === undefined ? 0 : accessors[first as number].count);
+  }, 0));
+  const used = new Set<number>(), skinnedUsed = new Set<number>();
+  let instanced = 0, skinnedInstanced = 0;
+  for (const d of nodes) {
+    if (d.mesh === undefined) continue;
+    used.add(d.mesh);
+    instanced += meshVertices[d.mesh];
+    if (d.skin !== undefined) { skinnedUsed.add(d.mesh); skinnedInstanced += meshVertices[d.mesh]; }
+  }
+  const distinct = (set: Set<number>) => [...set].reduce((sum, m) => sum + meshVertices[m], 0);
+  if (skinnedInstanced > LIMITS.instancing * distinct(skinnedUsed))
+    fail('TOO_LARGE', '/nodes',
+      `its skinned nodes instance ${n(skinnedInstanced)} vertices from meshes of ${n(distinct(skinnedUsed))}: more than ${LIMITS.instancing} uses per skinned mesh vertex`);
+  if (instanced > Math.max(LIMITS.instancing * distinct(used), LIMITS.instancedFloor))
+    fail('TOO_LARGE', '/nodes',
+      `its nodes instance ${n(instanced)} vertices from meshes of ${n(distinct(used))}: more than ${LIMITS.instancing} uses per vertex (or ${n(LIMITS.instancedFloor)} in all)`);
+
   // the node graph
   const nodeName = (i: number) => named('node', i, nodes[i]);
   const children = nodes.map((d) => (d.children ?? []) as number[]);
@@ -439,6 +567,20 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
         `${nodeName(c)} has two parents, ${nodeName(parent[c])} and ${nodeName(i)}: a glTF node has at most one`);
     parent[c] = i;
   }));
+
+  // Depth of the hierarchy (acyclic by now): each node's is its parent's + 1, walked from each root down.
+  const depth = new Int32Array(nodes.length);
+  for (let r = 0; r < nodes.length; r++) {
+    if (parent[r] >= 0) continue;
+    const stack = [r];
+    depth[r] = 1;
+    while (stack.length) {
+      const v = stack.pop()!;
+      if (depth[v] > LIMITS.nodeDepth)
+        fail('TOO_LARGE', `/nodes/${v}`, `the node hierarchy is more than ${n(LIMITS.nodeDepth)} levels deep (at ${nodeName(v)}), past what the loaders walk`);
+      for (const c of children[v]) { depth[c] = depth[v] + 1; stack.push(c); }
+    }
+  }
 
   // scenes
   ref(json.scene, scenes, 'scene', '/scene', 'the file');
@@ -490,21 +632,80 @@ export function validateGltfJson(json: GltfJson, file: string, buffers: (BufferD
     });
   });
 
+  /**
+   * Key times (accessor `ai`, FLOAT) finite, from 0 on and never decreasing (three's interpolants
+   * search them in order: a time going back plays wrong poses silently), where readable.
+   */
+  const checkTimes = (ai: number, where: string, what: string) => {
+    const a = accessors[ai];
+    const dense = accessorReader(json, buffers, a), sparse = sparseReader(json, buffers, a);
+    const bad = (k: number, t: number, why: string) =>
+      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${t}: ${why}`);
+    if (sparse) for (let k = 0; k < sparse.count; k++) { const t = sparse.value(k, 0); if (!Number.isFinite(t)) bad(sparse.index(k), t, 'key times are finite seconds'); }
+    if (!dense || sparse) return; // the order of sparse-patched times is left to the loaders
+    let previous = 0;
+    for (let k = 0; k < a.count; k++) {
+      const t = dense(k, 0);
+      if (!Number.isFinite(t)) bad(k, t, 'key times are finite seconds');
+      if (t < previous) bad(k, t, k ? `before key ${n(k - 1)} at ${previous}: key times never go back` : 'key times start at 0 or later');
+      previous = t;
+    }
+  };
+  /** Animated values (accessor `ai`) all finite where they are floats and readable. */
+  const checkValues = (ai: number, where: string, what: string) => {
+    const a = accessors[ai];
+    const read = a.componentType === 5126 && !a.sparse ? accessorReader(json, buffers, a) : null;
+    if (!read) return;
+    const size = TYPE_COMPONENTS[a.type];
+    for (let k = 0; k < a.count; k++)
+      for (let c = 0; c < size; c++) {
+        const v = read(k, c);
+        if (!Number.isFinite(v)) fail('BAD_DATA', where, `value ${n(k)} of ${what} (accessor ${ai}) is ${v}: animated values are finite`);
+      }
+  };
+
   // animations
   animations.forEach((a, ai) => {
     const where = `/animations/${ai}`;
     const anim = named('animation', ai, a);
     const ss = Array.isArray(a.samplers) ? a.samplers : fail('BAD_STRUCTURE', `${where}/samplers`, `${anim} has no samplers array`);
-    ss.forEach((s: GltfJson, i: number) => {
-      if (!isObject(s)) fail('BAD_STRUCTURE', `${where}/samplers/${i}`, `sampler ${i} of ${anim} is not an object`);
-      ref(s.input, accessors, 'accessor', `${where}/samplers/${i}/input`, `the input of sampler ${i} of ${anim}`, true);
-      ref(s.output, accessors, 'accessor', `${where}/samplers/${i}/output`, `the output of sampler ${i} of ${anim}`, true);
-    });
     if (!Array.isArray(a.channels)) fail('BAD_STRUCTURE', `${where}/channels`, `${anim} has no channels array`);
+    for (const [key, length] of [['samplers', ss.length], ['channels', a.channels.length]] as const)
+      if (length > LIMITS.items) fail('TOO_LARGE', `${where}/${key}`, `${anim} has ${n(length)} ${key}, more than the ${n(LIMITS.items)} this loader reads`);
+    ss.forEach((s: GltfJson, i: number) => {
+      const sw = `${where}/samplers/${i}`;
+      if (!isObject(s)) fail('BAD_STRUCTURE', sw, `sampler ${i} of ${anim} is not an object`);
+      ref(s.input, accessors, 'accessor', `${sw}/input`, `the input of sampler ${i} of ${anim}`, true);
+      ref(s.output, accessors, 'accessor', `${sw}/output`, `the output of sampler ${i} of ${anim}`, true);
+      if (s.interpolation !== undefined && !INTERPOLATIONS.includes(s.interpolation))
+        fail('BAD_STRUCTURE', `${sw}/interpolation`, `sampler ${i} of ${anim} has interpolation ${JSON.stringify(s.interpolation)}, not ${INTERPOLATIONS.join(', ')}`);
+      const input = accessors[s.input];
+      if (input.type !== 'SCALAR' || input.componentType !== 5126)
+        fail('BAD_STRUCTURE', `${sw}/input`, `the key times of sampler ${i} of ${anim} (accessor ${s.input}) are ${input.type} of ${COMPONENT[input.componentType].name}, not SCALAR of FLOAT`);
+      checkTimes(s.input, `${sw}/input`, `sampler ${i} of ${anim}`);
+      checkValues(s.output, `${sw}/output`, `sampler ${i} of ${anim}`);
+    });
     a.channels.forEach((c: GltfJson, i: number) => {
       if (!isObject(c) || !isObject(c.target)) fail('BAD_STRUCTURE', `${where}/channels/${i}`, `channel ${i} of ${anim} has no target`);
       ref(c.sampler, ss, 'sampler', `${where}/channels/${i}/sampler`, `channel ${i} of ${anim}`, true);
       ref(c.target.node, nodes, 'node', `${where}/channels/${i}/target/node`, `channel ${i} of ${anim}`);
+      if (!TARGET_PATHS.includes(c.target.path))
+        fail('BAD_STRUCTURE', `${where}/channels/${i}/target/path`,
+          `channel ${i} of ${anim} animates ${JSON.stringify(c.target.path) ?? 'nothing'}, not ${TARGET_PATHS.join(', ')}`);
+      // The values must be what the path takes, one per key (three per key for CUBICSPLINE: in-tangent,
+      // value, out-tangent; weights: one per morph target): three's interpolants read them by stride, and
+      // a rotation fed 3-vectors makes its mixer loop forever.
+      const sampler = ss[c.sampler], input = accessors[sampler.input], output = accessors[sampler.output];
+      const perKey = sampler.interpolation === 'CUBICSPLINE' ? 3 : 1;
+      const type = PATH_TYPES[c.target.path as string];
+      const sw = `${where}/samplers/${c.sampler}/output`;
+      if (output.type !== type)
+        fail('BAD_STRUCTURE', sw, `channel ${i} of ${anim} animates ${c.target.path} with ${output.type} values (accessor ${sampler.output}), not ${type}`);
+      const keys = input.count * perKey;
+      if (c.target.path === 'weights' ? output.count % keys !== 0 : output.count !== keys)
+        fail('BAD_STRUCTURE', sw,
+          `channel ${i} of ${anim} has ${plural(input.count, 'key')} but ${plural(output.count, 'value')} (accessor ${sampler.output}): ` +
+          `${c.target.path === 'weights' ? 'a multiple of ' : ''}${n(keys)} expected${perKey > 1 ? ' (CUBICSPLINE: 3 per key)' : ''}`);
     });
   });
 

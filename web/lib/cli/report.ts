@@ -99,7 +99,23 @@ export class ReportError extends Error {
   }
 }
 
-const oneLine = (s: string) => s.replace(/\s*\n\s*/g, ' ').trim();
+/**
+ * Text safe for a terminal: control characters (C0, DEL, C1) and bidirectional overrides, which a
+ * file's names may carry to set the window title, clear the screen or reorder text, written as
+ * escapes (\x1b, \n, \u202e) instead of being sent raw.
+ */
+export function printable(s: string): string {
+  return s.replace(/[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]/g, (c) => {
+    const code = c.charCodeAt(0);
+    if (c === '\n') return '\\n';
+    if (c === '\r') return '\\r';
+    if (c === '\t') return '\\t';
+    return code < 0x100 ? `\\x${code.toString(16).padStart(2, '0')}` : `\\u${code.toString(16).padStart(4, '0')}`;
+  });
+}
+
+/** One printable line: a message's line breaks (engine messages have some) become spaces, other controls escapes. */
+const oneLine = (s: string) => printable(s.replace(/\s*\n\s*/g, ' ').trim());
 
 const round = (x: number, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)) : x);
 const roundOrNull = (x: number | null) => (x === null ? null : round(x));
@@ -249,12 +265,12 @@ function table(rows: string[][]): string {
 
 /** The human-readable report. */
 export function formatReport(r: Report): string {
-  const out: string[] = [`gcs-skin report: ${r.file}`,
+  const out: string[] = [`gcs-skin report: ${printable(r.file)}`,
     `character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`];
-  for (const w of r.warnings) out.push(`loader warning: ${w}`);
+  for (const w of r.warnings) out.push(`loader warning: ${printable(w)}`);
   for (const m of r.meshes) {
     const c = m.counts;
-    out.push('', `mesh '${m.name}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
+    out.push('', `mesh '${printable(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
     out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
@@ -264,7 +280,7 @@ export function formatReport(r: Report): string {
     const rows = [['method', 'build ms', 'median ms', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'creases', 'stretched', 'normal off', 'non-finite', 'seam gap %', 'note']];
     for (const name of METHODS) {
       const x = m.methods[name];
-      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', '', `${x.error!.code}: ${x.error!.message}`]); continue; }
+      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', '', `${x.error!.code}: ${printable(x.error!.message)}`]); continue; }
       const f = x.fidelity;
       const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : `${f.flipped} (LBS ${lbs})`;
       const creases = name === 'lbs' || name === 'dqs' || !(creaseBase > 0) ? String(f.creases)
@@ -276,7 +292,7 @@ export function formatReport(r: Report): string {
     out.push(table(rows));
     if (!m.clips.length) out.push('(no animation clips: per-clip timing needs a clip)');
     for (const clip of m.clips) {
-      out.push('', `clip '${clip.name}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
+      out.push('', `clip '${printable(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
       const rows2 = [['method', 'median ms', 'p95 ms', 'adjusted']];
       for (const name of METHODS) {
         const x = clip.methods[name];
@@ -327,7 +343,7 @@ export async function run(argv: string[]): Promise<number> {
   try {
     args = parseArgs(argv);
   } catch (e) {
-    process.stderr.write(`gcs-skin report: ${(e as Error).message}\n${usage}\n`);
+    process.stderr.write(`gcs-skin report: ${oneLine((e as Error).message)}\n${usage}\n`);
     return 2;
   }
   if (args.help) {
@@ -351,7 +367,7 @@ export async function run(argv: string[]): Promise<number> {
   console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r));
   const bad = nonFiniteMethods(r);
   if (bad.length) {
-    process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${b.mesh}' (${b.count})`).join(', ')}\n`);
+    process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${printable(b.mesh)}' (${b.count})`).join(', ')}\n`);
     return 1;
   }
   return 0;

@@ -1,0 +1,146 @@
+// The demo page against hostile input, in headless Chromium: markup in ?clip=, ?model=, a dropped
+// file's name and a glTF's animation name reaches the page as text (lil-gui writes its option
+// labels with innerHTML: an <img onerror> there would run), and broken or crafted files are
+// refused by the same validation as the CLI, in one sentence ending with its code.
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { BrowserContext, Page } from 'playwright-core';
+import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
+import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
+import { launchChromium, skipReason, startDemo, type DemoServer } from './harness.js';
+
+const reason = skipReason();
+if (reason) console.log(reason);
+
+/** Markup that, run, counts itself in window.__pwned. */
+const markup = (tag: string) => `<img src=x-${tag} onerror="window.__pwned=(window.__pwned||0)+1">`;
+
+declare global { interface Window { __pwned?: number } }
+
+describe.skipIf(!!reason)('demo page: hostile names and files (headless Chromium)', () => {
+  let server: DemoServer;
+  let context: BrowserContext;
+  let human: { json: Json; bin: Uint8Array };
+
+  beforeAll(async () => {
+    [server, context, human] = await Promise.all([startDemo(), launchChromium(), humanToGlb(createHuman({ vertices: 2000 })).then(splitGlb)]);
+  });
+  afterAll(async () => {
+    await context?.close();
+    await server?.close();
+  });
+
+  /** A page at `query`, ready and idle, with its page errors collected. */
+  async function open(query: string): Promise<{ page: Page; errors: string[] }> {
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    page.on('dialog', (d) => { errors.push(`dialog: ${d.message()}`); void d.dismiss(); });
+    await page.goto(`${server.url}${query}`);
+    await page.waitForFunction(() => window.__demo !== undefined);
+    await page.evaluate(() => window.__demo.ready);
+    await page.evaluate(() => window.__demo.idle());
+    return { page, errors };
+  }
+
+  /** Nothing ran, and no element was made from the markup anywhere in the page. */
+  async function expectInert(page: Page, errors: string[]): Promise<void> {
+    await page.waitForTimeout(300); // an injected image's error event would have fired by now
+    expect(await page.evaluate(() => window.__pwned)).toBeUndefined();
+    expect(await page.evaluate(() => document.querySelectorAll('img[onerror], [onerror]').length)).toBe(0);
+    expect(errors).toEqual([]);
+  }
+
+  /** The options of a lil-gui menu, as the page shows them. */
+  const menu = (page: Page, name: string) =>
+    page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) })
+      .locator('select').evaluate((el: HTMLSelectElement) => Array.from(el.options).map((o) => o.text));
+
+  /** Drops a file on the page as a user would. */
+  async function drop(page: Page, name: string, bytes: Uint8Array): Promise<void> {
+    await page.evaluate(async ({ name, b64 }) => {
+      const dt = new DataTransfer();
+      dt.items.add(new File([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], name));
+      window.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+      await new Promise((r) => setTimeout(r, 50));
+      await window.__demo.idle();
+    }, { name, b64: Buffer.from(bytes).toString('base64') });
+  }
+
+  /** The default human as .glb, its JSON changed by `edit`. */
+  function humanGlb(edit: (json: Json, bin: DataView) => void = () => {}): Uint8Array {
+    const json = structuredClone(human.json);
+    const bin = human.bin.slice();
+    edit(json, new DataView(bin.buffer));
+    return packGlb(json, bin);
+  }
+
+  test('?clip=<img onerror> runs nothing; the clip menu showed it as text', async () => {
+    const clip = markup('clip');
+    const { page, errors } = await open(`?clip=${encodeURIComponent(clip)}`);
+    await expectInert(page, errors);
+    expect(await page.evaluate(() => window.__demo.error())).toBe('');
+    await page.close();
+  });
+
+  test('?model=<img onerror>.glb (a URL that fails) runs nothing: its message is text, the human is shown', async () => {
+    const { page, errors } = await open(`?model=${encodeURIComponent(`${markup('model')}.glb`)}`);
+    await expectInert(page, errors.filter((e) => !/404|Failed to load/.test(e)));
+    const message = await page.evaluate(() => window.__demo.error());
+    expect(message).toContain(`${markup('model')}.glb`);
+    // A 404, or the preview server's index page served in its place (NOT_GLTF): a code either way.
+    expect(message).toMatch(/\((UNREADABLE|NOT_GLTF)\) Showing the default human instead\.$/);
+    expect(await page.evaluate(() => window.__demo.character())).toMatch(/Human/);
+    await page.close();
+  });
+
+  test('a dropped file whose name and animation name are markup loads, shown as text in both menus', async () => {
+    const { page, errors } = await open('');
+    const clip = markup('animation');
+    const file = `${markup('file')}.glb`;
+    await drop(page, file, humanGlb((json) => { json.animations[1].name = clip; }));
+    expect(await page.evaluate(() => window.__demo.error())).toBe('');
+    expect(await page.evaluate(() => window.__demo.character())).toBe(file);
+    expect(await menu(page, 'character')).toContain(file);
+    expect(await menu(page, 'clip')).toContain(clip);
+    // Choosing the markup-named clip plays it (the value is the name as given).
+    await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^clip$/ }) }).locator('select').selectOption({ label: clip });
+    expect(await page.evaluate(() => window.__demo.clip())).toBe(clip);
+    await expectInert(page, errors);
+    await page.close();
+  });
+
+  test('broken and crafted files: one sentence with the code of the CLI, no engine message, the character stays', async () => {
+    const { page, errors } = await open('');
+    const character = await page.evaluate(() => window.__demo.character());
+    const cases: [string, Uint8Array, string][] = [
+      ['not-gltf.glb', new TextEncoder().encode('this is not a glTF file at all'), 'NOT_GLTF'],
+      ['truncated.glb', humanGlb().subarray(0, 5000), 'TRUNCATED'],
+      ['past-view.glb', humanGlb((json) => { json.accessors[0].count = 100000; }), 'OUT_OF_BOUNDS'],
+      ['unknown-ext.glb', humanGlb((json) => { json.extensionsRequired = json.extensionsUsed = ['KHR_hostile']; }), 'UNSUPPORTED'],
+      ['huge-count.glb', humanGlb((json) => { json.accessors.push({ componentType: 5125, type: 'SCALAR', count: 2 ** 31 - 1 }); }), 'TOO_LARGE'],
+      ['nan-time.glb', humanGlb((json, bin) => {
+        const times = json.accessors[json.animations[0].samplers[0].input];
+        bin.setFloat32(json.bufferViews[times.bufferView].byteOffset + times.byteOffset, NaN, true);
+      }), 'BAD_DATA'],
+      ['bad-data-uri.gltf', new TextEncoder().encode(JSON.stringify({ asset: { version: '2.0' }, buffers: [{ byteLength: 4, uri: 'data:application/octet-stream;base64,@@' }] })), 'BAD_URI'],
+      ['no-skin.glb', humanGlb((json) => { for (const d of json.nodes) delete d.skin; delete json.skins; }), 'NO_SKINNED_MESH'],
+      ['zero-weights.glb', humanGlb((json, bin) => {
+        const w = json.accessors[json.meshes[0].primitives[0].attributes.WEIGHTS_0];
+        const view = json.bufferViews[w.bufferView];
+        for (let c = 0; c < 4; c++) bin.setFloat32(view.byteOffset + w.byteOffset + 7 * view.byteStride + 4 * c, 0, true);
+      }), 'BAD_WEIGHTS'],
+    ];
+    for (const [name, bytes, code] of cases) {
+      await drop(page, name, bytes);
+      const message = await page.evaluate(() => window.__demo.error());
+      expect(message, name).toContain(name.replace(/\.[^.]+$/, ''));
+      expect(message, name).toMatch(new RegExp(`\\(${code}\\)$`));
+      expect(message.split(/\n/), name).toHaveLength(1);
+      expect(message, name).not.toMatch(/Invalid typed array|DataView|Cannot read properties|Maximum call stack|URIError|URI malformed/);
+      expect(await page.evaluate(() => window.__demo.character()), name).toBe(character);
+      console.log(`demo refuses ${name}: ${message}`);
+    }
+    await expectInert(page, errors);
+    await page.close();
+  });
+});
