@@ -134,11 +134,14 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     await expect(menu.evaluate((el: HTMLSelectElement) => el.options[el.selectedIndex].text)).resolves.toBe('weights (default)');
     expect(await disabled(page, 'influence width')).toBe(true);
     expect(await disabled(page, 'twist spread')).toBe(true);
-    expect(await disabled(page, 'smooth mode')).toBe(false);
+    expect(await disabled(page, 'smooth \\(no steps\\)')).toBe(false);
     await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/weights criterion · 6 sections: weight step 1\/8/);
     const readout = await page.locator('.readout[data-view=gcs]').innerText();
     expect(readout).toMatch(/criterion weights: vertices bound 100 % to a bone move exactly with it; the paper's Y rule bends them/);
     expect(readout).toMatch(/\d+ % of vertices in rigid cores/);
+    // What the settings cost, measured in the page once it rests: the default (smooth) beside the stepped mode.
+    await expect.poll(async () => page.locator('.readout[data-view=gcs]').innerText(), { timeout: 30000 })
+      .toMatch(/cost in this page: [\d.]+ ms as set · plain \(stepped, smooth off\) [\d.]+ ms/);
   });
 
   test('both views render a lit character (not blank, many colours in each)', async () => {
