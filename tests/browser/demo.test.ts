@@ -140,8 +140,8 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     expect(readout).toMatch(/criterion weights: vertices bound 100 % to a bone move exactly with it; the paper's Y rule bends them/);
     expect(readout).toMatch(/\d+ % of vertices in rigid cores/);
     // What the settings cost, measured in the page once it rests: the default (smooth) beside the stepped mode.
-    await expect.poll(async () => page.locator('.readout[data-view=gcs]').innerText(), { timeout: 30000 })
-      .toMatch(/cost in this page: [\d.]+ ms as set · plain \(stepped, smooth off\) [\d.]+ ms/);
+    const cost = page.locator('.lil-gui .controller').filter({ has: page.locator('.name', { hasText: /^cost \/ frame$/ }) }).locator('input');
+    await expect.poll(async () => cost.inputValue(), { timeout: 30000 }).toMatch(/^[\d.]+ ms as set · [\d.]+ ms stepped$/);
   });
 
   test('both views render a lit character (not blank, many colours in each)', async () => {
