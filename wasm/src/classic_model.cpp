@@ -1380,12 +1380,13 @@ void ClassicModel::deform(const glm::mat4* skin) {
     dqsVertices(poses.data(), scale, carriedJoints.data(), carriedWeights.data(), restPositions.data(), restNormals.data(),
                 &positions[size_t(carriedFirst) * 3], &normals[size_t(carriedFirst) * 3], vertexCount - carriedFirst);
   // Tube normals: area-weighted from the deformed tube and band triangles (the bands after the
-  // carried vertices have moved). Edges are divided by the tube's extent first: the cross products
-  // of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.
+  // carried vertices have moved). Edges are divided by the extent of everything those triangles
+  // touch first (tube and carried vertices: a band reaches carried skin that may lie far away): the
+  // cross products of a ×1e20 tube overflowed (NaN normals), a ×1e-20 one's underflowed.
   float extent = 0.0f;
   if (tubeVertexCount) {
     glm::vec3 lo(positions[0], positions[1], positions[2]), hi = lo;
-    for (uint32_t v = 1; v < tubeVertexCount; ++v) {
+    for (uint32_t v = 1; v < vertexCount; ++v) {
       glm::vec3 p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
       lo = glm::min(lo, p), hi = glm::max(hi, p);
     }

@@ -199,6 +199,47 @@ struct WeightKeyHash {
   }
 };
 
+// The sections of the weights criterion from their keys, ordered by dominant joint, its rigid core
+// first, then by key (a part is contiguous); `weightOf(key, slot)` is the blend weight of the key's
+// joint in that slot (ignored for a rigid core: weight 1). Returns each key's section index.
+template <class WeightOf>
+std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<WeightKey>& keys, WeightOf weightOf) {
+  const uint32_t K = uint32_t(keys.size());
+  std::vector<uint32_t> order(K);
+  for (uint32_t k = 0; k < K; ++k) order[k] = k;
+  auto rank = [&](uint32_t k) {
+    const WeightKey& key = keys[k];
+    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
+                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
+  std::vector<uint32_t> sectionOfKey(K);
+  m.sections.resize(K);
+  m.influences.clear();
+  for (uint32_t i = 0; i < K; ++i) {
+    const uint32_t k = order[i];
+    sectionOfKey[k] = i;
+    const WeightKey& key = keys[k];
+    Section& sec = m.sections[i];
+    const uint32_t d = key.dominant();
+    sec.part = key.joint[d];
+    sec.rigid = key.n == 1;
+    sec.influenceFirst = uint32_t(m.influences.size());
+    uint32_t second = ~0u;
+    for (uint32_t s = 0; s < key.n; ++s) {
+      m.influences.push_back({key.joint[s], sec.rigid ? 1.0f : weightOf(k, s)});
+      if (s != d && (second == ~0u || key.q[s] > key.q[second])) second = s;
+    }
+    sec.influenceCount = key.n;
+    sec.distal = second == ~0u ? -1 : int32_t(key.joint[second]);
+    sec.shared = second != ~0u && key.q[second] == key.q[d];
+    sec.alpha = m.influences[sec.influenceFirst + d].weight;
+    sec.beta = second == ~0u ? 0.0f : m.influences[sec.influenceFirst + second].weight;
+    sec.t = sec.beta;
+  }
+  return sectionOfKey;
+}
+
 // A welded vertex's weights as the criterion reads them: influences below 0.5 % dropped, the
 // same joint listed twice merged, the rest normalised to sum 1.
 uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
@@ -279,42 +320,12 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
       if (s != ~0u) sums[size_t(keyOf[g]) * 4 + s] += weight[i];
     }
   }
-  // Sections ordered by dominant joint, its rigid core first, then by key: a part is contiguous.
-  std::vector<uint32_t> order(K);
-  for (uint32_t k = 0; k < K; ++k) order[k] = k;
-  auto rank = [&](uint32_t k) {
-    const WeightKey& key = keys[k];
-    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
-                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
-  std::vector<uint32_t> sectionOfKey(K);
-  m.sections.resize(K);
-  m.influences.clear();
-  for (uint32_t i = 0; i < K; ++i) {
-    const uint32_t k = order[i];
-    sectionOfKey[k] = i;
-    const WeightKey& key = keys[k];
-    Section& sec = m.sections[i];
-    const uint32_t d = key.dominant();
-    sec.part = key.joint[d];
-    sec.rigid = key.n == 1;
-    sec.influenceFirst = uint32_t(m.influences.size());
+  // Each key's blend: its members' mean weights (a rigid core: weight 1 on its joint).
+  const std::vector<uint32_t> sectionOfKey = sectionsFromKeys(m, keys, [&](uint32_t k, uint32_t slot) {
     double total = 0.0;
-    for (uint32_t s = 0; s < key.n; ++s) total += sums[size_t(k) * 4 + s];
-    uint32_t second = ~0u;
-    for (uint32_t s = 0; s < key.n; ++s) {
-      float w = sec.rigid ? 1.0f : float(sums[size_t(k) * 4 + s] / total);
-      m.influences.push_back({key.joint[s], w});
-      if (s != d && (second == ~0u || key.q[s] > key.q[second])) second = s;
-    }
-    sec.influenceCount = key.n;
-    sec.distal = second == ~0u ? -1 : int32_t(key.joint[second]);
-    sec.shared = second != ~0u && key.q[second] == key.q[d];
-    sec.alpha = m.influences[sec.influenceFirst + d].weight;
-    sec.beta = second == ~0u ? 0.0f : m.influences[sec.influenceFirst + second].weight;
-    sec.t = sec.beta;
-  }
+    for (uint32_t t = 0; t < keys[k].n; ++t) total += sums[size_t(k) * 4 + t];
+    return float(sums[size_t(k) * 4 + slot] / total);
+  });
   sectionOfGroup.resize(G);
   for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = sectionOfKey[keyOf[g]];
   m.partCount = 0;
@@ -393,40 +404,11 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
       blendOfGroup[g] = frac;
     }
   }
-  // Sections ordered by dominant joint, its rigid core first, then by key: a part is contiguous.
+  // Each node's blend: exactly its key's weights.
+  const std::vector<uint32_t> sectionOfKey = sectionsFromKeys(m, keys, [&](uint32_t k, uint32_t slot) {
+    return float(keys[k].q[slot]) / float(total);
+  });
   const uint32_t K = uint32_t(keys.size());
-  std::vector<uint32_t> order(K);
-  for (uint32_t k = 0; k < K; ++k) order[k] = k;
-  auto rank = [&](uint32_t k) {
-    const WeightKey& key = keys[k];
-    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
-                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
-  std::vector<uint32_t> sectionOfKey(K);
-  m.sections.resize(K);
-  m.influences.clear();
-  for (uint32_t i = 0; i < K; ++i) {
-    const uint32_t k = order[i];
-    sectionOfKey[k] = i;
-    const WeightKey& key = keys[k];
-    Section& sec = m.sections[i];
-    const uint32_t d = key.dominant();
-    sec.part = key.joint[d];
-    sec.rigid = key.n == 1;
-    sec.influenceFirst = uint32_t(m.influences.size());
-    uint32_t second = ~0u;
-    for (uint32_t t = 0; t < key.n; ++t) {
-      m.influences.push_back({key.joint[t], sec.rigid ? 1.0f : float(key.q[t]) / float(total)});
-      if (t != d && (second == ~0u || key.q[t] > key.q[second])) second = t;
-    }
-    sec.influenceCount = key.n;
-    sec.distal = second == ~0u ? -1 : int32_t(key.joint[second]);
-    sec.shared = second != ~0u && key.q[second] == key.q[d];
-    sec.alpha = m.influences[sec.influenceFirst + d].weight;
-    sec.beta = second == ~0u ? 0.0f : m.influences[sec.influenceFirst + second].weight;
-    sec.t = sec.beta;
-  }
   sectionOfGroup.resize(G);
   otherOfGroup.resize(G);
   for (uint32_t g = 0; g < G; ++g) {

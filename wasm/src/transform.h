@@ -293,6 +293,15 @@ inline v128_t normalise3(v128_t v) {
   v128_t sum = wasm_f32x4_add(t, wasm_i32x4_shuffle(t, t, 2, 3, 0, 1));
   return wasm_f32x4_div(v, wasm_f32x4_sqrt(wasm_f32x4_max(sum, wasm_f32x4_splat(1e-30f))));
 }
+// v (4th lane 0) scaled to unit length when it is already near unit (a blend of rotations less than
+// 35° apart): 1/sqrt(1 + e) ≈ 1 − e/2 + 3e²/8 with e = |v|² − 1 (error < 3e-4 there), no square root
+// or division. The constants are passed in so that loops keep them in registers.
+inline v128_t nearUnit(v128_t v, v128_t one, v128_t minusHalf, v128_t threeEighths) {
+  v128_t sq = wasm_f32x4_mul(v, v);
+  v128_t s2 = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+  v128_t e = wasm_f32x4_sub(wasm_f32x4_add(s2, wasm_i32x4_shuffle(s2, s2, 2, 3, 0, 1)), one);
+  return wasm_f32x4_mul(v, wasm_f32x4_add(one, wasm_f32x4_mul(e, wasm_f32x4_add(minusHalf, wasm_f32x4_mul(threeEighths, e)))));
+}
 #endif
 
 // A normal the transform has annihilated (a flattening scale maps some directions to 0) keeps
@@ -370,12 +379,7 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
     v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
     if (NearRotation) {
-      v128_t sq = wasm_f32x4_mul(rn, rn);
-      v128_t s2 = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
-      v128_t e = wasm_f32x4_sub(wasm_f32x4_add(s2, wasm_i32x4_shuffle(s2, s2, 2, 3, 0, 1)), one);  // |n|² − 1
-      // 1/sqrt(1 + e) ≈ 1 − e/2 + 3e²/8
-      rn = wasm_f32x4_mul(rn, wasm_f32x4_add(one, wasm_f32x4_mul(e, wasm_f32x4_add(half, wasm_f32x4_mul(c38, e)))));
-      wasm_v128_store(outNrm + 3 * i, rn);
+      wasm_v128_store(outNrm + 3 * i, nearUnit(rn, one, half, c38));
     } else {
       wasm_v128_store(outNrm + 3 * i, normalise3(rn));
       keepUnit(outNrm + 3 * i, inNrm + 3 * i);
@@ -420,12 +424,8 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
     const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, d2)), c3 = wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
     // The 4th lane of c0..c2 is 0 (affine matrices), so the normal's 4th lane stays 0 for the sums below.
-    v128_t rn = wasm_f32x4_mul(affine(c0, c1, c2, zero, inNrm + 3 * i), inv);
-    v128_t sq = wasm_f32x4_mul(rn, rn);
-    v128_t s2 = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
-    v128_t e = wasm_f32x4_sub(wasm_f32x4_add(s2, wasm_i32x4_shuffle(s2, s2, 2, 3, 0, 1)), one);  // |n|² − 1
-    rn = wasm_f32x4_mul(rn, wasm_f32x4_add(one, wasm_f32x4_mul(e, wasm_f32x4_add(half, wasm_f32x4_mul(c38, e)))));
-    wasm_v128_store(outNrm + 3 * i, rn);
+    const v128_t rn = wasm_f32x4_mul(affine(c0, c1, c2, zero, inNrm + 3 * i), inv);
+    wasm_v128_store(outNrm + 3 * i, nearUnit(rn, one, half, c38));
   }
 #else
   for (uint32_t i = 0; i < count; ++i) {
