@@ -353,7 +353,7 @@ function initGui(): void {
   sectionsController = g.add(params, 'sections', 3, 48, 1).name('sections').onChange(() => { pendingGcs = true; });
   g.add(params, 'smooth').name('smooth (no steps)').onChange(() => { pendingGcs = true; });
   const cost = g.add(costShown, 'text').name('cost / frame').disable();
-  cost.domElement.title = 'deform time of the model as set, and of the stepped one (smooth off) at the same sections, measured in this page';
+  cost.domElement.title = 'ms per frame of the model as set, and of the stepped one (smooth off) at the same sections, measured in this page';
   costController = cost;
   paperOnlyControllers = [
     g.add(params, 'influenceWidth', 0.05, 1, 0.05).name('influence width').onChange(() => { pendingGcs = true; }),
@@ -937,8 +937,8 @@ function scheduleCostMeasure(ch: Character): void {
 function showCost(): void {
   const f = (v: number) => (v < 10 ? v.toFixed(2) : v.toFixed(1));
   costShown.text = !settingCost ? 'measuring…'
-    : Number.isNaN(settingCost.plain) ? `${f(settingCost.current)} ms as set`
-    : `${f(settingCost.current)} ms as set · ${f(settingCost.plain)} ms stepped`;
+    : Number.isNaN(settingCost.plain) ? `${f(settingCost.current)} ms`
+    : `${f(settingCost.current)} ms · stepped ${f(settingCost.plain)}`;
   costController?.updateDisplay();
 }
 
