@@ -428,22 +428,8 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
     wasm_v128_store(outNrm + 3 * i, nearUnit(rn, one, half, c38));
   }
 #else
-  for (uint32_t i = 0; i < count; ++i) {
-    const float t = f[i];
-    const float* p = inPos + 3 * i;
-    const float* n = inNrm + 3 * i;
-    for (int r = 0; r < 3; ++r) {
-      float v = 0.0f, w = 0.0f;
-      for (int c = 0; c < 3; ++c) {
-        const float m = pa[c][r] + t * (pb[c][r] - pa[c][r]);
-        v += m * p[c];
-        w += m * n[c];
-      }
-      outPos[3 * i + r] = v + pa[3][r] + t * (pb[3][r] - pa[3][r]);
-      outNrm[3 * i + r] = w * invS;
-    }
-    normaliseInPlace(outNrm + 3 * i);
-  }
+  // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
+  blendRunT<false>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm, outPos, outNrm, count);
 #endif
 }
 

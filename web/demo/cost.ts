@@ -2,6 +2,7 @@
 // plain (stepped) one at the same section count, measured in the page (not a constant that could
 // go stale), so the readout can say what smooth blending and the section count cost.
 import type { GcsOptions } from '../lib/index.js';
+import { identitySkin } from '../lib/measure.js';
 import type { SkinDeformer } from '../lib/three.js';
 
 export interface SettingCost {
@@ -34,9 +35,7 @@ export function measureSettingCost(skins: readonly SkinDeformer[], options: GcsO
   let current = 0, plain = 0;
   const byWeights = (options.criterion ?? 'weights') === 'weights';
   for (const s of skins) {
-    const J = s.deformer.jointCount;
-    const identity = new Float32Array(16 * J);
-    for (let j = 0; j < J; j++) identity[16 * j] = identity[16 * j + 5] = identity[16 * j + 10] = identity[16 * j + 15] = 1;
+    const identity = identitySkin(s.deformer.jointCount);
     // Scratch models: timing the live one would leave the bind pose on screen.
     const same = s.rig.buildGcs(options);
     const stepped = byWeights ? s.rig.buildGcs({ ...options, smooth: false }) : null;

@@ -93,19 +93,27 @@ export function countNonFinite(...arrays: ArrayLike<number>[]): number {
  * seams): pairs [first of group, other member], flattened. `rest` is xyz per output vertex.
  */
 export function coincidentPairs(rest: ArrayLike<number>): Uint32Array {
+  const weld = weldByPosition(rest);
+  const pairs: number[] = [];
+  for (let v = 0; v < weld.length; v++) if (weld[v] !== v) pairs.push(weld[v], v);
+  return Uint32Array.from(pairs);
+}
+
+/** For each vertex, the first vertex at exactly its rest position (itself when none comes before). */
+export function weldByPosition(rest: ArrayLike<number>): Uint32Array {
   const n = Math.floor(rest.length / 3);
   const f = new Float32Array(3);
   const u = new Uint32Array(f.buffer);
   const seen = new Map<string, number>();
-  const pairs: number[] = [];
+  const weld = new Uint32Array(n);
   for (let v = 0; v < n; v++) {
     f[0] = rest[3 * v] + 0; f[1] = rest[3 * v + 1] + 0; f[2] = rest[3 * v + 2] + 0; // +0 folds -0
     const key = `${u[0]},${u[1]},${u[2]}`;
-    const first = seen.get(key);
-    if (first === undefined) seen.set(key, v);
-    else pairs.push(first, v);
+    const at = seen.get(key);
+    if (at === undefined) seen.set(key, v);
+    weld[v] = at ?? v;
   }
-  return Uint32Array.from(pairs);
+  return weld;
 }
 
 /** Largest distance between vertices that coincide at rest (0 = no seam opens). NaN counts as infinite. */
@@ -560,17 +568,7 @@ export const CREASE_DEGREES = 20;
  */
 export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>): { a: Uint32Array; b: Uint32Array } {
   const n = Math.floor(rest.length / 3);
-  const weld = new Uint32Array(n);
-  const f = new Float32Array(3);
-  const u = new Uint32Array(f.buffer);
-  const seen = new Map<string, number>();
-  for (let v = 0; v < n; v++) {
-    f[0] = rest[3 * v] + 0; f[1] = rest[3 * v + 1] + 0; f[2] = rest[3 * v + 2] + 0;
-    const key = `${u[0]},${u[1]},${u[2]}`;
-    const at = seen.get(key);
-    if (at === undefined) seen.set(key, v);
-    weld[v] = at ?? v;
-  }
+  const weld = weldByPosition(rest);
   // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
   const first = new Map<number, number>();
   const second = new Map<number, number>();
