@@ -13,7 +13,7 @@ renderer.setPixelRatio(1);
 document.body.append(renderer.domElement);
 
 /** Renders one method at the run clip's time t; returns the canvas as a PNG data URL. */
-async function shot(method: DeformerKind, gcs: GcsOptions, t: number): Promise<string> {
+async function shot(method: DeformerKind, gcs: GcsOptions, t: number, bone: string, offset: readonly number[]): Promise<string> {
   const core = await ready;
   const human = createHuman();
   const scene = new THREE.Scene();
@@ -32,11 +32,12 @@ async function shot(method: DeformerKind, gcs: GcsOptions, t: number): Promise<s
   mixer.setTime(t);
   group.updateMatrixWorld(true);
   character.update();
-  // The camera looks at the inside of the right elbow from the front and a little to the side.
-  const elbow = human.mesh.skeleton.bones.find((b) => b.name === 'RightForeArm')!;
-  const at = elbow.getWorldPosition(new THREE.Vector3());
+  // The camera looks at the joint (by default the inside of the right elbow, from the front and a
+  // little to the side).
+  const joint = human.mesh.skeleton.bones.find((b) => b.name === bone)!;
+  const at = joint.getWorldPosition(new THREE.Vector3());
   const camera = new THREE.PerspectiveCamera(30, W / H, 0.01, 10);
-  camera.position.copy(at).add(new THREE.Vector3(-0.3, 0.0, 0.25));
+  camera.position.copy(at).add(new THREE.Vector3(offset[0], offset[1], offset[2]));
   camera.lookAt(at);
   renderer.render(scene, camera);
   const url = renderer.domElement.toDataURL('image/png');
@@ -58,8 +59,11 @@ async function pixels(url: string): Promise<Uint8ClampedArray> {
  * The default GCS, DQS and plain GCS at time t: the share of the character's pixels (not
  * background in either picture) that differ from DQS's by more than 8/255 in a channel.
  */
-async function compare(t: number): Promise<{ coverage: number; defaultVsDqs: number; plainVsDqs: number; shots: Record<string, string> }> {
-  const shots = { gcs: await shot('gcs', {}, t), dqs: await shot('dqs', {}, t), plain: await shot('gcs', { smooth: false }, t) };
+async function compare(t: number, bone = 'RightForeArm', offset: readonly number[] = [-0.3, 0, 0.25]): Promise<{ coverage: number; defaultVsDqs: number; plainVsDqs: number; shots: Record<string, string> }> {
+  const shots = {
+    gcs: await shot('gcs', {}, t, bone, offset), dqs: await shot('dqs', {}, t, bone, offset),
+    plain: await shot('gcs', { smooth: false }, t, bone, offset),
+  };
   const [a, d, p] = await Promise.all([pixels(shots.gcs), pixels(shots.dqs), pixels(shots.plain)]);
   const bg = (x: Uint8ClampedArray, i: number) => x[i] === 0x20 && x[i + 1] === 0x24 && x[i + 2] === 0x28;
   const differs = (x: Uint8ClampedArray, y: Uint8ClampedArray, i: number) =>
