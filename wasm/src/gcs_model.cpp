@@ -149,6 +149,12 @@ void finishModel(GcsDeformerImpl& m) {
   uint32_t most = 1;
   for (const Section& sec : m.sections) most = std::max(most, sec.influenceCount);
   m.blendPoseScratch.resize(most);
+  m.blendedSections.clear();
+  for (uint32_t i = 0; i < S; ++i)
+    if (m.settings.criterion == GCS_CRITERION_WEIGHTS && !m.sections[i].rigid) m.blendedSections.push_back(i);
+  const size_t padded = (m.blendedSections.size() + 3) / 4 * 4;
+  m.nodeReal.assign(padded, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  m.nodeDual.assign(padded, glm::vec4(0.0f));
   std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
   std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
 }
@@ -765,6 +771,9 @@ glm::mat4 rigidInverse(const glm::mat4& m) {
 // Weights criterion: each section's transform is the dual-quaternion blend of its joints at its
 // mean weights (a rigid core: S_j itself). O(sections × influences).
 void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale) {
+#if defined(__wasm_simd128__)
+  if (scale.uniform) return sectionTransformsWeightsUniform(skin, scale.s);
+#endif
   const uint32_t S = uint32_t(sections.size());
   for (uint32_t i = 0; i < S; ++i) {
     const Section& sec = sections[i];
@@ -785,6 +794,95 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const Scal
     renormalise[i] = renorm;
   }
 }
+
+#if defined(__wasm_simd128__)
+
+// The same blends as sectionTransformsWeights when every scale is s·I (the common case), in SIMD:
+// each blended section's dual quaternion accumulated in two registers, then four sections at a
+// time turned into matrices (one lane each), with the very formulas of blendPoses.
+void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, float s) {
+  const uint32_t S = uint32_t(sections.size());
+  const v128_t signBit = wasm_f32x4_splat(-0.0f);
+  uint32_t b = 0;
+  for (uint32_t i = 0; i < S; ++i) {
+    const Section& sec = sections[i];
+    renormalise[i] = 0;
+    if (sec.rigid) {
+      sectionMatrices[i] = skin[sec.part];
+      normalMatrices[i] = poses[sec.part].normal;
+      continue;
+    }
+    const Influence* in = &influences[sec.influenceFirst];
+    const v128_t pivot = wasm_v128_load(&poses[in[0].joint].real);
+    const v128_t w0 = wasm_f32x4_splat(in[0].weight);
+    v128_t br = wasm_f32x4_mul(w0, pivot), bd = wasm_f32x4_mul(w0, wasm_v128_load(&poses[in[0].joint].dual));
+    for (uint32_t k = 1; k < sec.influenceCount; ++k) {
+      const JointPose& p = poses[in[k].joint];
+      const v128_t r = wasm_v128_load(&p.real);
+      v128_t dot = wasm_f32x4_mul(r, pivot);
+      dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 1, 0, 3, 2));
+      dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 2, 3, 0, 1));
+      // The weight, negated when the quaternion lies in the other hemisphere (dot < 0).
+      const v128_t w = wasm_v128_xor(wasm_f32x4_splat(in[k].weight), wasm_v128_and(dot, signBit));
+      br = wasm_f32x4_add(br, wasm_f32x4_mul(w, r));
+      bd = wasm_f32x4_add(bd, wasm_f32x4_mul(w, wasm_v128_load(&p.dual)));
+    }
+    wasm_v128_store(&nodeReal[b], br);
+    wasm_v128_store(&nodeDual[b], bd);
+    ++b;
+  }
+  const uint32_t B = b;
+  const v128_t one = wasm_f32x4_splat(1.0f), two = wasm_f32x4_splat(2.0f), scale = wasm_f32x4_splat(s);
+  const v128_t zero = wasm_f32x4_splat(0.0f);
+  for (uint32_t g = 0; g < B; g += 4) {
+    v128_t x = wasm_v128_load(&nodeReal[g]), y = wasm_v128_load(&nodeReal[g + 1]);
+    v128_t z = wasm_v128_load(&nodeReal[g + 2]), w = wasm_v128_load(&nodeReal[g + 3]);
+    transpose4(x, y, z, w);
+    v128_t dx = wasm_v128_load(&nodeDual[g]), dy = wasm_v128_load(&nodeDual[g + 1]);
+    v128_t dz = wasm_v128_load(&nodeDual[g + 2]), dw = wasm_v128_load(&nodeDual[g + 3]);
+    transpose4(dx, dy, dz, dw);
+    const v128_t inv2 = wasm_f32x4_div(
+        one, wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(x, x), wasm_f32x4_mul(y, y)),
+                            wasm_f32x4_add(wasm_f32x4_mul(z, z), wasm_f32x4_mul(w, w))));
+    const v128_t k2 = wasm_f32x4_mul(two, inv2);
+    const v128_t xx = wasm_f32x4_mul(x, x), yy = wasm_f32x4_mul(y, y), zz = wasm_f32x4_mul(z, z);
+    const v128_t xy = wasm_f32x4_mul(x, y), xz = wasm_f32x4_mul(x, z), yz = wasm_f32x4_mul(y, z);
+    const v128_t wx = wasm_f32x4_mul(w, x), wy = wasm_f32x4_mul(w, y), wz = wasm_f32x4_mul(w, z);
+    auto oneMinus = [&](v128_t a, v128_t b2) { return wasm_f32x4_sub(one, wasm_f32x4_mul(k2, wasm_f32x4_add(a, b2))); };
+    auto times = [&](v128_t a) { return wasm_f32x4_mul(k2, a); };
+    // Rows of the transposed blocks: entry (row r of column c) for the four sections.
+    v128_t c00 = oneMinus(yy, zz), c01 = times(wasm_f32x4_add(xy, wz)), c02 = times(wasm_f32x4_sub(xz, wy)), c03 = zero;
+    v128_t c10 = times(wasm_f32x4_sub(xy, wz)), c11 = oneMinus(xx, zz), c12 = times(wasm_f32x4_add(yz, wx)), c13 = zero;
+    v128_t c20 = times(wasm_f32x4_add(xz, wy)), c21 = times(wasm_f32x4_sub(yz, wx)), c22 = oneMinus(xx, yy), c23 = zero;
+    // t = 2·(w·d − dw·r − d × r)/|r|² (the vector part of 2·bd·conj(br)/|br|²).
+    auto tRow = [&](v128_t wd, v128_t dwr, v128_t crossA, v128_t crossB) {
+      return wasm_f32x4_mul(k2, wasm_f32x4_sub(wasm_f32x4_sub(wasm_f32x4_mul(w, wd), wasm_f32x4_mul(dw, dwr)),
+                                               wasm_f32x4_sub(crossA, crossB)));
+    };
+    v128_t t0 = tRow(dx, x, wasm_f32x4_mul(dy, z), wasm_f32x4_mul(y, dz));
+    v128_t t1 = tRow(dy, y, wasm_f32x4_mul(dz, x), wasm_f32x4_mul(z, dx));
+    v128_t t2 = tRow(dz, z, wasm_f32x4_mul(dx, y), wasm_f32x4_mul(x, dy));
+    v128_t t3 = one;
+    transpose4(c00, c01, c02, c03);
+    transpose4(c10, c11, c12, c13);
+    transpose4(c20, c21, c22, c23);
+    transpose4(t0, t1, t2, t3);
+    const v128_t normalCol[3][4] = {{c00, c01, c02, c03}, {c10, c11, c12, c13}, {c20, c21, c22, c23}};
+    const v128_t translation[4] = {t0, t1, t2, t3};
+    for (uint32_t k = 0; k < 4 && g + k < B; ++k) {
+      const uint32_t i = blendedSections[g + k];
+      float* n = &normalMatrices[i][0][0];
+      float* m = &sectionMatrices[i][0][0];
+      for (int c = 0; c < 3; ++c) {
+        wasm_v128_store(n + 4 * c, normalCol[c][k]);
+        wasm_v128_store(m + 4 * c, wasm_f32x4_mul(scale, normalCol[c][k]));
+      }
+      wasm_v128_store(n + 12, zero);
+      wasm_v128_store(m + 12, translation[k]);
+    }
+  }
+}
+#endif
 
 // The paper's rule (Y and axial criteria): M = S_p · D_j^α · D_k^β on the rigid parts of the skin
 // matrices, then the section's scale (the same blend of the joints' scales) applied first.

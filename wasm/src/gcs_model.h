@@ -91,6 +91,10 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<glm::mat4> normalMatrices;    // normal transform of each section (3×3 in a mat4)
   std::vector<uint8_t> renormalise;         // normals of the section need renormalising
   std::vector<const JointPose*> blendPoseScratch;
+  // Weights criterion, uniform scale: the blended sections' dual quaternions (real, dual), four
+  // sections converted to matrices at a time; blendedSections lists them (padded to a multiple of 4).
+  std::vector<glm::vec4> nodeReal, nodeDual;
+  std::vector<uint32_t> blendedSections;
   std::vector<glm::mat4> lastSkin;          // the last frame's S_j, for the adjusted statistic
   ScaleState frameScale;                    // what the last frame's scales have in common
   mutable uint32_t adjustedSections = 0;
@@ -99,6 +103,7 @@ class GcsDeformerImpl final : public Deformer {
  private:
   uint32_t countAdjusted() const;
   void sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale);
+  void sectionTransformsWeightsUniform(const glm::mat4* skin, float s);
   void sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale);
 };
 

@@ -274,6 +274,13 @@ inline void swingTwist(const glm::quat& q, const glm::vec3& axis, glm::quat& swi
 }
 
 #if defined(__wasm_simd128__)
+// The 4×4 transpose of rows a, b, c, d (lane k of the result i is lane i of row k).
+inline void transpose4(v128_t& a, v128_t& b, v128_t& c, v128_t& d) {
+  const v128_t ab0 = wasm_i32x4_shuffle(a, b, 0, 4, 1, 5), ab1 = wasm_i32x4_shuffle(a, b, 2, 6, 3, 7);
+  const v128_t cd0 = wasm_i32x4_shuffle(c, d, 0, 4, 1, 5), cd1 = wasm_i32x4_shuffle(c, d, 2, 6, 3, 7);
+  a = wasm_i32x4_shuffle(ab0, cd0, 0, 1, 4, 5), b = wasm_i32x4_shuffle(ab0, cd0, 2, 3, 6, 7);
+  c = wasm_i32x4_shuffle(ab1, cd1, 0, 1, 4, 5), d = wasm_i32x4_shuffle(ab1, cd1, 2, 3, 6, 7);
+}
 // x·c0 + y·c1 + z·c2 (+ c3) of the 3 floats at p, in one SIMD register (4th lane unused).
 inline v128_t affine(v128_t c0, v128_t c1, v128_t c2, v128_t c3, const float* p) {
   return wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(p)),
@@ -416,16 +423,25 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
   const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
   const v128_t d0 = wasm_f32x4_sub(wasm_v128_load(&pb[0][0]), a0), d1 = wasm_f32x4_sub(wasm_v128_load(&pb[1][0]), a1);
   const v128_t d2 = wasm_f32x4_sub(wasm_v128_load(&pb[2][0]), a2), d3 = wasm_f32x4_sub(wasm_v128_load(&pb[3][0]), a3);
-  const v128_t zero = wasm_f32x4_splat(0.0f), inv = wasm_f32x4_splat(invS);
-  const v128_t one = wasm_f32x4_splat(1.0f), half = wasm_f32x4_splat(-0.5f), c38 = wasm_f32x4_splat(0.375f);
+  // 1/|v| for |v|² = x near s²: invS·(1 − e/2 + 3e²/8), e = x/s² − 1, as a polynomial in x (three
+  // constants, so that the loop's live values fit the registers).
+  const float k = invS * invS;
+  const v128_t p0 = wasm_f32x4_splat(1.875f * invS), p1 = wasm_f32x4_splat(-1.25f * invS * k);
+  const v128_t p2 = wasm_f32x4_splat(0.375f * invS * k * k);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i);
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
-    const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, d2)), c3 = wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3));
-    wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
+    const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, d2));
+    const float* n = inNrm + 3 * i;
     // The 4th lane of c0..c2 is 0 (affine matrices), so the normal's 4th lane stays 0 for the sums below.
-    const v128_t rn = wasm_f32x4_mul(affine(c0, c1, c2, zero, inNrm + 3 * i), inv);
-    wasm_v128_store(outNrm + 3 * i, nearUnit(rn, one, half, c38));
+    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
+                                                    wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
+                                     wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
+    wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3)), inPos + 3 * i));
+    v128_t sq = wasm_f32x4_mul(rn, rn);
+    sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+    sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
+    wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
   }
 #else
   // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
