@@ -72,6 +72,33 @@ export function timeFrames(frameCount: number, step: (frame: number) => void, op
   return { medianMs: median(samples), p95Ms: percentile(samples, 95), samples: samples.length };
 }
 
+/**
+ * Times several steps in turn, one call each per round, so that whatever else the machine does
+ * lands on all of them alike: their ratios hold on a shared, noisy host where timings taken one
+ * after the other do not. Each step cycles over `frameCount` frames. Returns one Timing per step.
+ */
+export function timeInterleaved(frameCount: number, steps: ((frame: number) => void)[], options: TimingOptions = {}): Timing[] {
+  const minSamples = options.minSamples ?? 200;
+  const minMs = options.minMs ?? 150;
+  const maxMs = options.maxMs ?? 3000;
+  const warmup = options.warmup ?? frameCount;
+  for (let i = 0; i < warmup; i++) for (const step of steps) step(i % frameCount);
+  const samples: number[][] = steps.map(() => []);
+  const start = performance.now();
+  for (let i = 0; ; i++) {
+    let t1 = 0;
+    steps.forEach((step, k) => {
+      const t0 = performance.now();
+      step(i % frameCount);
+      t1 = performance.now();
+      samples[k].push(t1 - t0);
+    });
+    const elapsed = t1 - start;
+    if ((samples[0].length >= minSamples && elapsed >= minMs) || elapsed >= maxMs) break;
+  }
+  return samples.map((s) => ({ medianMs: median(s), p95Ms: percentile(s, 95), samples: s.length }));
+}
+
 // ------------------------------------------------------------------------------------ small helpers
 
 /** J identity matrices: the skin matrices of the bind pose. */

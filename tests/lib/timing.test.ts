@@ -1,0 +1,34 @@
+// The timing helpers of gcs-skin/measure: what they call and how often (no wall-clock assertions:
+// those flake on shared hosts; the benchmark prints the figures).
+import { describe, expect, test } from 'vitest';
+import { timeFrames, timeInterleaved } from '../../web/lib/measure.js';
+
+describe('timeInterleaved', () => {
+  test('calls every step once per round, in turn, cycling over the frames', () => {
+    const calls: string[] = [];
+    const timings = timeInterleaved(3, [(f) => calls.push(`a${f}`), (f) => calls.push(`b${f}`)], { minSamples: 5, minMs: 0, warmup: 2 });
+    expect(timings).toHaveLength(2);
+    // Warm-up: two rounds, then the timed rounds alternate a, b on the same frame.
+    expect(calls.slice(0, 4)).toEqual(['a0', 'b0', 'a1', 'b1']);
+    expect(calls.slice(4, 10)).toEqual(['a0', 'b0', 'a1', 'b1', 'a2', 'b2']);
+    expect(timings[0].samples).toBe(timings[1].samples);
+    expect(timings[0].samples).toBeGreaterThanOrEqual(5);
+    expect(calls.length).toBe(4 + 2 * timings[0].samples);
+    for (const t of timings) expect(t.p95Ms).toBeGreaterThanOrEqual(t.medianMs);
+  });
+
+  test('stops at maxMs whatever the sample count', () => {
+    const t = timeInterleaved(1, [() => { const end = performance.now() + 2; while (performance.now() < end); }], { minSamples: 1e9, maxMs: 30, warmup: 0 });
+    expect(t[0].samples).toBeGreaterThan(0);
+    expect(t[0].samples).toBeLessThan(100);
+  });
+});
+
+describe('timeFrames', () => {
+  test('cycles over the frames after the warm-up', () => {
+    const frames: number[] = [];
+    const t = timeFrames(4, (f) => frames.push(f), { minSamples: 6, minMs: 0, warmup: 4 });
+    expect(frames.slice(0, 10)).toEqual([0, 1, 2, 3, 0, 1, 2, 3, 0, 1]);
+    expect(t.samples).toBe(frames.length - 4);
+  });
+});
