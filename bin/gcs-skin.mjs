@@ -33,7 +33,8 @@ if (bin) {
 } else {
   const { version } = JSON.parse(readFileSync(new URL('../package.json', import.meta.url), 'utf8'));
   process.stderr.write(`gcs-skin: the command line is the package ${CLI}; running ${CLI}@${version} through npm exec (npm install -D ${CLI} keeps it at hand)\n`);
-  const args = ['exec', '--yes', `--package=${CLI}@${version}`, '--', 'gcs-skin', ...process.argv.slice(2)];
+  // No --yes: npm asks on a terminal (or refuses where the user's npmrc says yes=false), as npx did for gcs-skin.
+  const args = ['exec', `--package=${CLI}@${version}`, '--', 'gcs-skin', ...process.argv.slice(2)];
   const env = { ...process.env, [FETCHED]: '1' };
   // Under npx/npm exec, npm_execpath is the npm that runs us: use the same one.
   const npmCli = process.env.npm_execpath?.endsWith('npm-cli.js') ? process.env.npm_execpath : null;
