@@ -162,6 +162,8 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
     writeFileSync(join(app, 'src/main.ts'), `import { installTestHook } from './test-hook';\n${example}\n${hook}\n`);
     const plain = example.split('\n').filter((l) => !GCS_SKIN_LINE.test(l.replace(/\/\/.*$/, ''))).join('\n');
     writeFileSync(join(app, 'src/reference.ts'), `import { installTestHook } from './test-hook';\n${plain}\n${hook.replace('character }', 'character: null }')}\n`);
+    const page = readFileSync(join(app, 'index.html'), 'utf8');
+    writeFileSync(join(app, 'reference.html'), page.replace('/src/main.ts', '/src/reference.ts'));
     const [webgpu] = readmeBlocks('### With WebGPURenderer', 'ts');
     writeFileSync(join(app, 'src/webgpu.ts'), webgpu);
 
