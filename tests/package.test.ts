@@ -271,6 +271,15 @@ function removeNpxInstalls(env: NodeJS.ProcessEnv, version: string) {
   }
 }
 
+test('without its peer three (npm --legacy-peer-deps, as yarn berry installs), the command line names the missing package', () => {
+  const a = app('no-peer');
+  install(a, '--legacy-peer-deps', packed.cli);
+  expect(existsSync(join(a, 'node_modules/three'))).toBe(false);
+  const r = spawnSync(npx, ['gcs-skin', 'human', '-o', 'h.glb'], { cwd: a, env: userEnv(), encoding: 'utf8' });
+  expect(r.status).toBe(1);
+  expect(r.stderr.trim()).toBe("gcs-skin: cannot load human: the package 'three' is not installed; install it beside @gcs-skin/cli (npm install three)");
+}, 240000);
+
 test('a three.js app with its own three gets no second copy', () => {
   const a = app('three-app');
   install(a, 'three@0.170.0');

@@ -30,7 +30,7 @@ if (cmd === '-h' || cmd === '--help') {
     // install it) or a missing build (a git checkout before `npm run build:lib`).
     const pkg = e?.code === 'ERR_MODULE_NOT_FOUND' && /Cannot find package '([^']+)'/.exec(e.message)?.[1];
     process.stderr.write(pkg
-      ? `gcs-skin: cannot load ${cmd}: the package '${pkg}' is not installed; install it beside gcs-skin (npm install ${pkg})\n`
+      ? `gcs-skin: cannot load ${cmd}: the package '${pkg}' is not installed; install it beside @gcs-skin/cli (npm install ${pkg})\n`
       : `gcs-skin: cannot load ${SUBCOMMANDS[cmd].module} (${e.message}); run 'npm run build:lib' first\n`);
     process.exit(1);
   }
