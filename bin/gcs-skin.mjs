@@ -1,36 +1,46 @@
 #!/usr/bin/env node
-// gcs-skin command line: a table of subcommands, each a module (built into ../dist by
-// `npm run build:lib`) exporting `run(argv) → Promise<exit code>` and `usage`.
-const SUBCOMMANDS = {
-  human: { module: '../dist/human/cli.js', about: 'write the default human character (mesh, skin, clips) as .glb' },
-  report: { module: '../dist/cli/report.js', about: 'build every deformer on a glTF skinned model and report counts, timings, fidelity' },
-};
+// `gcs-skin <command>` from the library package. The command line and its glTF readers are the
+// package @gcs-skin/cli, so that `npm install gcs-skin` stays lean; `npx gcs-skin report` fetches
+// this package (npx runs the bin of the package named like the command), and this file hands the
+// arguments to @gcs-skin/cli's bin: the one installed beside gcs-skin or in the current project,
+// else the same version fetched with `npm exec` (as `eslint --init` runs `npm init @eslint/config`).
+import { spawnSync } from 'node:child_process';
+import { readFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { dirname, join } from 'node:path';
+import { pathToFileURL } from 'node:url';
 
-function usage() {
-  const w = Math.max(...Object.keys(SUBCOMMANDS).map((k) => k.length));
-  return ['usage: gcs-skin <command> [options]', 'commands:',
-    ...Object.entries(SUBCOMMANDS).map(([k, v]) => `  ${k.padEnd(w)}  ${v.about}`),
-    "run 'gcs-skin <command> --help' for a command's options"].join('\n');
+const CLI = '@gcs-skin/cli';
+const FETCHED = 'GCS_SKIN_CLI_FETCHED'; // set for the fetched CLI: never fetch twice
+
+/** The path of @gcs-skin/cli's bin, resolved beside this package or from the current folder; null when absent. */
+function installedCli() {
+  for (const from of [import.meta.url, join(process.cwd(), 'package.json')]) {
+    try {
+      const manifest = createRequire(from).resolve(`${CLI}/package.json`);
+      return join(dirname(manifest), JSON.parse(readFileSync(manifest, 'utf8')).bin['gcs-skin']);
+    } catch { /* not there */ }
+  }
+  return null;
 }
 
-const [cmd, ...rest] = process.argv.slice(2);
-if (cmd === '-h' || cmd === '--help') {
-  console.log(usage());
-} else if (!cmd || !Object.hasOwn(SUBCOMMANDS, cmd)) {
-  process.stderr.write(`gcs-skin: ${cmd ? `unknown command '${cmd}'` : 'missing command'}\n${usage()}\n`);
-  process.exitCode = 2;
+const bin = installedCli();
+if (bin) {
+  await import(pathToFileURL(bin).href); // it reads process.argv: the same arguments
+} else if (process.env[FETCHED]) {
+  process.stderr.write(`gcs-skin: npm exec ran without ${CLI}; install it (npm install ${CLI})\n`);
+  process.exitCode = 1;
 } else {
-  let mod;
-  try {
-    mod = await import(new URL(SUBCOMMANDS[cmd].module, import.meta.url).href);
-  } catch (e) {
-    // A missing package (three is a peer dependency: yarn berry, or npm --legacy-peer-deps, does not
-    // install it) or a missing build (a git checkout before `npm run build:lib`).
-    const pkg = e?.code === 'ERR_MODULE_NOT_FOUND' && /Cannot find package '([^']+)'/.exec(e.message)?.[1];
-    process.stderr.write(pkg
-      ? `gcs-skin: cannot load ${cmd}: the package '${pkg}' is not installed; install it beside gcs-skin (npm install ${pkg})\n`
-      : `gcs-skin: cannot load ${SUBCOMMANDS[cmd].module} (${e.message}); run 'npm run build:lib' first\n`);
-    process.exit(1);
-  }
-  process.exitCode = await mod.run(rest);
+  const { version } = JSON.parse(readFileSync(new URL('../package.json', import.meta.url), 'utf8'));
+  process.stderr.write(`gcs-skin: the command line is the package ${CLI}; running ${CLI}@${version} through npm exec (npm install -D ${CLI} keeps it at hand)\n`);
+  // No --yes: npm asks on a terminal (or refuses where the user's npmrc says yes=false), as npx did for gcs-skin.
+  const args = ['exec', `--package=${CLI}@${version}`, '--', 'gcs-skin', ...process.argv.slice(2)];
+  const env = { ...process.env, [FETCHED]: '1' };
+  // Under npx/npm exec, npm_execpath is the npm that runs us: use the same one.
+  const npmCli = process.env.npm_execpath?.endsWith('npm-cli.js') ? process.env.npm_execpath : null;
+  const r = npmCli
+    ? spawnSync(process.execPath, [npmCli, ...args], { stdio: 'inherit', env })
+    : spawnSync(process.platform === 'win32' ? 'npm.cmd' : 'npm', args, { stdio: 'inherit', env, shell: process.platform === 'win32' });
+  if (r.error) process.stderr.write(`gcs-skin: cannot run npm (${r.error.message}); install ${CLI} and run its gcs-skin\n`);
+  process.exitCode = r.status ?? 1;
 }

@@ -1,29 +1,35 @@
-// Packaging: the `npm pack` tarball, installed into an empty folder, imports and deforms in node
-// through the package's `exports` map (no access to this repository's sources); its command line
-// works there with nothing else installed (three, a peer dependency, is installed by npm ≥ 7),
-// reads compressed glTF files, and `gcs-skin/gltf` poses a character for `initGcsSkin`. In a
-// three.js app that has its own three, the install adds no second copy.
-import { execFileSync, spawnSync } from 'node:child_process';
-import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+// Packaging: the two `npm pack` tarballs, installed into empty folders (no access to this
+// repository's sources). A library user's `npm install gcs-skin three` gets gcs-skin and three and
+// nothing else (the sizes are printed), imports and deforms in node through the `exports` map;
+// with @gcs-skin/cli beside it the command line reads compressed glTF files and
+// `@gcs-skin/cli/gltf` poses a character; `npx gcs-skin report` works from an empty folder with
+// nothing installed (both packages served by a local registry, as if published); and a three.js
+// app that has its own three gets no second copy.
+import { execFileSync, spawn, spawnSync } from 'node:child_process';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import { NodeIO } from '@gltf-transform/core';
 import { EXTMeshoptCompression, KHRMeshQuantization } from '@gltf-transform/extensions';
 import { meshopt, quantize } from '@gltf-transform/functions';
 import { MeshoptEncoder } from 'meshoptimizer';
+import { npm, packTarballs, ROOT, sizeOf, userEnv, type Tarballs } from './helpers/pack.js';
+import { startRegistry, upstreamRegistry } from './helpers/registry.js';
+// @ts-expect-error: a plain .mjs script, no types
+import { installedSizes } from '../scripts/install-size.mjs';
 
-const root = resolve(__dirname, '..');
-const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
 const npx = process.platform === 'win32' ? 'npx.cmd' : 'npx';
+/** The readers only the command line needs: a library user must not get them. */
+const CLI_ONLY = ['@gltf-transform/core', '@gltf-transform/extensions', 'draco3dgltf', 'meshoptimizer', 'ktx-parse', 'property-graph'];
 let dir: string;
-let tarball: string;
+let packed: Tarballs;
 
 /** npm install in `cwd`; asserts success and that no install script of gcs-skin runs or is warned about. */
 function install(cwd: string, ...specs: string[]) {
-  const r = spawnSync(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', '--foreground-scripts', ...specs], { cwd, encoding: 'utf8' });
+  const r = spawnSync(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', '--foreground-scripts', ...specs], { cwd, env: userEnv(), encoding: 'utf8' });
   expect(r.status, r.stderr).toBe(0);
-  expect(`${r.stdout}\n${r.stderr}`).not.toMatch(/gcs-skin@[^\n]*(prepare|install|postinstall)|install script/i);
+  expect(`${r.stdout}\n${r.stderr}`).not.toMatch(/gcs-skin[^\n]*(prepare|install|postinstall)|install script/i);
   return r;
 }
 
@@ -35,32 +41,45 @@ function app(name: string): string {
   return a;
 }
 
+const versionOf = (pkg: string) => JSON.parse(readFileSync(join(ROOT, 'node_modules', pkg, 'package.json'), 'utf8')).version as string;
+const lastJson = (out: string) => JSON.parse(out.trim().split('\n').pop()!);
+
 beforeAll(() => {
   dir = mkdtempSync(join(tmpdir(), 'gcs-skin-pack-'));
-  // Pack from a copy of the package sources: `prepack` rebuilds dist/ there, never under the
-  // feet of other test files that use this checkout's dist/.
-  const src = join(dir, 'src');
-  for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
-    cpSync(join(root, entry), join(src, entry), { recursive: true });
-  symlinkSync(join(root, 'node_modules'), join(src, 'node_modules'));
-  execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: src, stdio: ['ignore', 'pipe', 'pipe'] });
-  const name = readdirSync(dir).find((f) => f.endsWith('.tgz'));
-  expect(name).toBeDefined();
-  tarball = join(dir, name!);
+  // A version no earlier run left in npm's npx cache (npx reuses an install of the same version).
+  const base = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')).version;
+  packed = packTarballs(dir, `${base}-test.${Date.now()}`);
 }, 240000);
 afterAll(() => rmSync(dir, { recursive: true, force: true }));
 
-describe('the npm tarball, alone in an empty folder', () => {
+describe("a library user: `npm install gcs-skin three` in an empty folder", () => {
   let a: string;
   beforeAll(() => {
     a = app('app');
-    install(a, tarball);
+    install(a, packed.library, `three@${versionOf('three')}`);
   }, 240000);
+
+  test('installs gcs-skin and three, nothing else (sizes printed), and none of the command line', () => {
+    const sizes = installedSizes(a) as { packages: Record<string, number>; total: number };
+    console.log(`package sizes: ${JSON.stringify({
+      tarballs: { 'gcs-skin': sizeOf(packed.library), '@gcs-skin/cli': sizeOf(packed.cli) },
+      'npm install gcs-skin three': sizes,
+    })}`);
+    expect(Object.keys(sizes.packages).sort()).toEqual(['gcs-skin', 'three']);
+    for (const name of CLI_ONLY) expect(existsSync(join(a, 'node_modules', name)), name).toBe(false);
+    // The library's files only: no command-line modules (they are @gcs-skin/cli's).
+    expect(existsSync(join(a, 'node_modules/gcs-skin/dist/cli'))).toBe(false);
+    expect(existsSync(join(a, 'node_modules/gcs-skin/dist/human/cli.js'))).toBe(false);
+    expect(existsSync(join(a, 'node_modules/gcs-skin/dist/gcs-skin.wasm'))).toBe(true);
+    const manifest = JSON.parse(readFileSync(join(a, 'node_modules/gcs-skin/package.json'), 'utf8'));
+    expect(manifest.sideEffects).toBe(false);
+    expect(manifest.dependencies ?? {}).toEqual({});
+  });
 
   test('installs with no install script, its peer three once, and imports and deforms', () => {
     const installed = JSON.parse(readFileSync(join(a, 'node_modules/gcs-skin/package.json'), 'utf8'));
     expect(Object.keys(installed.scripts ?? {}).filter((k) => /^(pre|post)?install$|^prepare$/.test(k))).toEqual([]);
-    // three: installed by npm as gcs-skin's peer, at the top, once.
+    // three: the app's, at the top, once (no copy under gcs-skin).
     expect(existsSync(join(a, 'node_modules/three/package.json'))).toBe(true);
     expect(existsSync(join(a, 'node_modules/gcs-skin/node_modules/three'))).toBe(false);
     // The MIT licence its package.json names, as a file.
@@ -68,8 +87,6 @@ describe('the npm tarball, alone in an empty folder', () => {
     expect(readFileSync(join(a, 'node_modules/gcs-skin/LICENSE'), 'utf8')).toMatch(/^MIT License\n[\s\S]*Permission is hereby granted, free of charge/);
     // The types carry no @internal members.
     expect(readFileSync(join(a, 'node_modules/gcs-skin/dist/index.d.ts'), 'utf8')).not.toMatch(/@internal|refreshViews|copyIn/);
-    // gcs-skin/gltf's types show nothing of three.
-    expect(readFileSync(join(a, 'node_modules/gcs-skin/dist/cli/gltf.d.ts'), 'utf8')).not.toMatch(/three/i);
     writeFileSync(join(a, 'main.mjs'), `
     import { initGcsSkin, GcsError } from 'gcs-skin';
     const gcs = await initGcsSkin();
@@ -94,7 +111,7 @@ describe('the npm tarball, alone in an empty folder', () => {
     try { rig.buildGcs({ sections: 1 }); } catch (e) { code = e instanceof GcsError ? e.code : String(e); }
     console.log(JSON.stringify({ vertices: d.vertexCount, sections: d.sectionCount, paperSections: paper.sectionCount, first: Array.from(d.positions.slice(0, 3)), code }));
   `);
-    const out = execFileSync(process.execPath, ['main.mjs'], { cwd: a, encoding: 'utf8' });
+    const out = execFileSync(process.execPath, ['main.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' });
     const result = JSON.parse(out.trim().split('\n').pop()!);
     expect(result.vertices).toBe(16);
     expect(result.sections).toBe(2); // weights criterion: two rigid cores (every weight is 1.0)
@@ -113,17 +130,41 @@ describe('the npm tarball, alone in an empty folder', () => {
       subclasses: webgpu.GcsCharacter.prototype instanceof three.GcsCharacter && webgpu.GcsCrowd.prototype instanceof crowd.GcsCrowd && webgpu.SkinDeformer.prototype instanceof three.SkinDeformer,
     }));
   `);
-    const result = JSON.parse(execFileSync(process.execPath, ['webgpu.mjs'], { cwd: a, encoding: 'utf8' }).trim().split('\n').pop()!);
+    const result = JSON.parse(execFileSync(process.execPath, ['webgpu.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' }).trim().split('\n').pop()!);
     expect(result.names).toEqual(expect.arrayContaining(['GcsCharacter', 'GcsCrowd', 'SkinDeformer', 'bakeClip', 'writeSkinMatrices']));
     expect(result.subclasses).toBe(true);
     for (const file of ['webgpu.d.ts', 'three.d.ts', 'crowd.d.ts'])
       expect(readFileSync(join(a, 'node_modules/gcs-skin/dist', file), 'utf8')).not.toMatch(/@internal|gpuKit\?:|warned\?:/);
   });
 
+  test('gcs-skin/human builds a character in the lean install; humanToGlb names the package it needs', () => {
+    writeFileSync(join(a, 'human.mjs'), `
+    import { createHuman, humanToGlb } from 'gcs-skin/human';
+    const human = createHuman({ vertices: 2000 });
+    let code = null, message = '';
+    try { await humanToGlb(human); } catch (e) { code = e.code; message = e.message; }
+    console.log(JSON.stringify({ vertices: human.mesh.geometry.getAttribute('position').count, code, message }));
+  `);
+    const r = lastJson(execFileSync(process.execPath, ['human.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' }));
+    expect(r.vertices).toBeGreaterThan(1900);
+    expect(r.code).toBe('MISSING_PACKAGE');
+    expect(r.message).toMatch(/@gltf-transform\/core/);
+  });
+});
+
+describe('the command line: `npm install -D @gcs-skin/cli` beside it', () => {
+  let a: string;
+  beforeAll(() => {
+    a = app('cli-app');
+    install(a, packed.library, `three@${versionOf('three')}`);
+    install(a, '-D', packed.cli);
+  }, 240000);
+
   test('npx gcs-skin human, then npx gcs-skin report on meshopt-compressed and quantized copies', async () => {
-    const human = spawnSync(npx, ['gcs-skin', 'human', '--vertices', '3000', '-o', 'h.glb'], { cwd: a, encoding: 'utf8' });
+    const human = spawnSync(npx, ['gcs-skin', 'human', '--vertices', '3000', '-o', 'h.glb'], { cwd: a, env: userEnv(), encoding: 'utf8' });
     expect(human.status, human.stderr).toBe(0);
     expect(human.stdout).toMatch(/^wrote h\.glb: \d+ vertices/);
+    expect(human.stderr).not.toContain('npm exec'); // the installed @gcs-skin/cli, not a fetched one
     // The compressed copies are written with this checkout's gltf-transform (a devDependency).
     await MeshoptEncoder.ready;
     const io = new NodeIO().registerExtensions([KHRMeshQuantization, EXTMeshoptCompression]).registerDependencies({ 'meshopt.encoder': MeshoptEncoder });
@@ -134,20 +175,22 @@ describe('the npm tarball, alone in an empty folder', () => {
       await io.write(join(a, name), doc);
     }
     for (const file of ['h-meshopt.glb', 'h-quantized.glb']) {
-      const r = spawnSync(npx, ['gcs-skin', 'report', file, '--clip', 'walk', '--frames', '6', '--time-ms', '5', '--json'], { cwd: a, encoding: 'utf8' });
+      const r = spawnSync(npx, ['gcs-skin', 'report', file, '--clip', 'walk', '--frames', '6', '--time-ms', '5', '--json'], { cwd: a, env: userEnv(), encoding: 'utf8' });
       expect(r.status, `${file}: ${r.stderr}`).toBe(0);
       const report = JSON.parse(r.stdout);
       expect(report.meshes[0].counts.vertices).toBeGreaterThan(2900);
       expect(report.meshes[0].methods.gcs.fidelity.nonFinite).toBe(0);
       expect(report.meshes[0].methods.gcs.fidelity.dqsP95).toBeLessThan(1);
     }
+    // @gcs-skin/cli/gltf's types show nothing of three.
+    expect(readFileSync(join(a, 'node_modules/@gcs-skin/cli/dist/cli/gltf.d.ts'), 'utf8')).not.toMatch(/three/i);
   }, 120000);
 
-  test('gcs-skin/gltf poses a character and initGcsSkin deforms it', () => {
+  test('@gcs-skin/cli/gltf poses a character and initGcsSkin deforms it', () => {
     // The ten-line example of docs/node.md.
     writeFileSync(join(a, 'pose.mjs'), `
     import { initGcsSkin } from 'gcs-skin';
-    import { loadCharacter } from 'gcs-skin/gltf';
+    import { loadCharacter } from '@gcs-skin/cli/gltf';
     const gcs = await initGcsSkin();
     const character = await loadCharacter('h-meshopt.glb');
     const { rigInput, clip, height } = character.meshes[0];
@@ -156,8 +199,7 @@ describe('the npm tarball, alone in an empty folder', () => {
     deformer.deform(walk.sample(0.5 * walk.duration));
     console.log(JSON.stringify({ finite: deformer.positions.every(Number.isFinite), sections: deformer.sectionCount, height, clips: character.clipNames }));
   `);
-    const out = execFileSync(process.execPath, ['pose.mjs'], { cwd: a, encoding: 'utf8' });
-    const r = JSON.parse(out.trim().split('\n').pop()!);
+    const r = lastJson(execFileSync(process.execPath, ['pose.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' }));
     expect(r.finite).toBe(true);
     expect(r.sections).toBeGreaterThan(0);
     expect(r.height).toBeGreaterThan(1.5);
@@ -165,19 +207,93 @@ describe('the npm tarball, alone in an empty folder', () => {
   });
 });
 
+describe('`npx gcs-skin report` in an empty folder, nothing installed (a local registry serves both packages)', () => {
+  let reason: string | null = null;
+  beforeAll(async () => {
+    try {
+      const r = await fetch(`${upstreamRegistry()}three`, { method: 'HEAD', signal: AbortSignal.timeout(10000) });
+      if (!r.ok) reason = `the registry answered ${r.status}`;
+    } catch (e) {
+      reason = `no registry to fetch three and the readers from (${(e as Error).message})`;
+    }
+    if (reason) console.log(`npx test skipped: ${reason}`);
+  }, 20000);
+
+  test('npx fetches gcs-skin, whose bin fetches @gcs-skin/cli of the same version: human, then report', async (ctx) => {
+    if (reason) ctx.skip();
+    const registry = await startRegistry([packed.library, packed.cli]);
+    const empty = join(dir, 'empty');
+    mkdirSync(empty);
+    // npx asks before it installs (on a terminal; elsewhere it warns and goes on, unless an npmrc
+    // says yes=false, as this machine's does): the user's answer is yes.
+    const env = userEnv({ npm_config_registry: registry.url, npm_config_yes: 'true', npm_config_prefer_offline: 'true', npm_config_update_notifier: 'false' });
+    try {
+      const t0 = performance.now();
+      // As typed by a user.
+      const human = await run(npx, ['gcs-skin', 'human', '--vertices', '3000', '-o', 'h.glb'], { cwd: empty, env });
+      expect(human.status, human.stderr).toBe(0);
+      expect(human.stdout).toMatch(/^wrote h\.glb: \d+ vertices/);
+      expect(human.stderr).toContain(`@gcs-skin/cli@${packed.version} through npm exec`);
+      const report = await run(npx, ['gcs-skin', 'report', 'h.glb', '--frames', '4', '--time-ms', '5', '--json'], { cwd: empty, env });
+      expect(report.status, report.stderr).toBe(0);
+      const json = JSON.parse(report.stdout);
+      expect(json.meshes[0].counts.vertices).toBeGreaterThan(2900);
+      expect(json.meshes[0].methods.gcs.fidelity.nonFinite).toBe(0);
+      console.log(`npx gcs-skin human + report from an empty folder: ${Math.round(performance.now() - t0)} ms`);
+      expect(readdirSync(empty)).toEqual(['h.glb']); // nothing installed in the folder
+      expect(registry.served).toEqual(expect.arrayContaining(['gcs-skin', '@gcs-skin/cli']));
+    } finally {
+      await registry.close();
+      removeNpxInstalls(env, packed.version);
+    }
+  }, 240000);
+});
+
+/** A child process, awaited without blocking this process's event loop (the local registry answers from it). */
+function run(cmd: string, args: string[], options: { cwd: string; env: NodeJS.ProcessEnv }): Promise<{ status: number | null; stdout: string; stderr: string }> {
+  return new Promise((resolveRun, reject) => {
+    const child = spawn(cmd, args, { ...options, stdio: ['ignore', 'pipe', 'pipe'] });
+    let stdout = '', stderr = '';
+    child.stdout.on('data', (d) => (stdout += d));
+    child.stderr.on('data', (d) => (stderr += d));
+    child.once('error', reject);
+    child.once('close', (status) => resolveRun({ status, stdout, stderr }));
+  });
+}
+
+/** Removes the npx cache's installs of this run's test version (npm keeps them in <cache>/_npx). */
+function removeNpxInstalls(env: NodeJS.ProcessEnv, version: string) {
+  const npxCache = join(execFileSync(npm, ['config', 'get', 'cache'], { env, encoding: 'utf8' }).trim(), '_npx');
+  if (!existsSync(npxCache)) return;
+  for (const entry of readdirSync(npxCache)) {
+    const manifest = join(npxCache, entry, 'package.json');
+    if (existsSync(manifest) && readFileSync(manifest, 'utf8').includes(version)) rmSync(join(npxCache, entry), { recursive: true, force: true });
+  }
+}
+
+test('without its peer three (npm --legacy-peer-deps, as yarn berry installs), the command line names the missing package', () => {
+  const a = app('no-peer');
+  install(a, '--legacy-peer-deps', packed.cli);
+  expect(existsSync(join(a, 'node_modules/three'))).toBe(false);
+  const r = spawnSync(npx, ['gcs-skin', 'human', '-o', 'h.glb'], { cwd: a, env: userEnv(), encoding: 'utf8' });
+  expect(r.status).toBe(1);
+  expect(r.stderr.trim()).toBe("gcs-skin: cannot load human: the package 'three' is not installed; install it beside @gcs-skin/cli (npm install three)");
+}, 240000);
+
 test('a three.js app with its own three gets no second copy', () => {
   const a = app('three-app');
   install(a, 'three@0.170.0');
-  install(a, tarball);
+  install(a, packed.library, packed.cli);
   expect(JSON.parse(readFileSync(join(a, 'node_modules/three/package.json'), 'utf8')).version).toBe('0.170.0');
-  expect(existsSync(join(a, 'node_modules/gcs-skin/node_modules/three'))).toBe(false);
-  const tree = spawnSync(npm, ['ls', 'three', '--all', '--parseable'], { cwd: a, encoding: 'utf8' });
+  for (const pkg of ['gcs-skin', '@gcs-skin/cli']) expect(existsSync(join(a, 'node_modules', pkg, 'node_modules/three'))).toBe(false);
+  const tree = spawnSync(npm, ['ls', 'three', '--all', '--parseable'], { cwd: a, env: userEnv(), encoding: 'utf8' });
   expect(tree.stdout.trim().split('\n').filter((l) => l.endsWith('/three'))).toEqual([join(a, 'node_modules/three')]);
-  // And the adapter runs with that three.
+  // And the library and the command line's module run with that three.
   writeFileSync(join(a, 'main.mjs'), `
     import * as THREE from 'three';
-    import { loadCharacter } from 'gcs-skin/gltf';
+    import { GcsCharacter } from 'gcs-skin/three';
+    import { loadCharacter } from '@gcs-skin/cli/gltf';
     console.log(THREE.REVISION);
   `);
-  expect(execFileSync(process.execPath, ['main.mjs'], { cwd: a, encoding: 'utf8' }).trim()).toBe('170');
+  expect(execFileSync(process.execPath, ['main.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' }).trim()).toBe('170');
 }, 240000);

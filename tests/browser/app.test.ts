@@ -1,25 +1,33 @@
-// The issue's acceptance test: the README's GcsCharacter example, as an app outside this
-// repository would use it. The library is packed into a tarball (from a copy of its sources, so
-// `prepack` builds there), a fresh Vite + TypeScript app is made in a temp folder with its own
-// package.json (vite, typescript, three, @types/three at this repo's versions, the tarball as a
-// dependency; nothing points into this repo), its src/main.ts (tests/browser/app-fixture) is the
-// README example adapted to draw a known scene. It must type-check with `tsc --noEmit --strict`,
-// build with `vite build` and, served by `vite preview` in headless Chromium, draw:
-// - with GcsCharacter 'lbs', the same picture as three.js's own SkinnedMesh (pixels);
+// The issue's acceptance test: the README's "Using it with three.js" path, followed to the letter
+// by a newcomer outside this repository. Both packages are packed into tarballs (from a copy of
+// their sources, so `prepack` builds there). A fresh Vite + TypeScript app is made in a temp folder
+// as create-vite 9.3.0's vanilla-ts template makes it (tests/browser/app-fixture: its index.html,
+// without the template's favicon, and its tsconfig.json; vite and typescript at this repo's
+// versions); then each `npm install` line of the README's sh block runs there as written, the
+// package `gcs-skin` taken from its tarball and every other from this repo's versions (nothing
+// else is installed: a package the README forgets, like @types/three, fails `tsc`); src/main.ts is
+// the README's ts block itself, between one import and one call of a test hook
+// (app-fixture/src/test-hook.ts: a known scene, fixed clip times, switches). It must type-check
+// with `tsc --noEmit --strict`, build with `vite build` and, served by `vite preview` in headless
+// Chromium, draw:
+// - with GcsCharacter 'lbs', the same picture as three.js's own SkinnedMesh (reference.html: the
+//   README's block without its gcs-skin lines);
 // - shadows on the ground under the character, both ways;
-// - with GCS (the default), the character at the same place (silhouette overlap);
+// - with GCS (the README's method), the character at the same place (silhouette overlap);
 // and keep doing it through a clip change, rebuilds ('gcs' → 'dqs' → 'gcs') and dispose (then
-// the original SkinnedMeshes draw again, the same pixels as three's), with no page or WebGL error.
-// Characters from ../shared/models, copied into the temp app at test time only (skipped, with the
-// reason printed, when absent): Soldier (two skinned meshes on their own skeletons) and
-// CesiumMan (textured).
-import { execFileSync, spawn, spawnSync, type ChildProcess } from 'node:child_process';
-import { copyFileSync, cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+// the original SkinnedMeshes draw again, the same pixels as three's), with no page or WebGL error,
+// with no scrollbar (the page needs no CSS the README does not show). The README's WebGPURenderer
+// block is type-checked in the same app. Characters from ../shared/models, served to the page as
+// the README's 'character.glb' (never copied into the repository; skipped, with the reason
+// printed, when absent): Soldier (two skinned meshes on their own skeletons) and CesiumMan (textured).
+import { spawn, spawnSync, type ChildProcess } from 'node:child_process';
+import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
+import { packTarballs, userEnv } from '../helpers/pack.js';
 import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
@@ -62,23 +70,32 @@ const SILHOUETTE_IOU = 0.93;
  */
 const SHADOW_MIN = 0.1;
 
-/**
- * Lines of the README example that the fixture replaces (code only, comments stripped): the
- * file name (?model=), the method (?method=, 'three' = no GcsCharacter), the clip (?clip=) and
- * THREE.Timer (a fixed time). Every other line of the README's block must be in src/main.ts.
- */
-const REPLACED = [
-  "const gltf = await new GLTFLoader().loadAsync('character.glb');",
-  "const character = new GcsCharacter(gcs, gltf.scene, { method: 'gcs', gcs: { sections: 8 } });",
-  'const clip = gltf.animations[0];',
-  'const timer = new THREE.Timer();',
-  'timer.connect(document);',
-  'renderer.setAnimationLoop((time: number) => {',
-  'timer.update(time);',
-  'mixer.update(timer.getDelta());',
-  'character.update();',
-  '});',
-];
+/** The README's fenced blocks of a language under a heading (up to the next heading of that level or higher). */
+function readmeBlocks(heading: string, lang: string): string[] {
+  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
+  const start = readme.indexOf(`\n${heading}\n`);
+  if (start < 0) throw new Error(`README.md has no heading "${heading}"`);
+  const level = /^#+/.exec(heading)![0].length;
+  const rest = readme.slice(start + heading.length + 2);
+  const end = rest.search(new RegExp(`\\n#{1,${level}} `));
+  const section = end < 0 ? rest : rest.slice(0, end);
+  return [...section.matchAll(new RegExp(`\`\`\`${lang}\\n([\\s\\S]*?)\`\`\``, 'g'))].map((m) => m[1]);
+}
+
+const USING = '## Using it with three.js';
+/** The README's install commands: `npm install [-D] names…` lines of its sh block, comments dropped. */
+function readmeInstalls(): { flags: string[]; names: string[] }[] {
+  const sh = readmeBlocks(USING, 'sh');
+  if (sh.length !== 1) throw new Error(`expected one sh block under "${USING}", found ${sh.length}`);
+  return sh[0].split('\n').map((l) => l.replace(/#.*$/, '').trim()).filter(Boolean).map((line) => {
+    const words = line.split(/\s+/);
+    if (words[0] !== 'npm' || !['install', 'i', 'add'].includes(words[1])) throw new Error(`not an npm install line: ${line}`);
+    return { flags: words.slice(2).filter((w) => w.startsWith('-')), names: words.slice(2).filter((w) => !w.startsWith('-')) };
+  });
+}
+
+/** Lines of the README's example that need gcs-skin: left out of the three.js reference page. */
+const GCS_SKIN_LINE = /gcs-skin|GcsCharacter|\bgcs\b|\bcharacter\.(update|rebuild|dispose)\(/;
 
 function versionOf(pkg: string): string {
   return JSON.parse(readFileSync(join(ROOT, 'node_modules', pkg, 'package.json'), 'utf8')).version;
@@ -106,7 +123,7 @@ const missing = CHARACTERS.filter((c) => !existsSync(join(MODELS_DIR, c.file))).
 if (missing.length) console.log(`app test: ${missing.join(', ')} not in ${MODELS_DIR}: those characters are skipped`);
 
 function run(cmd: string, args: string[], cwd: string): string {
-  const r = spawnSync(cmd, args, { cwd, encoding: 'utf8', env: { ...process.env, NO_COLOR: '1' } });
+  const r = spawnSync(cmd, args, { cwd, encoding: 'utf8', env: userEnv({ NO_COLOR: '1' }) });
   if (r.status !== 0) throw new Error(`${cmd} ${args.join(' ')} failed (${r.status}):\n${r.stdout}\n${r.stderr}`);
   return r.stdout;
 }
@@ -123,29 +140,32 @@ function timed<T>(name: string, f: () => T): T {
 describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (installed tarball)', () => {
   beforeAll(async () => {
     dir = mkdtempSync(join(tmpdir(), 'gcs-skin-app-'));
-    // Pack from a copy of the package sources (as tests/package.test.ts): `prepack` builds dist/ there.
-    const src = join(dir, 'src');
-    for (const entry of ['package.json', 'tsconfig.json', 'README.md', 'bin', 'docs/node.md', 'docs/report-json.md', 'web/lib', 'wasm/include', 'scripts/build-lib.mjs'])
-      if (existsSync(join(ROOT, entry))) cpSync(join(ROOT, entry), join(src, entry), { recursive: true });
-    symlinkSync(join(ROOT, 'node_modules'), join(src, 'node_modules'));
-    timed('pack', () => execFileSync(npm, ['pack', '--silent', '--pack-destination', dir], { cwd: src, stdio: ['ignore', 'pipe', 'pipe'] }));
-    const tarball = readdirSync(dir).find((f) => f.endsWith('.tgz'));
-    if (!tarball) throw new Error('npm pack wrote no tarball');
-    rmSync(src, { recursive: true, force: true });
+    const packed = timed('pack', () => packTarballs(dir));
 
-    // The app: the fixture (index.html, tsconfig.json, src/main.ts) and its own package.json.
+    // The app as create-vite writes it, with no dependency but its tools.
     app = join(dir, 'app');
     cpSync(join(ROOT, 'tests/browser/app-fixture'), app, { recursive: true });
     writeFileSync(join(app, 'package.json'), JSON.stringify({
-      name: 'gcs-skin-app', private: true, type: 'module',
-      scripts: { build: 'tsc --noEmit --strict && vite build', preview: 'vite preview' },
-      dependencies: { 'gcs-skin': `file:../${tarball}`, three: versionOf('three') },
-      devDependencies: { vite: versionOf('vite'), typescript: versionOf('typescript'), '@types/three': versionOf('@types/three') },
+      name: 'vite-typescript-starter', private: true, version: '0.0.0', type: 'module',
+      scripts: { dev: 'vite', build: 'tsc && vite build', preview: 'vite preview' },
+      devDependencies: { typescript: versionOf('typescript'), vite: versionOf('vite') },
     }, null, 2));
     timed('install', () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline'], app));
-    // The characters, copied at test time only (never into the repository).
-    mkdirSync(join(app, 'public'), { recursive: true });
-    for (const c of CHARACTERS) if (!missing.includes(c.file)) copyFileSync(join(MODELS_DIR, c.file), join(app, 'public', c.file));
+    // The README's install lines, as written: gcs-skin from its tarball, any other at this repo's version.
+    for (const { flags, names } of readmeInstalls()) {
+      const specs = names.map((n) => (n === 'gcs-skin' ? packed.library : n === '@gcs-skin/cli' ? packed.cli : `${n}@${versionOf(n)}`));
+      timed(`npm install ${[...flags, ...names].join(' ')}`, () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', ...flags, ...specs], app));
+    }
+    // The README's example itself, and the same without gcs-skin for the reference page.
+    const [example] = readmeBlocks(USING, 'ts');
+    const hook = 'installTestHook({ renderer, scene, camera, gltf, mixer, character });';
+    writeFileSync(join(app, 'src/main.ts'), `import { installTestHook } from './test-hook';\n${example}\n${hook}\n`);
+    const plain = example.split('\n').filter((l) => !GCS_SKIN_LINE.test(l.replace(/\/\/.*$/, ''))).join('\n');
+    writeFileSync(join(app, 'src/reference.ts'), `import { installTestHook } from './test-hook';\n${plain}\n${hook.replace('character }', 'character: null }')}\n`);
+    const page = readFileSync(join(app, 'index.html'), 'utf8');
+    writeFileSync(join(app, 'reference.html'), page.replace('/src/main.ts', '/src/reference.ts'));
+    const [webgpu] = readmeBlocks('### With WebGPURenderer', 'ts');
+    writeFileSync(join(app, 'src/webgpu.ts'), webgpu);
 
     const port = await freePort();
     preview = spawn(join(app, 'node_modules/.bin/vite'), ['preview', '--host', '127.0.0.1', '--port', String(port), '--strictPort'], {
@@ -172,6 +192,7 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
     expect(assets.some((f) => /^gcs-skin.*\.wasm$/.test(f)), assets.join(' ')).toBe(true);
     // The app resolved the installed package, not this checkout.
     expect(existsSync(join(app, 'node_modules/gcs-skin/dist/three.js'))).toBe(true);
+    expect(existsSync(join(app, 'node_modules/@gltf-transform')), 'a library user got the glTF readers').toBe(false);
     expect(readFileSync(join(app, 'package.json'), 'utf8')).not.toContain(ROOT);
     for (const f of assets.filter((a) => a.endsWith('.js'))) expect(readFileSync(join(app, 'dist/assets', f), 'utf8')).not.toContain(ROOT);
   }, 120000);
@@ -189,10 +210,12 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       const steps: Record<string, number> = {};
       let last = t0;
       const lap = (name: string) => { const now = performance.now(); steps[name] = Math.round(now - last); last = now; };
-      const q = (method: string) => `${url}?model=${c.file}&method=${method}${c.clip ? `&clip=${c.clip}` : ''}`;
+      const clip = c.clip ? `clip=${c.clip}` : '';
+      const q = (method: string) => (method === 'three' ? `${url}reference.html?${clip}` : `${url}?method=${method}&${clip}`);
+      const model = join(MODELS_DIR, c.file);
 
       // three.js's own SkinnedMesh: the reference.
-      const three = await open(context, q('three'));
+      const three = await open(context, q('three'), model);
       lap('open three');
       expect(await three.page.evaluate(() => window.__app.deformedMeshes())).toBe(0);
       expect(await three.page.evaluate(() => window.__app.skinnedMeshes())).toBe(c.skinned);
@@ -211,7 +234,7 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       lap('three shots');
 
       // GcsCharacter, LBS: three's pixels.
-      const lbs = await open(context, q('lbs'));
+      const lbs = await open(context, q('lbs'), model);
       lap('open lbs');
       expect(await lbs.page.evaluate(() => window.__app.deformedMeshes())).toBe(c.skinned);
       const lbsFull = await shot(lbs.page, { ground: true, character: true });
@@ -219,7 +242,7 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       lap('lbs shots');
 
       // GCS (the default method): same place; then the lifecycle.
-      const gcsPage = await open(context, q('gcs'));
+      const gcsPage = await open(context, q('gcs'), model);
       const page = gcsPage.page;
       lap('open gcs');
       expect(await page.evaluate(() => window.__app.method())).toBe('gcs');
@@ -283,26 +306,16 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
   }
 });
 
-test("src/main.ts is the README's example: every line of it is there, but the ones the fixture replaces", () => {
-  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
-  const section = readme.slice(readme.indexOf('## Using it with three.js'));
-  const block = /```ts\n([\s\S]*?)```/.exec(section);
-  expect(block, 'no ```ts block under "## Using it with three.js" in README.md').not.toBeNull();
-  const code = (line: string) => line.replace(/\s+\/\/.*$/, '').trim();
-  const readmeLines = block![1].split('\n').map(code).filter((l) => l && !l.startsWith('//'));
-  const mainLines = new Set(readFileSync(join(ROOT, 'tests/browser/app-fixture/src/main.ts'), 'utf8').split('\n').map(code));
-  for (const line of REPLACED) expect(readmeLines, `REPLACED lists a line the README no longer has: ${line}`).toContain(line);
-  const absent = readmeLines.filter((l) => !mainLines.has(l) && !REPLACED.includes(l));
-  expect(absent, 'README lines missing from tests/browser/app-fixture/src/main.ts (update the fixture, or list them in REPLACED)').toEqual([]);
-});
-
-test("src/webgpu.ts is the README's WebGPURenderer example, line for line (type-checked with the app)", () => {
-  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
-  const section = readme.slice(readme.indexOf('### With WebGPURenderer'));
-  const block = /```ts\n([\s\S]*?)```/.exec(section);
-  expect(block, 'no ```ts block under "### With WebGPURenderer" in README.md').not.toBeNull();
-  const code = (text: string) => text.split('\n').filter((l) => l.trim() && !l.trim().startsWith('//'));
-  expect(code(readFileSync(join(ROOT, 'tests/browser/app-fixture/src/webgpu.ts'), 'utf8'))).toEqual(code(block![1]));
+test("the README's install lines and example are what the app is made of", () => {
+  // What the app test takes from README.md: the install lines (library, three, three's types) and
+  // an example that loads 'character.glb' and keeps `character` (the hook's one call names it).
+  const installs = readmeInstalls();
+  expect(installs.flatMap((i) => i.names)).toEqual(expect.arrayContaining(['gcs-skin', 'three', '@types/three']));
+  const [example] = readmeBlocks(USING, 'ts');
+  expect(example).toContain("loadAsync('character.glb')");
+  for (const name of ['renderer', 'scene', 'camera', 'gltf', 'mixer', 'character'])
+    expect(example, name).toMatch(new RegExp(`^const ${name} = `, 'm'));
+  expect(readmeBlocks('### With WebGPURenderer', 'ts')).toHaveLength(1);
 });
 
 async function waitForServer(address: string): Promise<void> {
@@ -338,10 +351,14 @@ declare global {
 
 /** Console warnings of every page, printed (not asserted). */
 const warnings: string[] = [];
-/** Opens the app, collects page errors, console errors and WebGL messages, waits until it draws. */
-async function open(ctx: BrowserContext, address: string): Promise<{ page: Page; errors: string[]; close(): Promise<void> }> {
+/**
+ * Opens the app with `model` served as the README's 'character.glb', collects page errors, console
+ * errors and WebGL messages, waits until it draws, and checks the page has no scrollbar.
+ */
+async function open(ctx: BrowserContext, address: string, model: string): Promise<{ page: Page; errors: string[]; close(): Promise<void> }> {
   const page = await ctx.newPage();
   await page.setViewportSize({ width: WIDTH, height: HEIGHT });
+  await page.route('**/character.glb', (route) => route.fulfill({ path: model, contentType: 'model/gltf-binary' }));
   const errors: string[] = [];
   page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
   page.on('response', (r) => { if (r.status() >= 400) errors.push(`HTTP ${r.status()} ${r.url()}`); });
@@ -353,6 +370,13 @@ async function open(ctx: BrowserContext, address: string): Promise<{ page: Page;
   await page.goto(address);
   await page.waitForFunction(() => document.title === 'ready' && window.__app?.frames() >= 2, undefined, { timeout: 60000, polling: 100 })
     .catch((e) => { throw new Error(`${address} did not draw: ${errors.join('; ') || (e as Error).message}`); });
+  // The canvas fills the window exactly: no scrollbar, no margin (the README's own style lines).
+  const layout = await page.evaluate(() => {
+    const canvas = document.querySelector('canvas')!.getBoundingClientRect();
+    const root = document.documentElement;
+    return { scrollW: root.scrollWidth, scrollH: root.scrollHeight, x: canvas.left, y: canvas.top, w: canvas.width, h: canvas.height };
+  });
+  expect(layout, address).toEqual({ scrollW: WIDTH, scrollH: HEIGHT, x: 0, y: 0, w: WIDTH, h: HEIGHT });
   return {
     page,
     errors,

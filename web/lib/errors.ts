@@ -13,7 +13,8 @@ export type GcsErrorCode =
   | 'OUT_OF_MEMORY'
   | 'DEGENERATE'
   | 'DISPOSED'
-  | 'WASM_LOAD';
+  | 'WASM_LOAD'
+  | 'MISSING_PACKAGE'; // JS only: an optional package a function needs is not installed
 
 const CODES: GcsErrorCode[] = [
   'INVALID_ARGUMENT', // 0 is OK: never thrown; index 0 stands in for an unknown code

@@ -1,5 +1,19 @@
-// GLB export of a skinned character and its clips, written with @gltf-transform/core.
+// GLB export of a skinned character and its clips, written with @gltf-transform/core: an optional
+// peer dependency of gcs-skin (installed with @gcs-skin/cli), loaded on the first call.
 import type * as THREE from 'three';
+import { GcsError } from '../errors.js';
+
+// A specifier in a variable: bundlers leave it alone, so an app that imports gcs-skin/human
+// builds without @gltf-transform/core installed.
+const GLTF_TRANSFORM = '@gltf-transform/core';
+
+async function gltfTransform(): Promise<typeof import('@gltf-transform/core')> {
+  try {
+    return await import(/* @vite-ignore */ GLTF_TRANSFORM);
+  } catch (e) {
+    throw new GcsError('MISSING_PACKAGE', `humanToGlb needs the package ${GLTF_TRANSFORM} (npm install ${GLTF_TRANSFORM}, or use @gcs-skin/cli): ${(e as Error).message}`);
+  }
+}
 
 interface HumanLike {
   mesh: THREE.SkinnedMesh;
@@ -8,7 +22,7 @@ interface HumanLike {
 
 /** Write the character (mesh, skin, skeleton, clips) as a binary glTF. */
 export async function humanToGlb(human: HumanLike): Promise<Uint8Array> {
-  const { Document, WebIO } = await import('@gltf-transform/core');
+  const { Document, WebIO } = await gltfTransform();
   const { mesh, clips } = human;
   const doc = new Document();
   doc.createScene('Scene');
