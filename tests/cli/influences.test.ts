@@ -22,7 +22,8 @@ import { loadCharacter } from '../../web/lib/cli/gltf.js';
 import { parseGlb, skinMatricesOf } from '../../web/lib/cli/gltf-node.js';
 import { formatReport, run, type Report } from '../../web/lib/cli/report.js';
 import { MODELS_DIR } from '../helpers/models.js';
-import { distances, eightInfluenceGlb, referenceDqs, referenceLbs } from '../helpers/influences.js';
+import { distances, referenceDqs, referenceLbs } from '../helpers/influences.js';
+import { eightInfluenceGlb } from '../helpers/influences-glb.js';
 
 const CESIUM = join(MODELS_DIR, 'CesiumMan.glb');
 const missing = existsSync(CESIUM) ? '' : `skipped: ${CESIUM} is absent (the shared test models are not on this machine)`;
