@@ -36,7 +36,7 @@ GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t ve
                        const float* weights, uint32_t influences, const int32_t* parents,
                        const float* inverseBind, uint32_t jointCount) {
   gcs::clearError();
-  if (vertexCount <= GCS_MAX_VERTICES && jointCount <= GCS_MAX_JOINTS && influences <= GCS_MAX_INFLUENCES &&
+  if (vertexCount <= GCS_MAX_VERTICES && jointCount <= GCS_MAX_JOINTS && influences >= 1 && influences <= GCS_MAX_INFLUENCES &&
       !gcs::reserveMemory(gcs::rigPeakBytes(vertexCount, indexCount, jointCount, influences > 4 ? 8 : 4), "the rig"))
     return nullptr;
   GcsRig* handle = new (std::nothrow) GcsRig();

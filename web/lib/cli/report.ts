@@ -290,10 +290,10 @@ export function formatReport(r: Report): string {
     const c = m.counts;
     out.push('', `mesh '${printable(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
-    out.push(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
-      (c.moreThan4Influences ? ' (three.js\'s own skinning would drop their JOINTS_1/WEIGHTS_1)' : ''));
     out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
+    out.push(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
+      (c.moreThan4Influences ? ' (three.js\'s own skinning would drop their JOINTS_1/WEIGHTS_1)' : ''));
     const lbs = m.methods.lbs?.fidelity?.flipped;
     // Creases against the baselines: the more of LBS's and DQS's count over the same frames.
     const creaseBase = Math.max(m.methods.lbs?.fidelity?.creases ?? 0, m.methods.dqs?.fidelity?.creases ?? 0);
