@@ -5,12 +5,16 @@
 // with the reason printed when absent), on both GPU paths: 'joints' (the default for this
 // criterion: the shader blends every section from the joint poses) and 'sections' (section
 // transforms computed in wasm) — and the character drawn by its own patched material looks the
-// same as on the CPU backend.
-import { existsSync } from 'node:fs';
+// same as on the CPU backend. With 8 influences per vertex (CesiumMan's weights spread onto 5–8
+// joints, written with JOINTS_1/WEIGHTS_1, tests/helpers/influences-glb.ts; the CPU result is checked
+// against an 8-influence reference in tests/lib/influences.test.ts): both paths again, the joint
+// table at 8 joints per section, and a crowd (each instance's shader output and its picture).
+import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Page } from 'playwright-core';
-import { MODELS_DIR, openFixture, skipReason, type FixturePage } from './harness.js';
+import { MODELS_DIR, openFixture, ROOT, skipReason, type FixturePage } from './harness.js';
+import { eightInfluenceGlb } from '../helpers/influences-glb.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -44,6 +48,7 @@ afterAll(async () => {
 interface Result {
   skins: number; backends: string[]; paths: string[]; anisotropy: number; notes: string[]; height: number; positionError: number; normalError: number; normalErrorRaw: number;
   motion: number; vertices: number; frames: number; pixelDiff: number[]; coverage: number; pixelMotion: number; extColorBufferFloat: boolean;
+  tableSlots: number[]; secondSet: number;
 }
 
 type Path = 'joints' | 'sections';
@@ -100,6 +105,48 @@ describe.skipIf(!!reason)('GPU backend = CPU backend (headless Chromium)', () =>
       const r = await check('human', smooth, [0.15, 0.45], 'run', 'joints', [1.3, 0.7, 1.1]);
       expect(r.anisotropy).toBeGreaterThan(1.5); // the scale reached the skin matrices (1.3 / 0.7 ≈ 1.86 along the hips' axes)
       expectEqual(r, `human scaled ${smooth ? 'smooth' : 'plain'}`, 'joints');
+    });
+  }
+});
+
+const CESIUM = join(MODELS_DIR, 'CesiumMan.glb');
+const noCesium = existsSync(CESIUM) ? '' : `skipped: ${CESIUM} is absent (the shared test models are not on this machine)`;
+if (noCesium) console.log(noCesium);
+
+describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (CesiumMan, weights spread onto 5–8 joints)', () => {
+  const file = join(ROOT, 'build', 'test-models', 'cesium-8.glb');
+  beforeAll(async () => {
+    mkdirSync(join(ROOT, 'build', 'test-models'), { recursive: true });
+    const w = await eightInfluenceGlb(CESIUM, file);
+    console.log(`${file}: ${w.overFour} of ${w.vertices} vertices with more than 4 influences`);
+  });
+
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    for (const smooth of [false, true]) {
+      const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
+      test(`GPU backend = CPU backend, ${mode}`, async () => {
+        const r = await check(`/@fs${file}`, smooth, [0.3, 0.9, 1.6], undefined, gpuPath);
+        console.log(`  table: ${r.tableSlots.join(', ')} joints per section; the second set of influences moves the skin up to ${r.secondSet.toFixed(4)} of the height`);
+        expectEqual(r, `CesiumMan 8 influences ${mode}`, gpuPath);
+        expect(r.tableSlots).toEqual([gpuPath === 'joints' ? 8 : 4]);
+        // What the GPU matches is the 8-influence result: cut to 4 it would be off by far more than the tolerance.
+        expect(r.secondSet).toBeGreaterThan(100 * POSITION_TOLERANCE);
+      });
+    }
+  }
+
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    test(`a crowd of 3 (${gpuPath} path): each instance's shader output = the CPU on its own pose; instance 0 drawn = the CPU backend's picture`, async () => {
+      const r = await page!.evaluate(([f, p]) => (window as unknown as { __gpu: { crowd(a: string, b: number[], c?: string, d?: string): Promise<{ path: string; tableSlots: number; instances: number; positionError: number; pixelDiff: number; coverage: number }> } })
+        .__gpu.crowd(f, [0.3, 0.9, 1.6], undefined, p), [`/@fs${file}`, gpuPath] as const);
+      console.log(`crowd of ${r.instances}, ${r.path} path (table ${r.tableSlots} joints per section): GPU − CPU ≤ ${r.positionError.toExponential(2)} of the height; ` +
+        `instance 0 vs the CPU picture ${(100 * r.pixelDiff).toFixed(3)} % of pixels (character covers ${(100 * r.coverage).toFixed(1)} %)`);
+      expect(r.path).toBe(gpuPath);
+      expect(r.tableSlots).toBe(gpuPath === 'joints' ? 8 : 4);
+      expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
+      expect(r.coverage).toBeGreaterThan(0.02);
+      expect(r.pixelDiff).toBeLessThan(PIXEL_TOLERANCE);
+      expect(errors).toEqual([]);
     });
   }
 });

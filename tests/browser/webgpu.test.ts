@@ -5,12 +5,15 @@
 //   plain and smooth: ≤ 1 % of the pixels differ by more than 8/255, and the pose differs from
 //   the rest pose; GLSL (gcs-skin/three, WebGLRenderer) vs TSL (gcs-skin/webgpu, WebGPURenderer)
 //   on the same pose; a crowd drawn and moving in one draw call; and each "never silently wrong"
-//   case: it works, or runs on the CPU with a note and one warning, or throws a GcsError.
-import { existsSync } from 'node:fs';
+//   case: it works, or runs on the CPU with a note and one warning, or throws a GcsError. With 8
+//   influences per vertex (CesiumMan's weights spread onto 5–8 joints, JOINTS_1/WEIGHTS_1): the TSL
+//   GPU backend and a TSL crowd = the CPU backend, and ≠ the same file read without its second set.
+import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Page } from 'playwright-core';
-import { MODELS_DIR, openFixture, skipReason, type FixturePage } from './harness.js';
+import { MODELS_DIR, openFixture, ROOT, skipReason, type FixturePage } from './harness.js';
+import { eightInfluenceGlb } from '../helpers/influences-glb.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -183,5 +186,40 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
       expect(r.error).toMatch(entry === 'webgpu' ? /setNodesHandler|WebGPURenderer/ : /gcs-skin\/webgpu/);
       expect(r.warnings).toHaveLength(1);
     });
+  }
+});
+
+const CESIUM_8_SOURCE = join(MODELS_DIR, 'CesiumMan.glb');
+const noCesium8 = existsSync(CESIUM_8_SOURCE) ? '' : `skipped: ${CESIUM_8_SOURCE} is absent (the shared test models are not on this machine)`;
+if (noCesium8) console.log(noCesium8);
+
+/** 8 influences: at most 0.5 % of the character's pixels may differ by more than 8/255. */
+const CHARACTER_PIXEL_SHARE = 0.005;
+
+describe.skipIf(!!reason || !!noCesium8)('8 influences per vertex on WebGPURenderer (CesiumMan, weights spread onto 5–8 joints)', () => {
+  const file = join(ROOT, 'build', 'test-models', 'cesium-8-webgpu.glb');
+  beforeAll(async () => {
+    mkdirSync(join(ROOT, 'build', 'test-models'), { recursive: true });
+    await eightInfluenceGlb(CESIUM_8_SOURCE, file);
+  });
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    for (const smooth of [false, true]) {
+      const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
+      test(`${mode}: GPU backend and crowd (TSL) = CPU backend; without the second set the picture differs`, async () => {
+        const r = await call<{ backends: string[]; paths: string[]; tableSlots: number[]; vsCpu: Diff; vsFour: Diff; crowdVsCpu: Diff; coverage: number }>(
+          'influences', `/@fs${file}`, { smooth }, 1.0, gpuPath);
+        console.log(`CesiumMan 8 influences ${mode} (table ${r.tableSlots.join(', ')}): GPU vs CPU ${pct(r.vsCpu)}; crowd vs CPU ${pct(r.crowdVsCpu)}; vs the first 4 only ${pct(r.vsFour)}`);
+        expect(r.backends).toEqual(['gpu']);
+        expect(r.paths).toEqual([gpuPath, gpuPath]);
+        expect(r.tableSlots).toEqual(gpuPath === 'joints' ? [8, 8] : [4, 4]);
+        expect(r.coverage).toBeGreaterThan(0.02);
+        // Of the character's own pixels (the image-wide 1 % would not see the second set: cut to 4
+        // it moves 3–4 % of the character's pixels, 0.4–0.5 % of the image).
+        expect(r.vsCpu.covered).toBeLessThanOrEqual(CHARACTER_PIXEL_SHARE);
+        expect(r.crowdVsCpu.covered).toBeLessThanOrEqual(CHARACTER_PIXEL_SHARE);
+        expect(r.vsFour.covered).toBeGreaterThan(CHARACTER_PIXEL_SHARE); // the comparison sees the second set
+        expect(errors).toEqual([]);
+      });
+    }
   }
 });

@@ -426,8 +426,8 @@ void fuzzValidTweaks(FuzzedDataProvider& f, RigInput& in) {
 // One deliberate break; returns the error code the header promises for it (GCS_OK: none).
 GcsError fuzzBreak(FuzzedDataProvider& f, RigInput& in, const float*& pos, const float*& nrm, const uint32_t*& idx,
                    const uint32_t*& jts, const float*& wts, const int32_t*& par, const float*& ibm,
-                   uint32_t& vertexCount, uint32_t& indexCount, uint32_t& jointCount) {
-  const int kind = f.ConsumeIntegralInRange<int>(0, 19);
+                   uint32_t& vertexCount, uint32_t& indexCount, uint32_t& jointCount, uint32_t& influences) {
+  const int kind = f.ConsumeIntegralInRange<int>(0, 20);
   const uint32_t v = f.ConsumeIntegralInRange<uint32_t>(0, in.vertexCount - 1);
   const uint32_t j = f.ConsumeIntegralInRange<uint32_t>(0, in.jointCount - 1);
   static const float nonFinite[] = {NAN, INFINITY, -INFINITY};
@@ -486,6 +486,7 @@ GcsError fuzzBreak(FuzzedDataProvider& f, RigInput& in, const float*& pos, const
     case 18:
       for (int i = 0; i < 16; ++i) in.inverseBind[16 * size_t(j) + i] = i == 15 ? f.ConsumeIntegralInRange<int>(0, 1) : 0.0f;
       return GCS_ERR_DEGENERATE;  // finite but not invertible
+    case 19: influences = f.ConsumeBool() ? 0 : GCS_MAX_INFLUENCES + 1 + f.ConsumeIntegral<uint8_t>(); return GCS_ERR_OUT_OF_RANGE;
     default:
       for (uint32_t u = 0; u < in.vertexCount; ++u)
         for (int c = 0; c < 3; ++c) in.positions[3 * size_t(u) + c] = in.positions[c];
@@ -1145,9 +1146,27 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
   const float* wts = in.weights.data();
   const int32_t* par = in.parents.data();
   const float* ibm = in.inverseBind.data();
-  uint32_t vertexCount = in.vertexCount, indexCount = in.indexCount, jointCount = in.jointCount;
+  uint32_t vertexCount = in.vertexCount, indexCount = in.indexCount, jointCount = in.jointCount, influences = 4;
   GcsError expected = GCS_OK;
-  if (broken) expected = fuzzBreak(f, in, pos, nrm, idx, jts, wts, par, ibm, vertexCount, indexCount, jointCount);
+  if (broken) expected = fuzzBreak(f, in, pos, nrm, idx, jts, wts, par, ibm, vertexCount, indexCount, jointCount, influences);
+  // Eight influences on a quarter of the rigs (chosen by the rig's sizes, so the seeds decode as
+  // before): every other vertex's four move to slots 4..7 behind four empty slots (weight 0, a joint
+  // id out of range, which the header allows), the rest keep slots 0..3 with 4..7 empty.
+  std::vector<uint32_t> wideJoints;
+  std::vector<float> wideWeights;
+  if (influences == 4 && jts && wts && vertexCount == in.vertexCount && (in.vertexCount * 7 + in.jointCount) % 4 == 0) {
+    influences = 8;
+    wideJoints.assign(size_t(in.vertexCount) * 8, in.jointCount + 7);
+    wideWeights.assign(size_t(in.vertexCount) * 8, 0.0f);
+    for (uint32_t v = 0; v < in.vertexCount; ++v)
+      for (int i = 0; i < 4; ++i) {
+        const size_t to = 8 * size_t(v) + (v % 2 ? 4 : 0) + size_t(i);
+        wideJoints[to] = in.joints[4 * size_t(v) + i];
+        wideWeights[to] = in.weights[4 * size_t(v) + i];
+      }
+    jts = wideJoints.data();
+    wts = wideWeights.data();
+  }
   // The rig is degenerate when every vertex is at one point: the header's GCS_ERR_DEGENERATE.
   float lo[3], hi[3];
   for (int c = 0; c < 3; ++c) lo[c] = hi[c] = in.positions[c];
@@ -1156,8 +1175,8 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
       lo[c] = std::fmin(lo[c], in.positions[3 * size_t(v) + c]), hi[c] = std::fmax(hi[c], in.positions[3 * size_t(v) + c]);
   const float height = std::fmax(hi[0] - lo[0], std::fmax(hi[1] - lo[1], hi[2] - lo[2]));
   if (expected == GCS_OK && !(height > 0.0f)) expected = GCS_ERR_DEGENERATE;
-  log("rig: %s, %u vertices, %u indices, %u joints, normals %s, expected code %d\n", in.generator, in.vertexCount,
-      in.indexCount, in.jointCount, nrm ? "given" : "computed", int(expected));
+  log("rig: %s, %u vertices, %u indices, %u joints, %u influences, normals %s, expected code %d\n", in.generator,
+      in.vertexCount, in.indexCount, in.jointCount, influences, nrm ? "given" : "computed", int(expected));
   if (g_verbose) {
     for (uint32_t v = 0; v < in.vertexCount; ++v) {
       const float* p = &in.positions[3 * size_t(v)];
@@ -1181,7 +1200,7 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
   std::snprintf(ctx, sizeof ctx, "rig %s: %u vertices, %u indices, %u joints, expected code %d", in.generator,
                 in.vertexCount, in.indexCount, in.jointCount, int(expected));
   g_context = ctx;
-  GcsRig* rig = gcs_rig_create(pos, nrm, vertexCount, idx, indexCount, jts, wts, par, ibm, jointCount);
+  GcsRig* rig = gcs_rig_create(pos, nrm, vertexCount, idx, indexCount, jts, wts, influences, par, ibm, jointCount);
   if (expected != GCS_OK) {
     CHECK(rig == nullptr, "gcs_rig_create accepted a broken rig (expected code %d)", int(expected));
     CHECK(gcs_last_error_code() == expected, "gcs_rig_create: code %d, expected %d", gcs_last_error_code(), int(expected));

@@ -58,6 +58,7 @@ typedef enum GcsError {
 #define GCS_MAX_SECTIONS 256
 #define GCS_MAX_JOINTS 1024
 #define GCS_MAX_VERTICES 16777216
+#define GCS_MAX_INFLUENCES 8  /* skin influences (joint, weight pairs) per vertex: glTF JOINTS_0/1, WEIGHTS_0/1 */
 
 /* ---------------------------------------------------------------- errors and memory */
 
@@ -83,8 +84,13 @@ typedef struct GcsRig GcsRig;
  *   vertexCount      1 .. GCS_MAX_VERTICES.
  *   indices          indexCount uint32, a triangle list; each < vertexCount.
  *   indexCount       a multiple of 3, at least 3.
- *   joints           vertexCount × 4 joint ids (uint32), each < jointCount where its weight > 0.
- *   weights          vertexCount × 4 floats, ≥ 0, finite, sum > 0 (normalised on copy).
+ *   joints           vertexCount × influences joint ids (uint32), each < jointCount where its weight > 0
+ *                    (vertex v's at v · influences …; glTF's JOINTS_0 then JOINTS_1 for 8).
+ *   weights          vertexCount × influences floats, ≥ 0, finite, sum > 0 (normalised on copy over all
+ *                    of the vertex's influences).
+ *   influences       influences per vertex, 1 .. GCS_MAX_INFLUENCES (else GCS_ERR_OUT_OF_RANGE, checked
+ *                    before anything is read or allocated). Every deformer uses all of them. A rig of at
+ *                    most 4 costs what a 4-influence rig costs; above 4 it stores 8 slots per vertex.
  *   parents          jointCount int32: the parent joint id, or -1 for a root; no cycles.
  *   inverseBind      jointCount × 16 floats (column-major): glTF inverse bind matrices,
  *                    mapping mesh space to joint space in the bind pose; finite (else
@@ -94,7 +100,7 @@ typedef struct GcsRig GcsRig;
  */
 GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount,
                        const uint32_t* indices, uint32_t indexCount,
-                       const uint32_t* joints, const float* weights,
+                       const uint32_t* joints, const float* weights, uint32_t influences,
                        const int32_t* parents, const float* inverseBind, uint32_t jointCount);
 void gcs_rig_destroy(GcsRig* rig);
 uint32_t gcs_rig_vertex_count(const GcsRig* rig);
@@ -292,21 +298,25 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
 /*
  * The joint-level GPU path (weights criterion only; docs/gpu.md). Under the weights criterion a
  * section's transform depends only on its joints' poses: a rigid core is exactly S_j; every other
- * section is the dual-quaternion blend of its (at most 4) joints at its members' mean weights, the
- * scale parts K_j = R_jᵀ·S_j blended linearly and applied first. So per frame only the joint poses
- * change (J per instance), and the vertex shader blends each vertex's section from them and from a
- * static per-section table (below), uploaded once.
+ * section is the dual-quaternion blend of its (at most GCS_MAX_INFLUENCES) joints at its members' mean
+ * weights, the scale parts K_j = R_jᵀ·S_j blended linearly and applied first. So per frame only the
+ * joint poses change (J per instance), and the vertex shader blends each vertex's section from them
+ * and from a static per-section table (below), uploaded once.
  *
- * gcs_gcs_section_influences: sectionCount × 8 floats, the static table, two RGBA32F texels per
- *   section: [joint 0, joint 1, joint 2, joint 3] (ids as floats, -1 past the last), then
- *   [weight 0, weight 1, weight 2, weight 3] — the blend gcs_deformer_deform computes, in its order
- *   (the first joint is the blend's hemisphere pivot). One joint (weight 1): a rigid core, moved by
- *   S_j itself. Null for a GCS deformer built with the Y or axial criterion (their transforms
- *   involve per-section fractions of parent/child motions: use gcs_gcs_compute_sections), and for
- *   other deformers.
+ * gcs_gcs_section_influence_slots: the table's joints per section, 4 (every section blends at most 4
+ *   joints: every rig of at most 4 influences) or 8; 0 where gcs_gcs_section_influences is null.
+ * gcs_gcs_section_influences: sectionCount × 2 · slots floats, the static table, 2 · slots / 4 RGBA32F
+ *   texels per section: for each group of 4 slots, [joint 4g, …, joint 4g+3] (ids as floats, -1 past
+ *   the last), then [weight 4g, …, weight 4g+3] — the blend gcs_deformer_deform computes, in its
+ *   order (the first joint is the blend's hemisphere pivot). With 4 slots: [joints 0–3], [weights
+ *   0–3]; with 8: [joints 0–3], [weights 0–3], [joints 4–7], [weights 4–7]. One joint (weight 1): a
+ *   rigid core, moved by S_j itself. Null for a GCS deformer built with the Y or axial criterion
+ *   (their transforms involve per-section fractions of parent/child motions: use
+ *   gcs_gcs_compute_sections), and for other deformers.
  */
 #define GCS_GPU_TEXELS_PER_JOINT 4
 const float* gcs_gcs_section_influences(const GcsDeformer* deformer);
+uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* deformer);
 /*
  * Joint poses only, for instanceCount poses of the same model, packed for an RGBA32F texture; O(J)
  * per instance, no per-section and no per-vertex work.

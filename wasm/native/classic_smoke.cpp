@@ -44,7 +44,7 @@ int main() {
                    1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1,
                    1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -2, 0, 1};
   GcsRig* rig = gcs_rig_create(c.pos.data(), nullptr, uint32_t(c.pos.size() / 3), c.idx.data(),
-                               uint32_t(c.idx.size()), c.joints.data(), c.weights.data(), parents, ibm, 3);
+                               uint32_t(c.idx.size()), c.joints.data(), c.weights.data(), 4, parents, ibm, 3);
   if (!rig) { std::printf("rig: %s\n", gcs_last_error_message()); return 1; }
   const uint32_t K = 32, M = 25;
   GcsDeformer* d = gcs_build_classic(rig, M, K, 1.0f);
@@ -90,7 +90,7 @@ int main() {
   // Build time on a denser mesh (~ 17k vertices).
   Mesh big = cylinder(128, 133);
   rig = gcs_rig_create(big.pos.data(), nullptr, uint32_t(big.pos.size() / 3), big.idx.data(),
-                       uint32_t(big.idx.size()), big.joints.data(), big.weights.data(), parents, ibm, 3);
+                       uint32_t(big.idx.size()), big.joints.data(), big.weights.data(), 4, parents, ibm, 3);
   auto t0 = std::chrono::steady_clock::now();
   d = gcs_build_classic(rig, 25, 20, 0.5f);
   auto t1 = std::chrono::steady_clock::now();

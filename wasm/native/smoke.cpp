@@ -28,7 +28,7 @@ int main() {
   float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
                    1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
   GcsRig* rig = gcs_rig_create(pos.data(), nullptr, uint32_t(pos.size() / 3), idx.data(),
-                               uint32_t(idx.size()), joints.data(), weights.data(), parents, ibm, 2);
+                               uint32_t(idx.size()), joints.data(), weights.data(), 4, parents, ibm, 2);
   if (!rig) { std::printf("rig: %s\n", gcs_last_error_message()); return 1; }
   GcsDeformer* d = gcs_build_gcs(rig, 5, GCS_CRITERION_AXIAL, 1.0f, 0, 0);
   if (!d) { std::printf("gcs: %s\n", gcs_last_error_message()); return 1; }

@@ -33,11 +33,11 @@ void gcs_copy_bytes(void* destination, const void* source, uint32_t bytes) {
 
 GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount,
                        const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,
-                       const float* weights, const int32_t* parents, const float* inverseBind,
-                       uint32_t jointCount) {
+                       const float* weights, uint32_t influences, const int32_t* parents,
+                       const float* inverseBind, uint32_t jointCount) {
   gcs::clearError();
-  if (vertexCount <= GCS_MAX_VERTICES && jointCount <= GCS_MAX_JOINTS &&
-      !gcs::reserveMemory(gcs::rigPeakBytes(vertexCount, indexCount, jointCount), "the rig"))
+  if (vertexCount <= GCS_MAX_VERTICES && jointCount <= GCS_MAX_JOINTS && influences >= 1 && influences <= GCS_MAX_INFLUENCES &&
+      !gcs::reserveMemory(gcs::rigPeakBytes(vertexCount, indexCount, jointCount, influences > 4 ? 8 : 4), "the rig"))
     return nullptr;
   GcsRig* handle = new (std::nothrow) GcsRig();
   if (!handle) {
@@ -45,7 +45,7 @@ GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t ve
     return nullptr;
   }
   if (!gcs::buildRig(positions, normals, vertexCount, indices, indexCount, joints, weights,
-                     parents, inverseBind, jointCount, handle->rig)) {
+                     influences, parents, inverseBind, jointCount, handle->rig)) {
     delete handle;
     return nullptr;
   }
@@ -81,7 +81,7 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
     return nullptr;
   }
   const gcs::Rig& r = rig->rig;
-  if (!gcs::reserveMemory(gcs::gcsPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the GCS model"))
+  if (!gcs::reserveMemory(gcs::gcsPeakBytes(r.vertexCount, r.indices.size(), r.jointCount, r.influenceSlots), "the GCS model"))
     return nullptr;
   gcs::GcsSettings settings;
   settings.sections = sections;
@@ -96,7 +96,7 @@ GcsDeformer* gcs_build_lbs(const GcsRig* rig) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
   const gcs::Rig& r = rig->rig;
-  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the LBS deformer"))
+  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount, r.influenceSlots), "the LBS deformer"))
     return nullptr;
   return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_LBS));
 }
@@ -105,7 +105,7 @@ GcsDeformer* gcs_build_dqs(const GcsRig* rig) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
   const gcs::Rig& r = rig->rig;
-  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount), "the DQS deformer"))
+  if (!gcs::reserveMemory(gcs::skinningPeakBytes(r.vertexCount, r.indices.size(), r.jointCount, r.influenceSlots), "the DQS deformer"))
     return nullptr;
   return wrap(gcs::buildSkinning(rig->rig, GCS_KIND_DQS));
 }
@@ -283,6 +283,11 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
 const float* gcs_gcs_section_influences(const GcsDeformer* d) {
   const gcs::GcsDeformerImpl* g = asGcs(d);
   return g && !g->influenceTable.empty() ? g->influenceTable.data() : nullptr;
+}
+
+uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g && !g->influenceTable.empty() ? g->influenceTableSlots : 0;
 }
 
 int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,

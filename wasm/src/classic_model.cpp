@@ -943,11 +943,11 @@ ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, flo
             float h = glm::dot(x, c.normal);
             if (std::fabs(h) > window || glm::length(x - h * c.normal) > reach) continue;
             float f = 1.0f - std::fabs(h) / window + 1e-3f;
-            for (int i = 0; i < 4; ++i) {
-              const uint32_t jj = rig.joints[v][i];
-              if (!(rig.weights[v][i] > 0.0f)) continue;
+            for (uint32_t i = 0; i < rig.influenceSlots; ++i) {
+              const uint32_t jj = rig.jointAt(v, i);
+              if (!(rig.weightAt(v, i) > 0.0f)) continue;
               if (sum[jj] == 0.0f) touched.push_back(jj);
-              sum[jj] += f * rig.weights[v][i];
+              sum[jj] += f * rig.weightAt(v, i);
             }
             total += f;
             }
@@ -1045,11 +1045,17 @@ ClassicModel* buildOnce(const Rig& rig, uint32_t contourSetting, uint32_t k, flo
     m.restNormals.assign(size_t(carried) * 3 + 1, 0.0f);
     m.carriedJoints.resize(carried);
     m.carriedWeights.resize(carried);
+    const bool eight = rig.influenceSlots == 8;
+    if (eight) m.carriedJoints1.resize(carried), m.carriedWeights1.resize(carried);
     m.poses.resize(J);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) {
       if (outputOf[v] < 0) continue;
       m.carriedJoints[size_t(outputOf[v] - m.carriedFirst)] = rig.joints[v];
       m.carriedWeights[size_t(outputOf[v] - m.carriedFirst)] = rig.weights[v];
+      if (eight) {
+        m.carriedJoints1[size_t(outputOf[v] - m.carriedFirst)] = rig.joints1[v];
+        m.carriedWeights1[size_t(outputOf[v] - m.carriedFirst)] = rig.weights1[v];
+      }
       size_t o = size_t(outputOf[v] - m.carriedFirst) * 3;
       for (int c = 0; c < 3; ++c) {
         m.restPositions[o + c] = rig.positions[v][c];
@@ -1251,12 +1257,14 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
       }
   const uint32_t C = uint32_t(cornerOf.size());
   std::vector<float> rest(size_t(C) * 3), restNormals(size_t(C) * 3), posed(size_t(C) * 3), posedNormals(size_t(C) * 3);
-  std::vector<glm::uvec4> joints(C);
-  std::vector<glm::vec4> weights(C);
+  const bool eight = rig.influenceSlots == 8;
+  std::vector<glm::uvec4> joints(C), joints1(eight ? C : 0);
+  std::vector<glm::vec4> weights(C), weights1(eight ? C : 0);
   for (uint32_t i = 0; i < C; ++i) {
     const uint32_t v = cornerOf[i];
     for (int c = 0; c < 3; ++c) rest[3 * i + c] = rig.positions[v][c], restNormals[3 * i + c] = rig.normals[v][c];
     joints[i] = rig.joints[v], weights[i] = rig.weights[v];
+    if (eight) joints1[i] = rig.joints1[v], weights1[i] = rig.weights1[v];
   }
   std::vector<glm::mat4> skin;
   std::vector<JointPose> poses(J);
@@ -1265,8 +1273,8 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
     probeSkin(rig, axes[probe], angles[probe], skin);
     m.deform(skin.data());
     const ScaleState scale = decomposeAll(skin.data(), J, poses.data());
-    dqsVertices(poses.data(), scale, joints.data(), weights.data(), rest.data(), restNormals.data(), posed.data(),
-                posedNormals.data(), C);
+    dqsVertices(poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
+                eight ? weights1.data() : nullptr, rest.data(), restNormals.data(), posed.data(), posedNormals.data(), C);
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
       if (!P.resampled) continue;
@@ -1377,7 +1385,9 @@ void ClassicModel::deform(const glm::mat4* skin) {
   // with the skin around it (one rigid bone per part left it standing off the skin at every joint
   // it spans) and the bands zipped to it follow.
   if (carriedFirst < vertexCount)
-    dqsVertices(poses.data(), scale, carriedJoints.data(), carriedWeights.data(), restPositions.data(), restNormals.data(),
+    dqsVertices(poses.data(), scale, carriedJoints.data(), carriedWeights.data(),
+                carriedJoints1.empty() ? nullptr : carriedJoints1.data(),
+                carriedWeights1.empty() ? nullptr : carriedWeights1.data(), restPositions.data(), restNormals.data(),
                 &positions[size_t(carriedFirst) * 3], &normals[size_t(carriedFirst) * 3], vertexCount - carriedFirst);
   // Tube normals: area-weighted from the deformed tube and band triangles (the bands after the
   // carried vertices have moved). Edges are divided by the extent of everything those triangles

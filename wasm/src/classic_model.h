@@ -20,7 +20,7 @@ struct ClassicContour {
   int32_t proximal = -1;     // shared contour: the proximal part (whose distal end it is); else -1
   float t = 0.0f;            // 0 at the part's proximal joint … 1 at its distal joint
   glm::vec3 centre{0.0f}, normal{0.0f, 1.0f, 0.0f}, u{1.0f, 0.0f, 0.0f};  // bind pose
-  // The skin it resamples: the mean influences of the input vertices around its plane (≤ 4 joints).
+  // The skin it resamples: the mean influences of the input vertices around its plane (the 4 largest of all their influences).
   glm::uvec4 joints{0u};
   glm::vec4 weights{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 posedCentre{0.0f}, posedNormal{0.0f, 1.0f, 0.0f};  // per-frame scratch (caps)
@@ -97,6 +97,8 @@ class ClassicModel final : public Deformer {
   std::vector<float> restPositions, restNormals;  // carried vertices, interleaved (+1 spare)
   std::vector<glm::uvec4> carriedJoints;   // carried vertices' own influences (skinned by DQS)
   std::vector<glm::vec4> carriedWeights;
+  std::vector<glm::uvec4> carriedJoints1;  // their slots 4..7 (empty for a rig of at most 4 influences)
+  std::vector<glm::vec4> carriedWeights1;
   std::vector<JointPose> poses;            // per-frame scratch: every S_j decomposed
   std::vector<int32_t> report;             // partCount × 5 (see gcs_classic_parts)
   std::vector<int32_t> contourOfVertex;    // per output vertex: its contour, −1 for carried vertices

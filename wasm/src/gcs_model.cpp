@@ -130,14 +130,18 @@ void finishModel(GcsDeformerImpl& m) {
     info[7] = sec.beta;
   }
   if (m.settings.criterion == GCS_CRITERION_WEIGHTS) {
-    m.influenceTable.assign(size_t(S) * 8, 0.0f);
+    uint32_t most = 1;
+    for (const Section& sec : m.sections) most = std::max(most, sec.influenceCount);
+    const uint32_t slots = m.influenceTableSlots = most > 4 ? 8 : 4;
+    m.influenceTable.assign(size_t(S) * 2 * slots, 0.0f);
     for (uint32_t i = 0; i < S; ++i) {
       const Section& sec = m.sections[i];
-      float* row = &m.influenceTable[size_t(i) * 8];
-      for (uint32_t k = 0; k < 4; ++k) {
+      float* row = &m.influenceTable[size_t(i) * 2 * slots];
+      for (uint32_t k = 0; k < slots; ++k) {
         const bool used = k < sec.influenceCount;
-        row[k] = used ? float(m.influences[sec.influenceFirst + k].joint) : -1.0f;
-        row[4 + k] = used ? m.influences[sec.influenceFirst + k].weight : 0.0f;
+        float* texels = row + 8 * (k / 4);  // per 4 slots: a texel of joints, then one of weights
+        texels[k % 4] = used ? float(m.influences[sec.influenceFirst + k].joint) : -1.0f;
+        texels[4 + k % 4] = used ? m.influences[sec.influenceFirst + k].weight : 0.0f;
       }
     }
   }
@@ -159,10 +163,10 @@ void finishModel(GcsDeformerImpl& m) {
   std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
 }
 
-// A section key of the weights criterion: up to 4 (joint, quantised weight) pairs sorted by joint.
+// A section key of the weights criterion: up to 8 (joint, quantised weight) pairs sorted by joint.
 struct WeightKey {
-  uint32_t joint[4] = {~0u, ~0u, ~0u, ~0u};
-  uint32_t q[4] = {0, 0, 0, 0};
+  uint32_t joint[kMaxInfluences] = {~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u};
+  uint32_t q[kMaxInfluences] = {0, 0, 0, 0, 0, 0, 0, 0};
   uint32_t n = 0;
   bool operator==(const WeightKey& o) const {
     if (n != o.n) return false;
@@ -175,7 +179,7 @@ struct WeightKey {
     uint32_t k = 0;
     for (uint32_t i = 0; i < n; ++i)
       if (q[i] > 0) joint[k] = joint[i], q[k] = q[i], ++k;
-    for (uint32_t i = k; i < 4; ++i) joint[i] = ~0u, q[i] = 0;
+    for (uint32_t i = k; i < kMaxInfluences; ++i) joint[i] = ~0u, q[i] = 0;
     n = k;
     for (uint32_t i = 1; i < n; ++i)
       for (uint32_t j = i; j > 0 && joint[j] < joint[j - 1]; --j) std::swap(joint[j], joint[j - 1]), std::swap(q[j], q[j - 1]);
@@ -216,7 +220,8 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
   auto rank = [&](uint32_t k) {
     const WeightKey& key = keys[k];
     return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
-                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3]);
+                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3], key.joint[4], key.q[4],
+                           key.joint[5], key.q[5], key.joint[6], key.q[6], key.joint[7], key.q[7]);
   };
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
   std::vector<uint32_t> sectionOfKey(K);
@@ -251,10 +256,10 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
 uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
   uint32_t n = 0;
   float sum = 0.0f;
-  for (int i = 0; i < 4; ++i) {
-    float w = rig.weights[v][i];
+  for (uint32_t i = 0; i < rig.influenceSlots; ++i) {
+    float w = rig.weightAt(v, i);
     if (!(w > 0.0f)) continue;
-    uint32_t j = rig.joints[v][i], k = 0;
+    uint32_t j = rig.jointAt(v, i), k = 0;
     while (k < n && joint[k] != j) ++k;
     if (k == n) joint[n] = j, weight[n] = 0.0f, ++n;
     weight[k] += w;
@@ -280,16 +285,15 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
   std::vector<WeightKey> keys;
   std::vector<uint32_t> keyOf(G);
-  // Each group's cleaned weights, read once (4 joints, 4 weights, a count).
-  std::vector<glm::uvec4> cleanJoints(G);
-  std::vector<glm::vec4> cleanWeightsOf(G);
+  // Each group's cleaned weights, read once (`slots` joints, `slots` weights, a count).
+  const uint32_t slots = rig.influenceSlots;
+  std::vector<uint32_t> cleanJoints(size_t(G) * slots);
+  std::vector<float> cleanWeightsOf(size_t(G) * slots);
   std::vector<uint8_t> cleanCount(G);
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t joint[4] = {0, 0, 0, 0};
-    float weight[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    uint32_t* joint = &cleanJoints[size_t(g) * slots];
+    float* weight = &cleanWeightsOf[size_t(g) * slots];
     uint32_t n = cleanWeights(rig, representative[g], joint, weight);
-    cleanJoints[g] = glm::uvec4(joint[0], joint[1], joint[2], joint[3]);
-    cleanWeightsOf[g] = glm::vec4(weight[0], weight[1], weight[2], weight[3]);
     cleanCount[g] = uint8_t(n);
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
@@ -315,22 +319,22 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   }
   // Mean weights per key on its own joints.
   const uint32_t K = uint32_t(keys.size());
-  std::vector<double> sums(size_t(K) * 4, 0.0);
+  std::vector<double> sums(size_t(K) * kMaxInfluences, 0.0);
   for (uint32_t g = 0; g < G; ++g) {
-    const glm::uvec4& joint = cleanJoints[g];
-    const glm::vec4& weight = cleanWeightsOf[g];
+    const uint32_t* joint = &cleanJoints[size_t(g) * slots];
+    const float* weight = &cleanWeightsOf[size_t(g) * slots];
     const uint32_t n = cleanCount[g];
     const WeightKey& key = keys[keyOf[g]];
     for (uint32_t i = 0; i < n; ++i) {
       uint32_t s = key.slot(joint[i]);
-      if (s != ~0u) sums[size_t(keyOf[g]) * 4 + s] += weight[i];
+      if (s != ~0u) sums[size_t(keyOf[g]) * kMaxInfluences + s] += weight[i];
     }
   }
   // Each key's blend: its members' mean weights (a rigid core: weight 1 on its joint).
   const std::vector<uint32_t> sectionOfKey = sectionsFromKeys(m, keys, [&](uint32_t k, uint32_t slot) {
     double total = 0.0;
-    for (uint32_t t = 0; t < keys[k].n; ++t) total += sums[size_t(k) * 4 + t];
-    return float(sums[size_t(k) * 4 + slot] / total);
+    for (uint32_t t = 0; t < keys[k].n; ++t) total += sums[size_t(k) * kMaxInfluences + t];
+    return float(sums[size_t(k) * kMaxInfluences + slot] / total);
   });
   sectionOfGroup.resize(G);
   for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = sectionOfKey[keyOf[g]];
@@ -369,8 +373,8 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   std::vector<uint32_t> lowKey(G), highKey(G);
   blendOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t joint[4] = {0, 0, 0, 0};
-    float weight[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    uint32_t joint[kMaxInfluences] = {};
+    float weight[kMaxInfluences] = {};
     const uint32_t n = cleanWeights(rig, representative[g], joint, weight);
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
@@ -384,7 +388,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
       WeightKey key;
       key.n = n;
       const uint32_t units = 8 * l;
-      float rem[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+      float rem[kMaxInfluences] = {-1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f};
       uint32_t used = 0;
       for (uint32_t i = 0; i < n; ++i) {
         key.joint[i] = joint[i];
@@ -783,7 +787,7 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const Scal
       normalMatrices[i] = poses[sec.part].normal;
       renorm = poses[sec.part].renormalise;
     } else {
-      float w[4];
+      float w[kMaxInfluences];
       for (uint32_t k = 0; k < sec.influenceCount; ++k) {
         const Influence& in = influences[sec.influenceFirst + k];
         blendPoseScratch[k] = &poses[in.joint];

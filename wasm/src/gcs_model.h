@@ -68,9 +68,11 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<uint32_t> sectionOfVertex;
   std::vector<float> sectionInfo;       // 8 floats per section (see gcs_skin.h)
   std::vector<Influence> influences;    // weights criterion: the sections' blends
-  // Weights criterion: the sections' blends as gcs_gcs_section_influences packs them (8 floats per
-  // section: joints, -1 past the last, then weights); empty for the other criteria.
+  // Weights criterion: the sections' blends as gcs_gcs_section_influences packs them (2 ·
+  // influenceTableSlots floats per section: per 4 slots, joints, -1 past the last, then weights);
+  // empty for the other criteria. 4 slots unless a section blends more than 4 joints, then 8.
   std::vector<float> influenceTable;
+  uint32_t influenceTableSlots = 0;
   // Smooth mode: per output vertex, the other section it blends with and the factor towards it
   // (its own section is the run it sits in).
   std::vector<uint32_t> blendOther;

@@ -23,15 +23,16 @@ bool reserveMemory(uint64_t bytes, const char* what) {
 
 // The estimates count every array a build holds at its peak (see rig.cpp, gcs_model.cpp,
 // reference_deformers.cpp, classic_model.cpp), with a 1.5× margin for vector growth and the heap.
-uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
-  return (v * (12 + 12 + 16 + 16 + 12) + i * 4 + j * (64 * 2 + 12 + 4)) * 3 / 2 + 65536;
+uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
+  return (v * (12 + 12 + 8 * slots + 12) + i * 4 + j * (64 * 2 + 12 + 4)) * 3 / 2 + 65536;
 }
-uint64_t gcsPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
-  // Smooth weights nodes: up to two sections per welded vertex (~300 bytes each, tables included).
-  return (v * 860 + i * 8 + j * 4096) * 3 / 2 + 65536;
+uint64_t gcsPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
+  // Smooth weights nodes: up to two sections per welded vertex (~300 bytes each, tables included;
+  // keys and blends of 8 influences add ~40 bytes a slot).
+  return (v * (860 + 40 * (slots - 4)) + i * 8 + j * 4096) * 3 / 2 + 65536;
 }
-uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j) {
-  return (v * (24 + 24 + 24 + 16 + 16 + 4) + i * 4 + j * 128) * 3 / 2 + 65536;
+uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
+  return (v * (24 + 24 + 24 + 8 * slots + 4) + i * 4 + j * 128) * 3 / 2 + 65536;
 }
 uint64_t classicPeakBytes(uint64_t v, uint64_t i, uint64_t parts, uint64_t contours, uint64_t rays) {
   const uint64_t points = parts * (contours + 2) * (rays + 1);

@@ -12,10 +12,11 @@ namespace gcs {
 // Returns false with GCS_ERR_OUT_OF_MEMORY recorded (naming `what`) when they cannot be had.
 bool reserveMemory(uint64_t bytes, const char* what);
 
-// Upper bounds of the peak memory of each build (bytes), from the input sizes.
-uint64_t rigPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount);
-uint64_t gcsPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount);
-uint64_t skinningPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount);
+// Upper bounds of the peak memory of each build (bytes), from the input sizes; `slots` is the
+// rig's influence slots per vertex (4 or 8).
+uint64_t rigPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount, uint64_t slots);
+uint64_t gcsPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount, uint64_t slots);
+uint64_t skinningPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t jointCount, uint64_t slots);
 uint64_t classicPeakBytes(uint64_t vertexCount, uint64_t indexCount, uint64_t partCount, uint64_t contours,
                           uint64_t rays);
 

@@ -31,6 +31,8 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
       }
     d->joints = rig.joints;
     d->weights = rig.weights;
+    d->joints1 = rig.joints1;
+    d->weights1 = rig.weights1;
     d->indices = rig.indices;
     d->sourceVertex.resize(rig.vertexCount);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) d->sourceVertex[v] = v;
@@ -46,6 +48,7 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
 void SkinningDeformer::deform(const glm::mat4* skin) {
   const uint32_t n = vertexCount;
   const ScaleState scale = decomposeAll(skin, jointCount, poses.data());
+  const bool eight = !joints1.empty();
   if (kind_ == GCS_KIND_LBS) {
     for (uint32_t v = 0; v < n; ++v) {
       const glm::uvec4 j = joints[v];
@@ -53,6 +56,9 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
       glm::mat4 m = w[0] * skin[j[0]];
       for (int i = 1; i < 4; ++i)
         if (w[i] > 0.0f) m += w[i] * skin[j[i]];
+      if (eight)
+        for (int i = 0; i < 4; ++i)
+          if (weights1[v][i] > 0.0f) m += weights1[v][i] * skin[joints1[v][i]];
       const float* p = &restPositions[3 * size_t(v)];
       const float* q = &restNormals[3 * size_t(v)];
       glm::vec3 rp(m * glm::vec4(p[0], p[1], p[2], 1.0f));
@@ -67,16 +73,18 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
     }
     return;
   }
-  dqsVertices(poses.data(), scale, joints.data(), weights.data(), restPositions.data(), restNormals.data(),
-              positions.data(), normals.data(), n);
+  dqsVertices(poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
+              eight ? weights1.data() : nullptr, restPositions.data(), restNormals.data(), positions.data(),
+              normals.data(), n);
 }
 
 // Dual quaternions (Kavan et al. 2007) for the rigid part of each S_j; its scale blended linearly
 // and applied first (so rigs with scaled matrices work).
 void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uvec4* joints, const glm::vec4* weights,
-                 const float* restPositions, const float* restNormals, float* positions, float* normals, uint32_t n) {
-  const JointPose* blend[4];
-  float w4[4];
+                 const glm::uvec4* joints1, const glm::vec4* weights1, const float* restPositions,
+                 const float* restNormals, float* positions, float* normals, uint32_t n) {
+  const JointPose* blend[8];
+  float w8[8];
   glm::mat4 pm, nm;
   for (uint32_t v = 0; v < n; ++v) {
     const float* p = &restPositions[3 * size_t(v)];
@@ -95,6 +103,15 @@ void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uve
         br += sw * jp.real;
         bd += sw * jp.dual;
       }
+      if (joints1)
+        for (int i = 0; i < 4; ++i) {
+          const float w = weights1[v][i];
+          if (!(w > 0.0f)) continue;
+          const JointPose& jp = poses[joints1[v][i]];
+          const float sw = glm::dot(jp.real, pivot) < 0.0f ? -w : w;
+          br += sw * jp.real;
+          bd += sw * jp.dual;
+        }
       const float inv = 1.0f / glm::length(br);
       br *= inv;
       bd *= inv;
@@ -109,10 +126,16 @@ void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uve
       for (int i = 0; i < 4; ++i) {
         if (!(weights[v][i] > 0.0f)) continue;
         blend[k] = &poses[joints[v][i]];
-        w4[k++] = weights[v][i];
+        w8[k++] = weights[v][i];
       }
+      if (joints1)
+        for (int i = 0; i < 4; ++i) {
+          if (!(weights1[v][i] > 0.0f)) continue;
+          blend[k] = &poses[joints1[v][i]];
+          w8[k++] = weights1[v][i];
+        }
       bool renorm = false;
-      blendPoses(blend, w4, k, scale, pm, nm, renorm);
+      blendPoses(blend, w8, k, scale, pm, nm, renorm);
       rp = glm::vec3(pm * glm::vec4(p[0], p[1], p[2], 1.0f));
       rn = glm::vec3(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
       if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one

@@ -18,6 +18,8 @@ class SkinningDeformer final : public Deformer {
   std::vector<float> restPositions, restNormals;
   std::vector<glm::uvec4> joints;
   std::vector<glm::vec4> weights;
+  std::vector<glm::uvec4> joints1;  // influence slots 4..7, empty for a rig of at most 4 influences
+  std::vector<glm::vec4> weights1;
   // Per-frame scratch, allocated at build time: per joint, S_j split into rotation, translation
   // (a dual quaternion) and scale.
   std::vector<JointPose> poses;
@@ -29,9 +31,11 @@ class SkinningDeformer final : public Deformer {
 SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind);
 
 // Dual-quaternion skinning of n vertices (rest positions and normals xyz-interleaved, with their
-// joints and weights) under one frame's decomposed joint poses (decomposeAll): what the DQS deformer
-// does to every vertex and the classic model to its carried skin.
+// joints and weights: slots 0..3, and slots 4..7 in joints1/weights1 or null) under one frame's
+// decomposed joint poses (decomposeAll): what the DQS deformer does to every vertex and the classic
+// model to its carried skin.
 void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uvec4* joints, const glm::vec4* weights,
-                 const float* restPositions, const float* restNormals, float* positions, float* normals, uint32_t n);
+                 const glm::uvec4* joints1, const glm::vec4* weights1, const float* restPositions,
+                 const float* restNormals, float* positions, float* normals, uint32_t n);
 
 }  // namespace gcs

@@ -66,11 +66,10 @@ std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& repr
 }
 
 uint32_t Rig::dominantJoint(uint32_t v) const {
-  const glm::vec4& w = weights[v];
-  int best = 0;
-  for (int i = 1; i < 4; ++i)
-    if (w[i] > w[best]) best = i;
-  return joints[v][best];
+  uint32_t best = 0;
+  for (uint32_t i = 1; i < influenceSlots; ++i)
+    if (weightAt(v, i) > weightAt(v, best)) best = i;
+  return jointAt(v, best);
 }
 
 void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
@@ -114,8 +113,11 @@ static bool validateParents(const int32_t* parents, uint32_t jointCount) {
 
 bool buildRig(const float* positions, const float* normals, uint32_t vertexCount,
               const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,
-              const float* weights, const int32_t* parents, const float* inverseBind,
+              const float* weights, uint32_t influences, const int32_t* parents, const float* inverseBind,
               uint32_t jointCount, Rig& rig) {
+  if (influences < 1 || influences > GCS_MAX_INFLUENCES)
+    return fail(GCS_ERR_OUT_OF_RANGE, "a vertex has 1 to %d skin influences (joint, weight pairs); got %u",
+                GCS_MAX_INFLUENCES, influences);
   if (!positions || !indices || !joints || !weights || !parents || !inverseBind)
     return fail(GCS_ERR_INVALID_ARGUMENT,
                 "positions, indices, joints, weights, parents and inverse bind matrices are all required");
@@ -149,30 +151,39 @@ bool buildRig(const float* positions, const float* normals, uint32_t vertexCount
     rig.vertexCount = vertexCount;
     rig.jointCount = jointCount;
     rig.positions.resize(vertexCount);
+    rig.influenceSlots = influences > 4 ? 8 : 4;
     rig.joints.resize(vertexCount);
     rig.weights.resize(vertexCount);
+    if (rig.influenceSlots == 8) rig.joints1.resize(vertexCount), rig.weights1.resize(vertexCount);
     for (uint32_t v = 0; v < vertexCount; ++v) {
       rig.positions[v] = glm::vec3(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-      float sum = 0.0f;
-      for (int i = 0; i < 4; ++i) {
-        float w = weights[4 * v + i];
-        uint32_t j = joints[4 * v + i];
+      float slotWeight[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+      uint32_t slotJoint[8] = {0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
+      float big = 0.0f;
+      for (uint32_t i = 0; i < influences; ++i) {
+        const float w = weights[size_t(influences) * v + i];
+        const uint32_t j = joints[size_t(influences) * v + i];
         if (!std::isfinite(w)) return fail(GCS_ERR_NON_FINITE, "the skin weights of vertex %u are NaN or infinite", v);
         if (w < 0.0f) return fail(GCS_ERR_BAD_WEIGHTS, "vertex %u has a negative skin weight (%g)", v, double(w));
         if (w > 0.0f && j >= jointCount)
           return fail(GCS_ERR_JOINT_OUT_OF_RANGE,
                       "vertex %u is skinned to joint %u, but the skeleton has %u joints", v, j, jointCount);
-        rig.joints[v][i] = w > 0.0f ? j : 0u;  // unused slots point at joint 0 with weight 0
-        rig.weights[v][i] = w;
+        slotJoint[i] = w > 0.0f ? j : 0u;  // unused slots point at joint 0 with weight 0
+        slotWeight[i] = w;
+        big = std::fmax(big, w);
       }
-      // Normalise by the largest weight first: four weights near FLT_MAX would overflow the sum.
-      const glm::vec4 wv = rig.weights[v];
-      const float big = std::fmax(std::fmax(wv.x, wv.y), std::fmax(wv.z, wv.w));
+      // Normalise by the largest weight first: weights near FLT_MAX would overflow the sum.
       if (!(big > 0.0f))
         return fail(GCS_ERR_BAD_WEIGHTS, "vertex %u has no skin weight (its weights sum to 0)", v);
-      rig.weights[v] /= big;
-      sum = rig.weights[v].x + rig.weights[v].y + rig.weights[v].z + rig.weights[v].w;
-      rig.weights[v] /= sum;
+      float sum = 0.0f;
+      for (float& w : slotWeight) w /= big, sum += w;
+      for (float& w : slotWeight) w /= sum;
+      rig.joints[v] = glm::uvec4(slotJoint[0], slotJoint[1], slotJoint[2], slotJoint[3]);
+      rig.weights[v] = glm::vec4(slotWeight[0], slotWeight[1], slotWeight[2], slotWeight[3]);
+      if (rig.influenceSlots == 8) {
+        rig.joints1[v] = glm::uvec4(slotJoint[4], slotJoint[5], slotJoint[6], slotJoint[7]);
+        rig.weights1[v] = glm::vec4(slotWeight[4], slotWeight[5], slotWeight[6], slotWeight[7]);
+      }
     }
     rig.indices.assign(indices, indices + indexCount);
     if (normals) {

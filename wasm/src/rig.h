@@ -3,8 +3,11 @@
 #include <cstdint>
 #include <vector>
 #include <glm/glm.hpp>
+#include "../include/gcs_skin.h"
 
 namespace gcs {
+
+constexpr uint32_t kMaxInfluences = GCS_MAX_INFLUENCES;  // per vertex, and so per section
 
 struct Rig {
   uint32_t vertexCount = 0;
@@ -12,8 +15,13 @@ struct Rig {
   std::vector<glm::vec3> positions;      // bind pose, mesh space
   std::vector<glm::vec3> normals;        // unit length
   std::vector<uint32_t> indices;         // triangle list
-  std::vector<glm::uvec4> joints;        // 4 influences per vertex (ids < jointCount)
-  std::vector<glm::vec4> weights;        // normalised, sum 1
+  // Influence slots per vertex: 4, or 8 when the input gave more than 4 (slots 4..7 in joints1 /
+  // weights1, empty otherwise, so a 4-influence rig costs what it always did).
+  uint32_t influenceSlots = 4;
+  std::vector<glm::uvec4> joints;        // slots 0..3 (ids < jointCount; unused: joint 0, weight 0)
+  std::vector<glm::vec4> weights;        // slots 0..3; all slots together normalised, sum 1
+  std::vector<glm::uvec4> joints1;       // slots 4..7 (influenceSlots == 8 only)
+  std::vector<glm::vec4> weights1;
   std::vector<int32_t> parents;          // -1 for roots; parents[j] < jointCount
   std::vector<glm::mat4> inverseBind;    // B_j^-1
   std::vector<glm::mat4> bind;           // B_j
@@ -23,6 +31,9 @@ struct Rig {
 
   // Index of the joint with the largest weight on vertex v (ties: the first listed).
   uint32_t dominantJoint(uint32_t v) const;
+  // Slot i (< influenceSlots) of vertex v.
+  uint32_t jointAt(uint32_t v, uint32_t i) const { return i < 4 ? joints[v][int(i)] : joints1[v][int(i - 4)]; }
+  float weightAt(uint32_t v, uint32_t i) const { return i < 4 ? weights[v][int(i)] : weights1[v][int(i - 4)]; }
 
   // weldByPosition's result, computed by the first build that asks and kept: the positions never
   // change, and the sliders rebuild the same rig again and again.
@@ -34,7 +45,7 @@ struct Rig {
 // On failure records the error and leaves `rig` unspecified.
 bool buildRig(const float* positions, const float* normals, uint32_t vertexCount,
               const uint32_t* indices, uint32_t indexCount, const uint32_t* joints,
-              const float* weights, const int32_t* parents, const float* inverseBind,
+              const float* weights, uint32_t influences, const int32_t* parents, const float* inverseBind,
               uint32_t jointCount, Rig& rig);
 
 // Area-weighted vertex normals of a triangle mesh (zero-area neighbourhoods get +Y).

@@ -18,6 +18,8 @@ export { GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
 
 export const MIN_SECTIONS = 3;
+/** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
+export const MAX_INFLUENCES = 8;
 export const MAX_SECTIONS = 256;
 export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
 
@@ -31,10 +33,16 @@ export interface RigInput {
   normals?: ArrayLikeNumbers | null;
   /** Triangle list; each index < vertexCount. */
   indices: ArrayLikeNumbers;
-  /** vertexCount × 4 joint ids (glTF JOINTS_0). */
+  /** vertexCount × influences joint ids, vertex v's at v · influences (glTF JOINTS_0, then JOINTS_1 for 8). */
   joints: ArrayLikeNumbers;
-  /** vertexCount × 4 weights (glTF WEIGHTS_0); normalised on copy. */
+  /** vertexCount × influences weights (glTF WEIGHTS_0, then WEIGHTS_1); normalised on copy over all of a vertex's. */
   weights: ArrayLikeNumbers;
+  /**
+   * Influences (joint, weight pairs) per vertex, 1 … MAX_INFLUENCES; default 4 (glTF's JOINTS_0 /
+   * WEIGHTS_0). 8 takes a second set (JOINTS_1 / WEIGHTS_1), which three.js's own skinning drops:
+   * every method here (GCS, classic, LBS, DQS, both GPU paths, crowds) uses all of them.
+   */
+  influences?: number;
   /** jointCount parent ids, -1 for a root. */
   parents: ArrayLikeNumbers;
   /** jointCount × 16 column-major inverse bind matrices. */
@@ -212,6 +220,7 @@ export class GcsSkin {
       if (!a || typeof a.length !== 'number') throw new GcsError('INVALID_ARGUMENT', `createRig: '${key}' is missing or not an array`);
     }
     const { positions, normals, indices, joints, weights, parents, inverseBindMatrices } = input;
+    const influences = checkInfluences(input.influences);
     if (positions.length % 3 !== 0) throw new GcsError('LENGTH_MISMATCH', `positions has ${positions.length} numbers, which is not a multiple of 3`);
     const vertexCount = positions.length / 3;
     const jointCount = parents.length;
@@ -219,10 +228,11 @@ export class GcsSkin {
     if (jointCount === 0) throw new GcsError('NO_SKIN', 'the skeleton has no joints (parents is empty): is the mesh skinned?');
     if (normals && normals.length !== positions.length)
       throw new GcsError('LENGTH_MISMATCH', `normals has ${normals.length} numbers but positions has ${positions.length}`);
-    if (joints.length !== vertexCount * 4)
-      throw new GcsError('LENGTH_MISMATCH', `joints has ${joints.length} ids; 4 per vertex are expected (${vertexCount * 4})`);
-    if (weights.length !== vertexCount * 4)
-      throw new GcsError('LENGTH_MISMATCH', `weights has ${weights.length} numbers; 4 per vertex are expected (${vertexCount * 4})`);
+    const perVertex = `${influences} per vertex (influences: ${influences}) are expected (${vertexCount * influences})`;
+    if (joints.length !== vertexCount * influences)
+      throw new GcsError('LENGTH_MISMATCH', `joints has ${joints.length} ids; ${perVertex}`);
+    if (weights.length !== vertexCount * influences)
+      throw new GcsError('LENGTH_MISMATCH', `weights has ${weights.length} numbers; ${perVertex}`);
     if (inverseBindMatrices.length !== jointCount * 16)
       throw new GcsError('LENGTH_MISMATCH', `inverseBindMatrices has ${inverseBindMatrices.length} numbers; 16 per joint are expected (${jointCount * 16}, from ${jointCount} parents)`);
     for (let i = 0; i < indices.length; i++) {
@@ -235,7 +245,7 @@ export class GcsSkin {
         const j = joints[i];
         // Copied into wasm as u32, -1 would become 4294967295 and 1.5 would become 1: refuse them as given.
         if (!Number.isInteger(j) || j < 0)
-          throw new GcsError('JOINT_OUT_OF_RANGE', `vertex ${(i - (i % 4)) / 4} has joint id ${asGiven(j)} (joints[${i}]): joint ids are whole numbers from 0 to ${jointCount - 1}`);
+          throw new GcsError('JOINT_OUT_OF_RANGE', `vertex ${(i - (i % influences)) / influences} has joint id ${asGiven(j)} (joints[${i}]): joint ids are whole numbers from 0 to ${jointCount - 1}`);
       }
     const ptrs: number[] = [];
     try {
@@ -246,7 +256,7 @@ export class GcsSkin {
       const wt = this.copyIn(weights, 'f32'); ptrs.push(wt);
       const pa = this.copyIn(parents, 'i32'); ptrs.push(pa);
       const ib = this.copyIn(inverseBindMatrices, 'f32'); ptrs.push(ib);
-      const handle = this.core.gcs_rig_create(p, n, vertexCount, ix, indices.length, jt, wt, pa, ib, jointCount);
+      const handle = this.core.gcs_rig_create(p, n, vertexCount, ix, indices.length, jt, wt, influences, pa, ib, jointCount);
       if (!handle) this.raise('the rig was rejected');
       try {
         return new Rig(this, handle);
@@ -278,6 +288,16 @@ export function asGiven(value: unknown): string {
   if (Array.isArray(value)) return 'an array';
   if (value !== null && typeof value === 'object') return 'an object';
   return String(value);
+}
+
+/** RigInput.influences: a whole number in 1 … MAX_INFLUENCES, 4 when omitted. */
+function checkInfluences(value: unknown): number {
+  if (value === undefined) return 4;
+  if (typeof value !== 'number' || !Number.isInteger(value))
+    throw new GcsError('INVALID_ARGUMENT', `influences must be a whole number of influences per vertex (1 to ${MAX_INFLUENCES}); got ${asGiven(value)}`);
+  if (value < 1 || value > MAX_INFLUENCES)
+    throw new GcsError('OUT_OF_RANGE', `influences must be 1 to ${MAX_INFLUENCES} per vertex; got ${value}`);
+  return value;
 }
 
 /** Options must be an object (or undefined): a number or string there is a mistake, not "no options". */
@@ -603,13 +623,22 @@ export class GcsDeformer extends Deformer {
       this.gcs.raise('computing the section transforms failed');
   }
   /**
-   * Weights criterion: each section's blend, 8 floats per section (two RGBA32F texels: its joints,
-   * -1 past the last, then their weights; one joint = a rigid core), a copy; null for the Y and
-   * axial criteria. The static table of the joint-level GPU path (gcs_gcs_section_influences).
+   * Weights criterion: each section's blend, 2 · sectionInfluenceSlots floats per section (per 4
+   * slots, two RGBA32F texels: its joints, -1 past the last, then their weights; one joint = a rigid
+   * core), a copy; null for the Y and axial criteria. The static table of the joint-level GPU path
+   * (gcs_gcs_section_influences).
    */
   sectionInfluences(): Float32Array | null {
-    const ptr = this.gcs.core.gcs_gcs_section_influences(this.live());
-    return ptr ? this.gcs.viewF32(ptr, this.sectionCount * 8).slice() : null;
+    const h = this.live();
+    const ptr = this.gcs.core.gcs_gcs_section_influences(h);
+    return ptr ? this.gcs.viewF32(ptr, this.sectionCount * 2 * this.gcs.core.gcs_gcs_section_influence_slots(h)).slice() : null;
+  }
+  /**
+   * Joints per section in sectionInfluences(): 4 (every section blends at most 4 joints, as on every
+   * rig of at most 4 influences) or 8; 0 for the Y and axial criteria.
+   */
+  get sectionInfluenceSlots(): number {
+    return this.gcs.core.gcs_gcs_section_influence_slots(this.live());
   }
   /** True when the joint-level GPU path can drive this deformer (the weights criterion). */
   get jointLevel(): boolean {

@@ -357,17 +357,17 @@ export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Floa
   const split: SplitMatrix[] = [];
   for (let j = 0; j < J; j++) split.push(splitSkinMatrix(skin, 16 * j));
   const n = Math.floor(input.positions.length / 3);
-  const P = input.positions, W = input.weights, Jt = input.joints;
+  const P = input.positions, W = input.weights, Jt = input.joints, K = input.influences ?? 4;
   const real = [0, 0, 0, 0], dual = [0, 0, 0, 0], k = new Float64Array(9);
   for (let v = 0; v < n; v++) {
     let sum = 0;
-    for (let i = 0; i < 4; i++) if (W[4 * v + i] > 0) sum += W[4 * v + i];
+    for (let i = 0; i < K; i++) if (W[K * v + i] > 0) sum += W[K * v + i];
     real.fill(0); dual.fill(0); k.fill(0);
     let pivot: Float64Array | null = null;
-    for (let i = 0; i < 4; i++) {
-      const w = W[4 * v + i] / sum;
+    for (let i = 0; i < K; i++) {
+      const w = W[K * v + i] / sum;
       if (!(w > 0)) continue;
-      const sj = split[Jt[4 * v + i]];
+      const sj = split[Jt[K * v + i]];
       if (!pivot) pivot = sj.dq;
       const dot = sj.dq[0] * pivot[0] + sj.dq[1] * pivot[1] + sj.dq[2] * pivot[2] + sj.dq[3] * pivot[3];
       const s = dot < 0 ? -w : w;
@@ -452,21 +452,22 @@ export class FidelityProbe {
     this.rigid = new Int32Array(n).fill(-1);
     this.dominant = new Int32Array(n);
     let rigidCount = 0;
+    const K = input.influences ?? 4;
     for (let v = 0; v < n; v++) {
       let sum = 0, best = 0;
-      for (let i = 0; i < 4; i++) sum += Math.max(0, input.weights[4 * v + i]);
-      for (let i = 1; i < 4; i++) if (input.weights[4 * v + i] > input.weights[4 * v + best]) best = i;
-      this.dominant[v] = input.joints[4 * v + best];
+      for (let i = 0; i < K; i++) sum += Math.max(0, input.weights[K * v + i]);
+      for (let i = 1; i < K; i++) if (input.weights[K * v + i] > input.weights[K * v + best]) best = i;
+      this.dominant[v] = input.joints[K * v + best];
       let bound = -1;
-      for (let i = 0; i < 4; i++) {
-        const w = input.weights[4 * v + i] / sum;
-        if (w >= 0.999) bound = input.joints[4 * v + i];
+      for (let i = 0; i < K; i++) {
+        const w = input.weights[K * v + i] / sum;
+        if (w >= 0.999) bound = input.joints[K * v + i];
       }
       // The same joint listed twice would sum to 1 with neither entry ≥ 0.999: merge.
       if (bound < 0) {
         const j0 = this.dominant[v];
         let w = 0;
-        for (let i = 0; i < 4; i++) if (input.joints[4 * v + i] === j0) w += Math.max(0, input.weights[4 * v + i]) / sum;
+        for (let i = 0; i < K; i++) if (input.joints[K * v + i] === j0) w += Math.max(0, input.weights[K * v + i]) / sum;
         if (w >= 0.999) bound = j0;
       }
       this.rigid[v] = bound;
@@ -660,10 +661,11 @@ export function boundsHeight(positions: ArrayLike<number>): number {
 
 function triangleJoint(input: RigInput, a: number, b: number, c: number): number {
   const sum = new Map<number, number>();
+  const K = input.influences ?? 4;
   for (const v of [a, b, c])
-    for (let i = 0; i < 4; i++) {
-      const w = input.weights[4 * v + i];
-      if (w > 0) sum.set(input.joints[4 * v + i], (sum.get(input.joints[4 * v + i]) ?? 0) + w);
+    for (let i = 0; i < K; i++) {
+      const w = input.weights[K * v + i];
+      if (w > 0) sum.set(input.joints[K * v + i], (sum.get(input.joints[K * v + i]) ?? 0) + w);
     }
   let best = -1, bw = -Infinity;
   for (const [j, w] of sum) if (w > bw || (w === bw && j < best)) { bw = w; best = j; }

@@ -97,27 +97,34 @@ export function writeSkinMatrices(source: THREE.SkinnedMesh, out: Float32Array, 
   }
 }
 
+type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
+
 /** Geometries already warned about (a rebuild with other options reads the same geometry again). */
 const warnedInfluences = new WeakSet<THREE.BufferGeometry>();
 
+/** Whether any vertex of a skin weight attribute has a weight above 0. */
+function anyWeight(weights: AnyAttribute): boolean {
+  for (let i = 0; i < weights.count; i++)
+    for (let k = 0; k < weights.itemSize; k++) if (weights.getComponent(i, k) > 0) return true;
+  return false;
+}
+
 /**
- * GLTFLoader keeps JOINTS_1/WEIGHTS_1 as `joints_1`/`weights_1`; the core (like three's own
- * skinning) takes the first 4 influences, so weight there is lost: say so once per geometry
- * (gltf-node's loader instead keeps the 4 largest and renormalises, with its own warning).
+ * The second set of influences, as GLTFLoader keeps JOINTS_1/WEIGHTS_1 (`joints_1`/`weights_1`;
+ * three's own skinning ignores them), or null when absent or all zero (the rig then costs what a
+ * 4-influence one does). Where the first four sum to 1 (as GLTFLoader leaves them) and the second
+ * set holds weight, the first four are scaled by 1 − Σ(second): a glTF's eight sum to 1. A third set (more than 8 influences) is beyond the core: said once per geometry.
  */
-function warnExtraInfluences(geometry: THREE.BufferGeometry): void {
-  const extra = geometry.getAttribute('weights_1');
-  if (!extra || warnedInfluences.has(geometry)) return;
-  let vertices = 0;
-  for (let i = 0; i < extra.count; i++) {
-    for (let k = 0; k < extra.itemSize; k++) {
-      if (extra.getComponent(i, k) > 0) { vertices++; break; }
-    }
+function secondInfluences(geometry: THREE.BufferGeometry): { joints: AnyAttribute; weights: AnyAttribute } | null {
+  const extra = geometry.getAttribute('weights_2');
+  if (extra && !warnedInfluences.has(geometry) && anyWeight(extra)) {
+    warnedInfluences.add(geometry);
+    console.warn('gcs-skin: the skinned mesh has more than 8 joint influences per vertex (joints_2/weights_2); only the first 8 are used ' +
+      '(gcs-skin/gltf keeps the 8 largest and renormalises)');
   }
-  if (!vertices) return;
-  warnedInfluences.add(geometry);
-  console.warn(`gcs-skin: the skinned mesh has 8 joint influences per vertex (joints_1/weights_1); only the first 4 are used: ` +
-    `${vertices.toLocaleString('en-US')} of ${extra.count.toLocaleString('en-US')} vertices lose weight (renormalise to 4 influences before loading to keep their sum)`);
+  const joints = geometry.getAttribute('joints_1'), weights = geometry.getAttribute('weights_1');
+  if (!joints || !weights || joints.itemSize !== 4 || weights.itemSize !== 4 || !anyWeight(weights)) return null;
+  return { joints, weights };
 }
 
 /** Reads the rig (bind-pose mesh, skin, skeleton) out of a SkinnedMesh as GLTFLoader gives it. */
@@ -131,19 +138,32 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
   if (!position) throw new GcsError('NO_SKIN', 'the skinned mesh has no position attribute');
   if (!skinIndex || !skinWeight)
     throw new GcsError('NO_SKIN', 'the mesh has no skin weights (skinIndex/skinWeight attributes): it cannot be deformed by bones');
-  warnExtraInfluences(geometry);
+  const second = secondInfluences(geometry);
+  const influences = second ? 8 : 4;
   const n = position.count;
   const positions = new Float32Array(n * 3);
-  const joints = new Uint32Array(n * 4);
-  const weights = new Float32Array(n * 4);
+  const joints = new Uint32Array(n * influences);
+  const weights = new Float32Array(n * influences);
   // Build-time only: getX/getY… handle interleaved and normalised attributes uniformly.
   for (let i = 0; i < n; i++) {
     positions[3 * i] = position.getX(i);
     positions[3 * i + 1] = position.getY(i);
     positions[3 * i + 2] = position.getZ(i);
     for (let k = 0; k < 4; k++) {
-      joints[4 * i + k] = skinIndex.getComponent(i, k);
-      weights[4 * i + k] = skinWeight.getComponent(i, k);
+      joints[influences * i + k] = skinIndex.getComponent(i, k);
+      weights[influences * i + k] = skinWeight.getComponent(i, k);
+    }
+    if (second) {
+      let first = 0, rest = 0;
+      for (let k = 0; k < 4; k++) {
+        joints[influences * i + 4 + k] = second.joints.getComponent(i, k);
+        weights[influences * i + 4 + k] = second.weights.getComponent(i, k);
+        first += weights[influences * i + k];
+        rest += Math.max(0, weights[influences * i + 4 + k]);
+      }
+      // GLTFLoader scales the first four to sum 1 (SkinnedMesh.normalizeSkinWeights) and leaves the
+      // second set alone; a glTF's eight sum to 1, so the first four had 1 − Σ(second) between them.
+      if (Math.abs(first - 1) < 1e-3) for (let k = 0; k < 4; k++) weights[influences * i + k] *= Math.max(0, 1 - rest);
     }
   }
   const normalAttr = geometry.getAttribute('normal');
@@ -179,10 +199,8 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
     m.multiplyMatrices(inv, source.bindMatrix);
     inverseBindMatrices.set(m.elements, 16 * i);
   });
-  return { positions, normals, indices, joints, weights, parents, inverseBindMatrices };
+  return { positions, normals, indices, joints, weights, influences, parents, inverseBindMatrices };
 }
-
-type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
 
 /** Morph targets as relative deltas in the source's vertex order (glTF / three: morphTargetsRelative). */
 interface MorphData {
@@ -486,7 +504,7 @@ export class SkinDeformer {
       if (p >= 0 && p < J) { neighbours[j].push(p); neighbours[p].push(j); }
     }
     const own = new Float64Array(J).fill(-1), near = new Float64Array(J).fill(-1);
-    const P = input.positions, Jt = input.joints, W = input.weights;
+    const P = input.positions, Jt = input.joints, W = input.weights, K = input.influences ?? 4;
     const n = P.length / 3;
     const reach = (r2: Float64Array, j: number, v: number) => {
       const dx = P[3 * v] - pivots[3 * j], dy = P[3 * v + 1] - pivots[3 * j + 1], dz = P[3 * v + 2] - pivots[3 * j + 2];
@@ -494,9 +512,9 @@ export class SkinDeformer {
       if (d > r2[j]) r2[j] = d;
     };
     for (let v = 0; v < n; v++) {
-      for (let k = 0; k < 4; k++) {
-        if (!(W[4 * v + k] > 0)) continue;
-        const j = Jt[4 * v + k];
+      for (let k = 0; k < K; k++) {
+        if (!(W[K * v + k] > 0)) continue;
+        const j = Jt[K * v + k];
         if (j >= J) continue;
         reach(own, j, v);
         reach(near, j, v);

@@ -7,8 +7,11 @@
 //     backend, same frame, same camera, read back as pixels.
 import * as THREE from 'three';
 import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib/index.js';
-import { GcsCharacter, type Backend } from '../../../web/lib/three.js';
+import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend } from '../../../web/lib/three.js';
+import { GcsCrowd } from '../../../web/lib/crowd.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
+import type { TableSlots } from '../../../web/lib/gpu/layout.js';
+import { firstFour } from '../../helpers/influences.js';
 import { load, stage } from '../fixture-scene.js';
 
 const W = 512, H = 512;
@@ -41,7 +44,7 @@ varying vec4 vOut;
 void main() { gl_FragColor = vOut; }`;
 
 /** What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals, float32. */
-function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath): { positions: Float32Array; normals: Float32Array } {
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath, slots: TableSlots): { positions: Float32Array; normals: Float32Array } {
   const src = mesh.geometry;
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
@@ -52,7 +55,7 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   }
   const material = new THREE.ShaderMaterial({
     uniforms: { ...(uniforms as Record<string, THREE.IUniform>), readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
-    vertexShader: patchVertexShader(READ_VERTEX, smooth, path),
+    vertexShader: patchVertexShader(READ_VERTEX, smooth, path, slots),
     fragmentShader: READ_FRAGMENT,
   });
   const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
@@ -105,6 +108,10 @@ export interface CheckResult {
   extColorBufferFloat: boolean;
   /** the largest ratio of the longest to the shortest column of a skin matrix's 3×3 (1: no non-uniform scale) */
   anisotropy: number;
+  /** each skin's joints per section in the joint-level table (4, or 8 on a rig that blends more) */
+  tableSlots: number[];
+  /** how far (of the height) the CPU result moves when each skin is cut to its first 4 influences: what the second set contributes */
+  secondSet: number;
 }
 
 /** Share of pixels of which a channel differs by more than 16 (of 255). */
@@ -131,7 +138,13 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
-    extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1 };
+    extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1,
+    tableSlots: character.skins.map((s) => s.gpuSections?.tableSlots ?? 0), secondSet: 0 };
+  // The same skins cut to their first 4 influences (on the CPU), for secondSet.
+  const cut = character.skins.map((s) => {
+    const rig = gcs.createRig(firstFour(rigInputFromSkinnedMesh(s.source)));
+    return { rig, deformer: rig.buildGcs(gcsOptions) };
+  });
   const pixels = (backend: Backend): Uint8Array => {
     if (character.backend !== backend) character.rebuild(undefined, { backend });
     character.update();
@@ -152,10 +165,10 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     if (boneScale) scaled!.scale.multiply(new THREE.Vector3(...boneScale));
     if (character.backend !== 'gpu') character.rebuild(undefined, { backend: 'gpu' });
     character.update();
-    for (const skin of character.skins) {
+    character.skins.forEach((skin, k) => {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
-      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path);
+      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path, sections.tableSlots);
       const d = skin.deformer as GcsDeformer;
       const S = (skin as unknown as { skin: Float32Array }).skin;
       d.deform(S); // the same frame on the CPU
@@ -179,7 +192,15 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
         if (!(raw <= result.normalErrorRaw)) result.normalErrorRaw = Number.isNaN(raw) ? Infinity : raw;
         if (moved > result.motion) result.motion = moved;
       }
-    }
+      cut[k].deformer.deform(S);
+      const src = d.sourceVertex!, cutSrc = cut[k].deformer.sourceVertex!, cutP = cut[k].deformer.positions;
+      const outputOf = new Uint32Array(src.length);
+      for (let o = 0; o < cutSrc.length; o++) outputOf[cutSrc[o]] = o;
+      for (let v = 0; v < d.vertexCount; v++) {
+        const o = outputOf[src[v]];
+        result.secondSet = Math.max(result.secondSet, Math.hypot(cutP[3 * o] - cpuP[3 * v], cutP[3 * o + 1] - cpuP[3 * v + 1], cutP[3 * o + 2] - cpuP[3 * v + 2]) / height);
+      }
+    });
     const a = pixels('gpu'), b = pixels('cpu');
     first ??= a;
     let covered = 0;
@@ -188,11 +209,82 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     result.pixelMotion = Math.max(result.pixelMotion, differing(a, first));
     result.coverage = Math.max(result.coverage, covered / (W * H));
   }
+  for (const c of cut) { c.deformer.dispose(); c.rig.dispose(); }
   character.dispose();
   return result;
 }
 
-declare global {
-  interface Window { __gpu: { check: typeof check } }
+export interface CrowdResult {
+  path: string; tableSlots: number; instances: number;
+  /** worst |GPU − CPU| over every instance's vertices (each instance at its own clip time), of the height */
+  positionError: number;
+  /** share of pixels differing between the crowd's instance 0 (one instanced draw) and the CPU backend's character at the same pose */
+  pixelDiff: number;
+  coverage: number;
 }
-window.__gpu = { check };
+
+/**
+ * GcsCrowd: instance i posed at `times[i]`. What the shader computes for each instance (its texels
+ * at gcsBase + i · gcsStride, read back as in check) against the CPU deformer on that instance's
+ * skin matrices; then the crowd drawn (instance 0 placed where the source stands) against the CPU
+ * backend's picture of the character at times[0].
+ */
+async function crowd(model: string, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CrowdResult> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const { scene, camera } = stage(root, W, H);
+  let source: THREE.SkinnedMesh | undefined;
+  root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
+  const c = new GcsCrowd(gcs, source!, times.length, { gpuPath });
+  const tmp = new THREE.Matrix4();
+  times.forEach((t, i) => {
+    mixer.setTime(t);
+    root.updateMatrixWorld(true);
+    writeSkinMatrices(source!, c.skins, c.offsetOf(i), tmp);
+  });
+  c.update();
+  const sections = c.sections, height = c.rig.height;
+  const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, positionError: 0, pixelDiff: 1, coverage: 0 };
+  const base = sections.uniforms.gcsBase.value, stride = sections.uniforms.gcsStride.value;
+  times.forEach((_, i) => {
+    const gpuOut = readBack(c.mesh, { ...sections.uniforms, gcsBase: { value: base + i * stride } }, sections.smooth, sections.path, sections.tableSlots);
+    c.deformer.deform(c.skins.subarray(c.offsetOf(i), c.offsetOf(i) + 16 * c.jointCount));
+    const cpu = c.deformer.positions;
+    for (let v = 0; v < c.deformer.vertexCount; v++) {
+      const dp = Math.hypot(gpuOut.positions[3 * v] - cpu[3 * v], gpuOut.positions[3 * v + 1] - cpu[3 * v + 1], gpuOut.positions[3 * v + 2] - cpu[3 * v + 2]) / height;
+      if (!(dp <= result.positionError)) result.positionError = Number.isNaN(dp) ? Infinity : dp;
+    }
+  });
+  // The picture: the character on the CPU backend at times[0], then the crowd's instance 0 in its place.
+  mixer.setTime(times[0]);
+  const character = new GcsCharacter(gcs, root, { backend: 'cpu' });
+  character.update();
+  const read = (): Uint8Array => {
+    renderer.setClearColor(0x000000, 1);
+    renderer.render(scene, camera);
+    const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return out;
+  };
+  const cpu = read();
+  for (const m of character.meshes) m.visible = false;
+  c.mesh.count = 1;
+  c.mesh.setMatrixAt(0, source!.matrixWorld);
+  c.mesh.instanceMatrix.needsUpdate = true;
+  scene.add(c.mesh);
+  const gpu = read();
+  let covered = 0;
+  for (let i = 0; i < W * H; i++) if (gpu[4 * i] + gpu[4 * i + 1] + gpu[4 * i + 2] > 0) covered++;
+  result.coverage = covered / (W * H);
+  result.pixelDiff = differing(gpu, cpu);
+  character.dispose();
+  c.dispose();
+  return result;
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check; crowd: typeof crowd } }
+}
+window.__gpu = { check, crowd };

@@ -10,7 +10,7 @@ import { WebGLNodesHandler } from 'three/addons/tsl/WebGLNodesHandler.js';
 import { initGcsSkin, type GcsOptions } from '../../../web/lib/index.js';
 import * as WebGL from '../../../web/lib/three.js';
 import { GcsCrowd as WebGLCrowd } from '../../../web/lib/crowd.js';
-import { bakeClip, GcsCharacter, GcsCrowd } from '../../../web/lib/webgpu.js';
+import { bakeClip, GcsCharacter, GcsCrowd, writeSkinMatrices } from '../../../web/lib/webgpu.js';
 import type { GpuPath } from '../../../web/lib/gpu.js';
 import { load, stage as stageAt, type Loaded } from '../fixture-scene.js';
 
@@ -217,6 +217,58 @@ async function crowd(model: string, count: number, clipName?: string): Promise<C
   return result;
 }
 
+export interface InfluencesResult {
+  backends: string[]; paths: string[]; tableSlots: number[];
+  /** the GPU backend (TSL) vs the CPU backend, same pose */
+  vsCpu: { image: number; covered: number };
+  /** the GPU backend vs the CPU backend of the same file without joints_1/weights_1 (what three's own skinning reads) */
+  vsFour: { image: number; covered: number };
+  /** the crowd's instance 0 (one instanced TSL draw, placed where the source stands) vs the CPU backend */
+  crowdVsCpu: { image: number; covered: number };
+  coverage: number;
+}
+
+/**
+ * A character with more than 4 influences per vertex on WebGPURenderer at one pose: gcs-skin/webgpu's
+ * GPU backend and a GcsCrowd against its CPU backend, and against the CPU backend of the same file
+ * read without its second set of influences.
+ */
+async function influences(model: string, gcsOptions: GcsOptions, time: number, gpuPath: GpuPath): Promise<InfluencesResult> {
+  const gcs = await gcsReady;
+  const renderer = await gpuRenderer();
+  const picture = async (backend: 'gpu' | 'cpu', dropSecondSet: boolean, asCrowd = false) => {
+    const loaded = await load(model);
+    let source: THREE.SkinnedMesh | undefined;
+    loaded.root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+    if (dropSecondSet) { source!.geometry.deleteAttribute('joints_1'); source!.geometry.deleteAttribute('weights_1'); }
+    const { scene, camera } = stage(loaded.root);
+    play(loaded).setTime(time);
+    loaded.root.updateMatrixWorld(true);
+    if (asCrowd) {
+      const c = new GcsCrowd(gcs, source!, 1, { gcs: gcsOptions, gpuPath });
+      writeSkinMatrices(source!, c.skins, 0);
+      c.update();
+      c.mesh.setMatrixAt(0, source!.matrixWorld);
+      source!.visible = false;
+      scene.add(c.mesh);
+      const pixels = await draw(renderer, scene, camera);
+      c.dispose();
+      return { pixels, backends: ['gpu'], paths: [c.sections.path], tableSlots: [c.sections.tableSlots] };
+    }
+    const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend, gpuPath });
+    character.update();
+    const pixels = await draw(renderer, scene, camera);
+    const out = { pixels, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), tableSlots: character.skins.map((s) => s.gpuSections?.tableSlots ?? 0) };
+    character.dispose();
+    return out;
+  };
+  const gpu = await picture('gpu', false), cpu = await picture('cpu', false), four = await picture('cpu', true), crowded = await picture('gpu', false, true);
+  return {
+    backends: gpu.backends, paths: [...gpu.paths, ...crowded.paths], tableSlots: [...gpu.tableSlots, ...crowded.tableSlots],
+    vsCpu: differing(gpu.pixels, cpu.pixels), vsFour: differing(gpu.pixels, four.pixels), crowdVsCpu: differing(crowded.pixels, cpu.pixels), coverage: coverage(gpu.pixels),
+  };
+}
+
 export interface FallbackResult {
   before: string; after: string; note: string; warnings: string[];
   /** the first frame vs the CPU backend's picture: drawn right, or (firstCoverage 0) not at all */
@@ -314,6 +366,6 @@ async function crowdOnWrongRenderer(model: string, entry: 'webgpu' | 'three'): P
 }
 
 declare global {
-  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer } }
+  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences } }
 }
-window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer };
+window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences };

@@ -6,7 +6,8 @@
 // reads it, with the decoders of the three compression extensions the field uses
 // (KHR_mesh_quantization, EXT_meshopt_compression with meshoptimizer's MeshoptDecoder,
 // KHR_draco_mesh_compression with draco3dgltf's decoder), drops the textures, turns the geometry
-// back into plain float attributes (more than 4 influences per vertex: the 4 largest, renormalised)
+// back into plain float attributes (JOINTS_1/WEIGHTS_1 kept: up to 8 influences per vertex; more
+// than 8: the 8 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
 // gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
 import { constants as fs } from 'node:fs';
@@ -168,8 +169,8 @@ const FLOAT_SEMANTICS = /^(POSITION|NORMAL|TANGENT)$/;
 
 /**
  * Turns decoded, possibly quantized geometry into plain glTF 2.0: POSITION, NORMAL and TANGENT
- * (and their morph targets) as FLOAT, more than 4 joint influences per vertex reduced to the 4
- * largest (renormalised, with a warning: the core takes 4), every accessor in one buffer, and the
+ * (and their morph targets) as FLOAT, more than 8 joint influences per vertex reduced to the 8
+ * largest (renormalised, with a warning: the core takes 8), every accessor in one buffer, and the
  * compression extensions removed, so the GLB written next is uncompressed.
  */
 function plainGeometry(doc: Doc, warnings: string[]): void {
@@ -193,8 +194,7 @@ function plainGeometry(doc: Doc, warnings: string[]): void {
     for (const target of prim.listTargets())
       for (const semantic of target.listSemantics())
         if (FLOAT_SEMANTICS.test(semantic)) target.setAttribute(semantic, toFloat(target.getAttribute(semantic)!));
-    const sets = prim.listSemantics().filter((s) => /^JOINTS_[1-9]\d*$/.test(s));
-    if (sets.length) {
+    if (prim.getAttribute('JOINTS_1') && prim.getAttribute('WEIGHTS_1')) {
       const name = `mesh ${mi}${mesh.getName() ? ` '${mesh.getName()}'` : ''} primitive ${pi}`;
       const w = reduceInfluences(doc, prim, name);
       if (w) warnings.push(w);
@@ -211,11 +211,13 @@ function plainGeometry(doc: Doc, warnings: string[]): void {
 }
 
 /**
- * JOINTS_0..n / WEIGHTS_0..n (more than 4 influences) → JOINTS_0 / WEIGHTS_0 with the 4 largest
- * weights of each vertex, renormalised to sum 1. Returns the warning, or null when the extra sets
- * were all zero.
+ * JOINTS_0..n / WEIGHTS_0..n (n ≥ 1: more than 4 influences) → JOINTS_0..1 / WEIGHTS_0..1 with the
+ * 8 largest weights of each vertex, renormalised to sum 1 (three's GLTFLoader then scales the first
+ * four to sum 1 on their own, and gcs-skin/three's reader undoes that knowing the eight sum to 1).
+ * Returns the warning, or null when nothing was dropped.
  */
 function reduceInfluences(doc: Doc, prim: import('@gltf-transform/core').Primitive, name: string): string | null {
+  const KEPT = 8;
   const pairs: [Accessor, Accessor][] = [];
   for (let k = 0; ; k++) {
     const j = prim.getAttribute(`JOINTS_${k}`), w = prim.getAttribute(`WEIGHTS_${k}`);
@@ -225,7 +227,7 @@ function reduceInfluences(doc: Doc, prim: import('@gltf-transform/core').Primiti
   const count = prim.getAttribute('POSITION')?.getCount() ?? pairs[0]?.[0].getCount() ?? 0;
   if (pairs.length < 2) return null;
   const influences = 4 * pairs.length;
-  const joints = new Uint16Array(4 * count), weights = new Float32Array(4 * count);
+  const joints = new Uint16Array(KEPT * count), weights = new Float32Array(KEPT * count);
   const jv = new Array<number>(influences), wv = new Array<number>(influences), order = new Array<number>(influences);
   const je: number[] = [], we: number[] = [];
   let cut = 0, maxDropped = 0, maxJoint = 0;
@@ -237,29 +239,33 @@ function reduceInfluences(doc: Doc, prim: import('@gltf-transform/core').Primiti
     });
     order.sort((a, b) => wv[b] - wv[a] || a - b);
     let kept = 0;
-    for (let c = 0; c < 4; c++) kept += Math.max(0, wv[order[c]]);
-    const dropped = wv[order[4]] > 0 ? wv[order[4]] : 0;
+    for (let c = 0; c < KEPT; c++) kept += Math.max(0, wv[order[c]]);
+    const dropped = wv[order[KEPT]] > 0 ? wv[order[KEPT]] : 0;
     if (dropped > 0) { cut++; maxDropped = Math.max(maxDropped, dropped); }
-    for (let c = 0; c < 4; c++) {
+    for (let c = 0; c < KEPT; c++) {
       const o = order[c];
       const weight = wv[o] > 0 ? wv[o] : 0;
-      joints[4 * v + c] = weight > 0 ? jv[o] : 0;
-      weights[4 * v + c] = kept > 0 ? weight / kept : 0;
-      maxJoint = Math.max(maxJoint, joints[4 * v + c]);
+      joints[KEPT * v + c] = weight > 0 ? jv[o] : 0;
+      weights[KEPT * v + c] = kept > 0 ? weight / kept : 0;
+      maxJoint = Math.max(maxJoint, joints[KEPT * v + c]);
     }
   }
   const buffer = pairs[0][0].getBuffer();
-  const jointsOut = maxJoint < 256 ? Uint8Array.from(joints) : joints;
-  prim.setAttribute('JOINTS_0', doc.createAccessor().setType('VEC4').setArray(jointsOut).setBuffer(buffer));
-  prim.setAttribute('WEIGHTS_0', doc.createAccessor().setType('VEC4').setArray(weights).setBuffer(buffer));
-  for (let k = 1; k < pairs.length; k++) {
+  for (let set = 0; set < KEPT / 4; set++) {
+    const j = new Uint16Array(4 * count), w = new Float32Array(4 * count);
+    for (let v = 0; v < count; v++)
+      for (let c = 0; c < 4; c++) j[4 * v + c] = joints[KEPT * v + 4 * set + c], w[4 * v + c] = weights[KEPT * v + 4 * set + c];
+    prim.setAttribute(`JOINTS_${set}`, doc.createAccessor().setType('VEC4').setArray(maxJoint < 256 ? Uint8Array.from(j) : j).setBuffer(buffer));
+    prim.setAttribute(`WEIGHTS_${set}`, doc.createAccessor().setType('VEC4').setArray(w).setBuffer(buffer));
+  }
+  for (let k = KEPT / 4; k < pairs.length; k++) {
     prim.setAttribute(`JOINTS_${k}`, null);
     prim.setAttribute(`WEIGHTS_${k}`, null);
   }
   for (const [j, w] of pairs) for (const a of [j, w]) if (a.listParents().every((p) => p === doc.getRoot())) a.dispose();
   if (!cut) return null;
   return `${name} has ${influences} joint influences per vertex (JOINTS_0..${pairs.length - 1}, WEIGHTS_0..${pairs.length - 1}); ` +
-    `gcs-skin takes 4: kept the 4 largest of each vertex and renormalised them (${n(cut)} of ${n(count)} vertices lost an influence, the largest lost weight ${maxDropped.toPrecision(3)})`;
+    `gcs-skin takes ${KEPT}: kept the ${KEPT} largest of each vertex and renormalised them (${n(cut)} of ${n(count)} vertices lost an influence, the largest lost weight ${maxDropped.toPrecision(3)})`;
 }
 
 /**
@@ -286,9 +292,10 @@ export async function loadGltfFile(file: string | Uint8Array, name = typeof file
     doc.getRoot().listMeshes().forEach((mesh, mi) => mesh.listPrimitives().forEach((prim, pi) => {
       const weights = prim.getAttribute('WEIGHTS_0');
       if (!weights) return;
+      const second = prim.getAttribute('WEIGHTS_1');
       const zero: number[] = [];
       for (let v = 0, count = weights.getCount(); v < count; v++)
-        if (weights.getElement(v, w).every((x) => x === 0)) zero.push(v);
+        if (weights.getElement(v, w).every((x) => x === 0) && (!second || second.getElement(v, w).every((x) => x === 0))) zero.push(v);
       if (zero.length) zeroWeights.set(`${mi}/${pi}`, zero);
     }));
     bytes = await io.writeBinary(doc);
@@ -429,10 +436,12 @@ export function characterHeight(meshes: readonly THREE.SkinnedMesh[]): Character
 function bindPoseMatrix(mesh: THREE.SkinnedMesh): THREE.Matrix4 {
   const J = mesh.skeleton.bones.length;
   const skin = skinMatricesOf(mesh, new Float32Array(16 * J));
-  const joints = mesh.geometry.getAttribute('skinIndex'), weights = mesh.geometry.getAttribute('skinWeight');
   const used = new Set<number>();
-  if (joints && weights)
-    for (let i = 0; i < joints.count; i++) for (let k = 0; k < 4; k++) if (weights.getComponent(i, k) > 0) used.add(joints.getComponent(i, k));
+  for (const [j, w] of [['skinIndex', 'skinWeight'], ['joints_1', 'weights_1']]) {
+    const joints = mesh.geometry.getAttribute(j), weights = mesh.geometry.getAttribute(w);
+    if (joints && weights)
+      for (let i = 0; i < joints.count; i++) for (let k = 0; k < 4; k++) if (weights.getComponent(i, k) > 0) used.add(joints.getComponent(i, k));
+  }
   const list = [...used].filter((j) => j < J);
   if (!list.length) return new THREE.Matrix4();
   const first = 16 * list[0];

@@ -63,7 +63,11 @@ export interface ClipMethodReport {
 
 export interface MeshReport {
   name: string;
-  counts: { vertices: number; triangles: number; joints: number; parts: number | null; sections: number | null; height: number };
+  counts: {
+    vertices: number; triangles: number; joints: number; parts: number | null; sections: number | null; height: number;
+    /** Influences per vertex read (4, or 8 with JOINTS_1/WEIGHTS_1), and how many vertices have more than 4 (weights > 0). */
+    influences: number; moreThan4Influences: number;
+  };
   /** Mean column length of the mesh's world matrix. */
   worldScale: number;
   /** The character's height in this mesh's units: 100 % of every fidelity distance. */
@@ -230,6 +234,7 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       counts: {
         vertices: rig.vertexCount, triangles: input.indices.length / 3, joints: rig.jointCount,
         parts: gcsCounts?.parts ?? null, sections: gcsCounts?.sections ?? null, height: round(rig.height, 6),
+        influences: input.influences ?? 4, moreThan4Influences: verticesOverFourInfluences(input),
       },
       worldScale: round(s.worldScale, 6),
       height: round(height, 6),
@@ -240,6 +245,19 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
   } finally {
     rig.dispose();
   }
+}
+
+/** How many vertices have more than 4 influences (weights > 0). */
+export function verticesOverFourInfluences(input: RigInput): number {
+  const K = input.influences ?? 4;
+  if (K <= 4) return 0;
+  let count = 0;
+  for (let v = 0, n = input.weights.length / K; v < n; v++) {
+    let used = 0;
+    for (let k = 0; k < K; k++) if (input.weights[K * v + k] > 0) used++;
+    if (used > 4) count++;
+  }
+  return count;
 }
 
 /** The methods that produced non-finite values, per mesh (empty: none). */
@@ -274,6 +292,8 @@ export function formatReport(r: Report): string {
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
     out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
+    out.push(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
+      (c.moreThan4Influences ? ' (three.js\'s own skinning would drop their JOINTS_1/WEIGHTS_1)' : ''));
     const lbs = m.methods.lbs?.fidelity?.flipped;
     // Creases against the baselines: the more of LBS's and DQS's count over the same frames.
     const creaseBase = Math.max(m.methods.lbs?.fidelity?.creases ?? 0, m.methods.dqs?.fidelity?.creases ?? 0);

@@ -5,8 +5,8 @@
  */
 import { GcsError } from '../errors.js';
 import {
-  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JOINTS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
-  SECTION_ATTRIBUTE, TABLE_TEXELS_PER_SECTION, UNIFORM_SCALE_TOLERANCE, type GpuPath,
+  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
+  SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -148,8 +148,10 @@ mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
 }
 // Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
 // dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first.
+// GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
 void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
-	vec4 joints = gcsTexel( gcsTable, ${TABLE_TEXELS_PER_SECTION} * s ), weights = gcsTexel( gcsTable, ${TABLE_TEXELS_PER_SECTION} * s + 1 );
+	int row = GCS_TABLE_TEXELS * s;
+	vec4 joints = gcsTexel( gcsTable, row ), weights = gcsTexel( gcsTable, row + 1 );
 	mat3 S; vec3 t; vec4 q;
 	gcsJoint( int( joints.x ), S, t, q );
 	if ( joints.y < 0.0 ) {
@@ -158,13 +160,21 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 		N = gcsNormalMatrix( r, transpose( r ) * S, renorm );
 		return;
 	}
+	#if GCS_TABLE_SLOTS > 4
+	vec4 joints1 = gcsTexel( gcsTable, row + 2 ), weights1 = gcsTexel( gcsTable, row + 3 );
+	#endif
 	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
 	mat3 K = mat3( 0.0 );
-	for ( int k = 0; k < ${JOINTS_PER_SECTION}; k ++ ) {
-		if ( joints[ k ] < 0.0 ) break;
-		if ( k > 0 ) gcsJoint( int( joints[ k ] ), S, t, q );
+	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+		#if GCS_TABLE_SLOTS > 4
+		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
+		float w = k < 4 ? weights[ k ] : weights1[ k - 4 ];
+		#else
+		float id = joints[ k ], w = weights[ k ];
+		#endif
+		if ( id < 0.0 ) break;
+		if ( k > 0 ) gcsJoint( int( id ), S, t, q );
 		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
-		float w = weights[ k ];
 		float sw = dot( q, pivot ) < 0.0 ? - w : w;
 		br += sw * q;
 		bd += sw * d;
@@ -226,14 +236,16 @@ const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', 
  * The vertex shader of a three.js built-in material (or any shader written with its chunks) with
  * three's skinning chunks replaced by GCS's: path 'sections', the section transforms come from the
  * `gcsSections` texture; path 'joints', each vertex's section is blended from the joint poses in
- * `gcsJoints` and the static table `gcsTable`. Morph targets still apply first (three's order),
- * then the section transform; normals and tangents turn with the normal matrix. Throws GcsError
- * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
+ * `gcsJoints` and the static table `gcsTable` (`slots` joints per section: GpuSections.tableSlots).
+ * Morph targets still apply first (three's order), then the section transform; normals and
+ * tangents turn with the normal matrix. Throws GcsError 'INVALID_ARGUMENT' when the shader lacks
+ * the chunks (a ShaderMaterial written without them).
  */
-export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections'): string {
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): string {
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
   if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
   const joints = path === 'joints';
   let out = source
     .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? JOINT_PARS : PARS}`)
@@ -241,6 +253,8 @@ export function patchVertexShader(source: string, smooth: boolean, path: GpuPath
     .replace(HOOKS[2], joints ? JOINT_POSITION : POSITION);
   // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
   out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
-  return `${smooth ? '#define GCS_SMOOTH\n' : ''}${out}`;
+  const table = joints ? `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n` : '';
+  const defines = `${smooth ? '#define GCS_SMOOTH\n' : ''}${table}`;
+  return `${defines}${out}`;
 }
 

@@ -13,10 +13,13 @@ export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION };
  */
 export type GpuPath = 'joints' | 'sections';
 
-/** Texels per section in the joint-level path's static table: its joints (−1 past the last), then their weights. */
-export const TABLE_TEXELS_PER_SECTION = 2;
-/** Most joints one section blends (the table's texel holds four). */
-export const JOINTS_PER_SECTION = 4;
+/**
+ * Joints per section in the joint-level path's static table (gcs_gcs_section_influence_slots): 4,
+ * or 8 where some section blends more than 4 (a rig with up to 8 influences per vertex).
+ */
+export type TableSlots = 4 | 8;
+/** Texels per section in the static table: per 4 slots, its joints (−1 past the last), then their weights. */
+export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2;
 
 /** Per-vertex attribute, plain mode: the vertex's section (a float). */
 export const SECTION_ATTRIBUTE = 'gcsSection';

@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
-import { BLEND_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath } from './layout.js';
+import { BLEND_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath, type TableSlots } from './layout.js';
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
@@ -40,6 +40,8 @@ export class GpuSections {
   readonly texture: THREE.DataTexture;
   /** Path 'joints': the static texture of each section's joints and weights; null otherwise. */
   readonly table: THREE.DataTexture | null;
+  /** Path 'joints': joints per section in `table` (4, or 8 where a section blends more); 4 otherwise. */
+  readonly tableSlots: TableSlots;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
 
@@ -50,7 +52,9 @@ export class GpuSections {
     const t = this.transforms;
     this.texture = floatTexture(t.texels, t.width, t.height);
     const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
+    this.tableSlots = 4;
     if (this.path === 'joints') {
+      this.tableSlots = deformer.sectionInfluenceSlots === 8 ? 8 : 4;
       const influences = deformer.sectionInfluences()!;
       const texels = influences.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
       const data = new Float32Array(width * height * 4);

@@ -11,8 +11,8 @@ import * as THREE from 'three';
 import * as TSL from 'three/tsl';
 import type { Node } from 'three/webgpu';
 import {
-  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JOINTS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
-  SECTION_ATTRIBUTE, TABLE_TEXELS_PER_SECTION, UNIFORM_SCALE_TOLERANCE,
+  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
+  SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import type { GpuSections } from './sections.js';
 
@@ -83,8 +83,8 @@ function normalMatrix(r: M3, k: M3): { n: M3; renorm: N } {
 /** One section's transform x ↦ M x + T, its normal matrix N and whether normals renormalise. */
 interface SectionBlend { m: M3; t: N; n: M3; renorm: N }
 
-/** The joint-level path's inputs: joint poses (per frame) and the section table (static). */
-interface JointInputs { joints: N; table: N; first: N }
+/** The joint-level path's inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
+interface JointInputs { joints: N; table: N; slots: TableSlots; first: N }
 
 /** Joint j's pose: S_j (columns), its translation and rotation quaternion. */
 function joint(inputs: JointInputs, j: N): { s: M3; t: N; q: N } {
@@ -100,8 +100,14 @@ function joint(inputs: JointInputs, j: N): { s: M3; t: N; q: N } {
  * Joints past the last (−1) get weight 0, which adds nothing: the GLSL's early break.
  */
 function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
-  const joints = texel(inputs.table, s.mul(TABLE_TEXELS_PER_SECTION)).toVar();
-  const weights = texel(inputs.table, s.mul(TABLE_TEXELS_PER_SECTION).add(1)).toVar();
+  // Per 4 slots, a texel of joints then one of weights (slots 4..7: the third and fourth texels).
+  const row = s.mul(tableTexelsPerSection(inputs.slots)).toVar();
+  const jointTexels: N[] = [], weightTexels: N[] = [];
+  for (let g = 0; g < inputs.slots / 4; g++) {
+    jointTexels.push(texel(inputs.table, row.add(2 * g)).toVar());
+    weightTexels.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
+  }
+  const joints = jointTexels[0], weights = weightTexels[0];
   const lanes = ['x', 'y', 'z', 'w'] as const;
   const j0 = joint(inputs, int(joints.x));
   const rigidRotation = rotation(j0.q, float(2));
@@ -110,11 +116,11 @@ function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
   const pivot = j0.q;
   let br: N = vec4(0), bd: N = vec4(0);
   let k: M3 = ZERO();
-  for (let c = 0; c < JOINTS_PER_SECTION; c++) {
-    const id = joints[lanes[c]];
+  for (let c = 0; c < inputs.slots; c++) {
+    const id = jointTexels[c >> 2][lanes[c & 3]];
     const { s: S, t, q } = c === 0 ? j0 : joint(inputs, max(int(id), int(0)));
     const d = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
-    const w = c === 0 ? weights.x : select(id.lessThan(0), float(0), weights[lanes[c]]);
+    const w = c === 0 ? weights.x : select(id.lessThan(0), float(0), weightTexels[c >> 2][lanes[c & 3]]);
     const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
     br = br.add(q.mul(sw));
     bd = bd.add(d.mul(sw));
@@ -226,7 +232,7 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node
   return Fn((builder: N) => {
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
     const vertex = sections.path === 'joints'
-      ? jointVertex({ joints: perFrame, table: texture(sections.table as THREE.DataTexture), first }, sections.smooth)
+      ? jointVertex({ joints: perFrame, table: texture(sections.table as THREE.DataTexture), slots: sections.tableSlots, first }, sections.smooth)
       : sectionVertex(perFrame, first, sections.smooth);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') : null;
     if (builder.hasGeometryAttribute('normal')) {

@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { patchVertexShader } from './glsl.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
-import type { GpuPath } from './layout.js';
+import type { GpuPath, TableSlots } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** Why a material cannot draw a GCS mesh on the GPU, or null when it can. */
@@ -19,10 +19,11 @@ export function gpuMaterialSupport(material: THREE.Material): string | null {
 
 /**
  * A clone of `source` (sharing its textures) whose vertex shader applies GCS section transforms
- * read from `uniforms` (path 'sections'), or blends them from the joint poses (path 'joints'). The
- * source's own onBeforeCompile, if any, runs first.
+ * read from `uniforms` (path 'sections'), or blends them from the joint poses (path 'joints', with
+ * `slots` joints per section in the table: GpuSections.tableSlots). The source's own
+ * onBeforeCompile, if any, runs first.
  */
-export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): M {
+export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): M {
   const reason = gpuMaterialSupport(source);
   if (reason) throw new GcsError('INVALID_ARGUMENT', reason);
   const material = source.clone() as M;
@@ -31,9 +32,9 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
   material.onBeforeCompile = (shader, renderer) => {
     own.call(source, shader, renderer);
     for (const [name, u] of Object.entries(uniforms)) if (u) shader.uniforms[name] = u;
-    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path);
+    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path, slots);
   };
-  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}-${path}`;
+  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}-${path}${path === 'joints' ? `-${slots}` : ''}`;
   material.name = source.name;
   material.userData.gcsSource = source;
   return material;
@@ -43,7 +44,7 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
  */
-export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
+export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };
@@ -54,7 +55,7 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
       m.alphaMap = s.alphaMap ?? null;
     }
   }
-  return { depth: gcsMaterial(depth, uniforms, smooth, path), distance: gcsMaterial(distance, uniforms, smooth, path) };
+  return { depth: gcsMaterial(depth, uniforms, smooth, path, slots), distance: gcsMaterial(distance, uniforms, smooth, path, slots) };
 }
 
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
@@ -62,10 +63,10 @@ export const glslKit: GpuMaterialKit = {
   entry: 'gcs-skin/three',
   support: gpuMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
-    const { uniforms, smooth, path } = sections;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path);
+    const { uniforms, smooth, path, tableSlots } = sections;
+    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, tableSlots);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
-    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path);
+    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, tableSlots);
     return { material, depth: shadow.depth, distance: shadow.distance };
   },
   mismatch(renderer: unknown): string | null {
