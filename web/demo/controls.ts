@@ -30,7 +30,6 @@ interface Ctl { domElement: HTMLElement; name(n: string): this; onChange(f: () =
 interface OptionsCtl extends Ctl { options(values: string[] | Record<string, string>): OptionsCtl }
 interface ValueCtl<T> extends Ctl { setValue(v: T): this }
 
-let gui: GUI;
 let modelController: OptionsCtl;
 let clipController: OptionsCtl;
 let sectionsController: ValueCtl<number>;
@@ -45,7 +44,7 @@ let actions: CharacterActions;
 export function initControls(menu: MenuEntry[], characterActions: CharacterActions): void {
   menuEntries = menu;
   actions = characterActions;
-  gui = new GUI({ title: 'gcs-skin', width: 270 });
+  const gui = new GUI({ title: 'gcs-skin', width: 270 });
   const buttons = { loadFile: () => dom.fileInput.click(), stepFrame: () => pauseAndStep() };
 
   const m = gui.addFolder('Character');

@@ -20,12 +20,20 @@ export function views(): ViewKind[] {
   return params.lbsView ? ['gcs', 'classic', 'lbs'] : ['gcs', 'classic'];
 }
 
-/** Each view's column of the window, left to right (px). */
-export function viewRects(): { kind: ViewKind; x: number; width: number }[] {
-  const list = views();
+export interface ViewRect { kind: ViewKind; x: number; width: number }
+let rects: ViewRect[] = [];
+let rectsFor = { width: -1, lbs: false };
+
+/** Each view's column of the window, left to right (px); the same array until the window or the views change (render() asks every frame). */
+export function viewRects(): readonly ViewRect[] {
   const w = window.innerWidth - sidebarWidth();
-  return list.map((kind, i) => {
-    const x = Math.round((i * w) / list.length);
-    return { kind, x, width: Math.round(((i + 1) * w) / list.length) - x };
-  });
+  if (rectsFor.width !== w || rectsFor.lbs !== params.lbsView) {
+    const list = views();
+    rects = list.map((kind, i) => {
+      const x = Math.round((i * w) / list.length);
+      return { kind, x, width: Math.round(((i + 1) * w) / list.length) - x };
+    });
+    rectsFor = { width: w, lbs: params.lbsView };
+  }
+  return rects;
 }
