@@ -126,7 +126,7 @@ describe.skipIf(!!reason)('crowd mode', () => {
     try {
       expect(await page.locator('.lil-gui .controller .name').allInnerTexts())
         .toEqual(['renderer', 'characters', 'backend', 'GPU path', 'smooth (no steps)', 'shadows', 'paused']);
-      await expect(menu(page, 'renderer').evaluate((el: HTMLSelectElement) => Array.from(el.options).map((o) => o.text))).resolves.toEqual(['WebGLRenderer', 'WebGPURenderer']);
+      await expect(menu(page, 'renderer').evaluate((el: HTMLSelectElement) => Array.from(el.options).map((o) => o.text), null, slow)).resolves.toEqual(['WebGLRenderer', 'WebGPURenderer']);
 
       const characters = page.locator('.lil-gui .controller.number').filter({ has: page.locator('.name', { hasText: /^characters$/ }) }).locator('input');
       await characters.fill('12');

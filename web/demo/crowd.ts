@@ -259,6 +259,7 @@ export async function startCrowd(): Promise<void> {
     samples.length = 0;
     steadyMs.reset();
     steadyBytes.reset();
+    readoutDue = true;
   };
 
   /** Every character's box (its ground square, its height), world units. */
@@ -321,6 +322,7 @@ export async function startCrowd(): Promise<void> {
   let frame = 0;
   // The readout's figures: steady medians, "warming up" before (the first frames upload whole buffers).
   const steadyMs = new SteadyFigure(), steadyBytes = new SteadyFigure();
+  let readoutDue = true; // a rebuild shows its settings at once, its figures when steady
   const waiters: { frames: number; resolve: (r: CrowdMeasure) => void; start: number }[] = [];
   const fmtBytes = (b: number) => (b >= 1e6 ? `${(b / 1e6).toFixed(2)} MB` : b >= 1e3 ? `${(b / 1e3).toFixed(1)} KB` : `${b.toFixed(0)} B`);
   const clock = new THREE.Timer();
@@ -369,7 +371,8 @@ export async function startCrowd(): Promise<void> {
     }
     steadyMs.add(ms);
     steadyBytes.add(bytes);
-    if (frame % 10 === 1) {
+    if (readoutDue || frame % 10 === 1) {
+      readoutDue = false;
       const head = `<b>${count}</b> characters × ${source.geometry.getAttribute('position').count.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
         `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}${params.smooth ? ' (smooth)' : ''}`;
       const perFrame = steadyMs.value(), uploaded = steadyBytes.value();
