@@ -434,7 +434,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
         await frames(page, 3);
         const diff = await analyse(page, await page.screenshot(), regions, before);
         await toggle(page, control);
-        diff.forEach((d, i) => expect(d.changed, `${control}: view ${i} changed`).toBeGreaterThan(control === 'wireframe' ? 0.01 : 0.001));
+        diff.forEach((d, i) => expect(d.changed, `${control}: view ${i} changed`).toBeGreaterThan(control === 'wireframe' ? 0.003 : 0.001));
       }
     } finally {
       await toggle(page, 'pause');
