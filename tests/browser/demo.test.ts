@@ -2,7 +2,9 @@
 // slider in each GCS criterion (weights, the default; the paper's Y and axial), load a dropped
 // character, and keep the old one when a file is broken. The three characters shipped in public/
 // (Fox, Cesium Man, Robot Expressive) load from the menu and from ?model=, each complete and in
-// its own materials in every view, animated, with its licence on the page.
+// its own materials in every view, animated, with its licence on the page. Every control of the
+// GUI is driven by a test here (CONTROLS lists which; a control added to the GUI fails the list
+// until it has one).
 import { createHash } from 'node:crypto';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
@@ -27,6 +29,11 @@ async function frames(page: Page, n: number): Promise<void> {
 /** Clicks a lil-gui checkbox by its label. */
 async function toggle(page: Page, name: string): Promise<void> {
   await page.locator('.lil-gui .controller.boolean').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('input').click();
+}
+
+/** Clicks a lil-gui button by its label. */
+async function press(page: Page, name: string): Promise<void> {
+  await page.locator('.lil-gui .controller.function').filter({ has: page.locator('.name', { hasText: new RegExp(`^${name}$`) }) }).locator('button').click();
 }
 
 /** Sets a lil-gui number controller by typing into its input. */
@@ -78,6 +85,30 @@ const SHIPPED = [
   { label: 'Robot Expressive', key: 'robot', file: 'RobotExpressive.glb', sha256: '047f5e5fb3bb6d378bd1df16ca6137f2a596c99b3a1b5690b4020c05aaf6f319', licence: /CC0 1\.0/, textured: false },
 ];
 
+/** Every control of the demo's GUI (its label, in order) and the test that drives it. */
+const CONTROLS: Record<string, string> = {
+  'character': 'the character menu loads …, the character menu goes back to the default human',
+  'load file… (.glb / .gltf)': 'a broken file, a mesh without skin and a .gltf with external buffers …',
+  'criterion': 'each criterion (weights, Y, axial) renders …',
+  'sections': 'the section-count slider rebuilds the GCS model live …',
+  'smooth (no steps)': 'smooth (no steps) rebuilds the GCS model stepped, and back',
+  'cost / frame': 'the page opens with the weights criterion … (read-only: the measured cost)',
+  'influence width': 'under the paper\'s Y criterion, influence width and twist spread rebuild the GCS model',
+  'twist spread': 'under the paper\'s Y criterion, influence width and twist spread rebuild the GCS model',
+  'contours': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'rays': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'muscle bulge': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'clip': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'speed': 'the picture changes over time (the walk is animated)',
+  'pause': 'pause, step one frame and their keys (space, ".")',
+  'step one frame': 'pause, step one frame and their keys (space, ".")',
+  'wireframe': 'wireframe and show skeleton change every view',
+  'colour by section': 'the section-count slider rebuilds the GCS model live …',
+  'show skeleton': 'wireframe and show skeleton change every view',
+  'three.js LBS view': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'renderer': 'the renderer switch reloads the page with ?renderer=webgpu …',
+};
+
 /** The character menu's select. */
 const characterMenu = (page: Page) =>
   page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^character$/ }) }).locator('select');
@@ -103,6 +134,11 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
   afterAll(async () => {
     await context?.close();
     await server?.close();
+  });
+
+  test('every control of the GUI is listed in CONTROLS, with the test that drives it', async () => {
+    const names = await page.locator('.lil-gui .controller .name').allInnerTexts();
+    expect(names).toEqual(Object.keys(CONTROLS));
   });
 
   test('the page starts walking the default human, with both views labelled', async () => {
@@ -231,6 +267,14 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
         const paperOnly = c.value !== 'weights';
         expect(await disabled(page, 'influence width'), `${c.value}: influence width enabled`).toBe(!paperOnly);
         expect(await disabled(page, 'twist spread'), `${c.value}: twist spread enabled`).toBe(!paperOnly);
+        // Under the paper's criteria, a note beside the menu says why the picture looks broken: text only.
+        const note = page.locator('.lil-gui .criterion-note');
+        await expect(note.isVisible(), `${c.value}: the note on the paper's criteria`).resolves.toBe(paperOnly);
+        if (paperOnly) {
+          expect(await note.innerText()).toMatch(/broken.*bound 100 % to one bone.*weights, keeps it rigid.*README/s);
+          expect(await note.evaluate((el) => ({ elements: el.children.length, afterMenu: !!el.previousElementSibling?.querySelector('select') })))
+            .toEqual({ elements: 0, afterMenu: true });
+        }
 
         const before = { readout: await sectionReadout(page), shot: await page.screenshot() };
         expect(before.readout).toBe(await page.evaluate(() => window.__demo.sectionCount()));
@@ -267,7 +311,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     await other.close();
   });
 
-  test('the other controls: clip, third (three.js LBS) view, classic contours and bulge', async () => {
+  test('the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge', async () => {
     await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^clip$/ }) }).locator('select').selectOption('run');
     await page.waitForFunction(() => window.__demo.clip() === 'run');
 
@@ -287,6 +331,11 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
       await setNumber(page, 'contours', 10);
       await page.waitForFunction((n) => window.__demo.classicBuilds() > n, builds);
       expect(await contours()).toBeLessThan(before);
+      await setNumber(page, 'rays', 10);
+      await page.waitForFunction((n) => window.__demo.classicBuilds() > n + 1, builds);
+      await expect(page.locator('.label[data-view=classic]').innerText()).resolves.toMatch(/10 contours × 10 rays per limb/);
+      await setNumber(page, 'rays', 20);
+      await page.waitForFunction((n) => window.__demo.classicBuilds() > n + 2, builds);
       const afterContours = await page.evaluate(() => window.__demo.classicBuilds());
       await setNumber(page, 'muscle bulge', 2);
       await frames(page, 2);
@@ -297,6 +346,100 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     await page.locator('.lil-gui .controller.option').filter({ has: page.locator('.name', { hasText: /^clip$/ }) }).locator('select').selectOption('walk');
     expect(await page.evaluate(() => window.__demo.error())).toBe('');
   });
+
+  test('smooth (no steps) rebuilds the GCS model stepped, and back', async () => {
+    const label = () => page.locator('.label[data-view=gcs]').innerText();
+    await expect(label()).resolves.toMatch(/weight step 1\/8, smooth$/m);
+    for (const smooth of [false, true]) {
+      const builds = await page.evaluate(() => window.__demo.gcsBuilds());
+      await toggle(page, 'smooth \\(no steps\\)');
+      await page.waitForFunction((n) => window.__demo.gcsBuilds() > n, builds);
+      await frames(page, 2);
+      if (smooth) await expect(label()).resolves.toMatch(/weight step 1\/8, smooth$/m);
+      else await expect(label()).resolves.toMatch(/weight step 1\/8$/m);
+    }
+    expect(await page.evaluate(() => window.__demo.error())).toBe('');
+  });
+
+  test('under the paper\'s Y criterion, influence width and twist spread rebuild the GCS model', async () => {
+    await toggle(page, 'pause');
+    await setCriterion(page, 'Y (paper)', 'y');
+    try {
+      await page.evaluate(() => window.__demo.pause(0.4)); // a bent pose: the knees and elbows show the ramp
+      await frames(page, 3);
+      const regions = await viewRegions(page);
+      const before = await page.screenshot();
+      let builds = await page.evaluate(() => window.__demo.gcsBuilds());
+      await setNumber(page, 'influence width', 0.2);
+      await page.waitForFunction((n) => window.__demo.gcsBuilds() > n, builds);
+      await frames(page, 3);
+      const diff = await analyse(page, await page.screenshot(), regions, before);
+      expect(diff[0].changed, 'the GCS view changed').toBeGreaterThan(0.001);
+      expect(diff[1].changed, 'the classic view unchanged').toBeLessThan(0.002);
+
+      builds = await page.evaluate(() => window.__demo.gcsBuilds());
+      await toggle(page, 'twist spread');
+      await page.waitForFunction((n) => window.__demo.gcsBuilds() > n, builds);
+      await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/Y \(paper\) criterion · 6 sections per part, smooth, twist spread/);
+      expect(await page.evaluate(() => window.__demo.error())).toBe('');
+    } finally {
+      await toggle(page, 'twist spread');
+      await setNumber(page, 'influence width', 1);
+      await setCriterion(page, 'weights (default)', 'weights');
+      await toggle(page, 'pause');
+      await frames(page, 2);
+    }
+  });
+
+  test('pause, step one frame and their keys (space, ".")', async () => {
+    const checked = () => page.locator('.lil-gui .controller.boolean').filter({ has: page.locator('.name', { hasText: /^pause$/ }) }).locator('input').isChecked();
+    const time = () => page.evaluate(() => window.__demo.time());
+    // The keys act on the page, not inside the GUI (lil-gui keeps its key events to itself).
+    const key = async (k: string) => {
+      await page.evaluate(() => (document.activeElement as HTMLElement | null)?.blur());
+      await page.keyboard.press(k);
+    };
+    try {
+      await key('Space');
+      expect(await checked(), 'space pauses (the checkbox shows it)').toBe(true);
+      let t = await time();
+      await frames(page, 3);
+      expect(await time(), 'paused: the clip stands still').toBe(t);
+      await press(page, 'step one frame');
+      expect(await time()).toBeCloseTo(t + 1 / 30, 6);
+      t = await time();
+      await key('.');
+      expect(await time()).toBeCloseTo(t + 1 / 30, 6);
+      await key('Space');
+      expect(await checked(), 'space again plays').toBe(false);
+      t = await time();
+      await frames(page, 3);
+      expect(await time()).toBeGreaterThan(t);
+      // The button pauses a playing clip first, then steps.
+      await press(page, 'step one frame');
+      expect(await checked()).toBe(true);
+    } finally {
+      if (await checked()) await toggle(page, 'pause');
+    }
+  });
+
+  test('wireframe and show skeleton change every view', async () => {
+    await toggle(page, 'pause');
+    try {
+      const regions = await viewRegions(page);
+      for (const control of ['wireframe', 'show skeleton']) {
+        await frames(page, 2);
+        const before = await page.screenshot();
+        await toggle(page, control);
+        await frames(page, 3);
+        const diff = await analyse(page, await page.screenshot(), regions, before);
+        await toggle(page, control);
+        diff.forEach((d, i) => expect(d.changed, `${control}: view ${i} changed`).toBeGreaterThan(control === 'wireframe' ? 0.003 : 0.001));
+      }
+    } finally {
+      await toggle(page, 'pause');
+    }
+  }, 300000); // wireframe in software rendering: slow frames
 
   test('a broken file, a mesh without skin and a .gltf with external buffers give clear messages; the character stays', async () => {
     const character = await page.evaluate(() => window.__demo.character());
@@ -316,7 +459,8 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
       bufferViews: [{ buffer: 0, byteLength: 36 }],
       buffers: [{ byteLength: 36, uri: `data:application/octet-stream;base64,${triangle.toString('base64')}` }],
     };
-    await page.locator('#file').setInputFiles({ name: 'triangle.gltf', mimeType: 'model/gltf+json', buffer: Buffer.from(JSON.stringify(noSkin)) });
+    const [chooser] = await Promise.all([page.waitForEvent('filechooser'), press(page, 'load file… \\(\\.glb / \\.gltf\\)')]);
+    await chooser.setFiles({ name: 'triangle.gltf', mimeType: 'model/gltf+json', buffer: Buffer.from(JSON.stringify(noSkin)) });
     await page.waitForFunction(() => /triangle\.gltf/.test(window.__demo.error()));
     await page.evaluate(() => window.__demo.idle());
     error = await page.evaluate(() => window.__demo.error());
@@ -472,14 +616,20 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     }
   }, 180000);
 
-  test('?renderer=webgpu draws both views with WebGPURenderer (its WebGL2 fallback here: no GPU), walking; the readouts name renderer and backend', async () => {
+  test('the renderer switch reloads the page with ?renderer=webgpu: WebGPURenderer (its WebGL2 fallback here: no GPU) draws both views, walking; the readouts name renderer and backend', async () => {
     expect(await page.locator('.readout[data-view=gcs]').innerText()).toMatch(/WebGLRenderer · CPU backend/);
     const other = await context.newPage();
     const errors: string[] = [];
     other.on('pageerror', (e) => errors.push(e.message));
     other.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
     try {
-      await other.goto(`${server.url}?renderer=webgpu`);
+      await other.goto(server.url);
+      await other.waitForFunction(() => window.__demo !== undefined);
+      await other.evaluate(() => window.__demo.ready);
+      await Promise.all([
+        other.waitForURL(/[?&]renderer=webgpu/),
+        other.locator('.lil-gui .controller.option').filter({ has: other.locator('.name', { hasText: /^renderer$/ }) }).locator('select').selectOption('WebGPURenderer'),
+      ]);
       await other.waitForFunction(() => window.__demo !== undefined);
       await other.evaluate(() => window.__demo.ready);
       await frames(other, 3);

@@ -179,8 +179,20 @@ export interface DemoHook {
   classicBuilds(): number;
   pause(t?: number): void;
   hideCharacter(hidden: boolean): void;
+  /** The rest pose (true: the clip stopped), or back on the clip at its start (false). */
+  restPose(rest: boolean): void;
   idle(): Promise<void>;
 }
+
+/** The crowd mode's figures over some frames (web/demo/crowd.ts). */
+export interface CrowdMeasure { renderer: string; characters: number; backend: string; path: string | null; joints: number; msPerFrame: number; bytesPerFrame: number; msPerCharacter: number; bytesPerCharacter: number; vertices: number; sections: number }
+/** The crowd mode's testing hook (web/demo/crowd.ts, window.__crowd). */
+export interface CrowdHook {
+  frame(): number; count(): number; backend(): string; drawn(): number; drawCalls(): number; readout(): string;
+  set(n: number, backend?: string, path?: string): void; measure(frames: number): Promise<CrowdMeasure>; pause(t?: number): void;
+  /** The characters' extent on the page (px). */
+  screenBounds(): { left: number; right: number; top: number; bottom: number };
+}
 declare global {
-  interface Window { __demo: DemoHook }
+  interface Window { __demo: DemoHook; __crowd: CrowdHook }
 }

@@ -16,13 +16,22 @@ import GUI from 'three/addons/libs/lil-gui.module.min.js';
 import { initGcsSkin, type GcsDeformer, type GcsSkin, type Rig } from '../lib/index.js';
 import { bakeClip, GcsCrowd, type BakedClip } from '../lib/crowd.js';
 import { rigInputFromSkinnedMesh } from '../lib/three.js';
-import { createHumanData, humanFromData, type Human, type HumanData } from '../lib/human/index.js';
+import { humanFromData, type Human, type HumanData } from '../lib/human/index.js';
+import { distanceToFit } from './fit-box.js';
+import { humanDataInWorker } from './human-data.js';
+import { applySidebar, sidebarWidth } from './layout.js';
+import { SteadyFigure } from './steady-figure.js';
 import { addRendererSwitch, createRenderer, glContext, rendererKind, rendererLabel, type DemoRenderer } from './renderer.js';
 
 export const MAX_CROWD = 500;
 /** The CPU backend keeps a deformer (about 1.4 MB of wasm memory at 17 k vertices) per character. */
 export const MAX_CPU_CROWD = 200;
 const SPACING = 1.1;
+/** A walking human's reach around its feet and its height (world units): what framing keeps in the picture. */
+const CHARACTER_RADIUS = 0.5;
+const CHARACTER_HEIGHT = 1.85;
+/** From the crowd's centre, where the camera looks from. */
+const VIEW_DIRECTION = new THREE.Vector3(0.55, 0.45, 0.95).normalize();
 
 type Backend = 'gpu' | 'cpu';
 type Path = 'joints' | 'sections';
@@ -138,29 +147,6 @@ class CpuCrowd {
   }
 }
 
-function humanData(vertices?: number): Promise<HumanData> {
-  return new Promise((resolve, reject) => {
-    let worker: Worker;
-    try {
-      worker = new Worker(new URL('./human-worker.ts', import.meta.url), { type: 'module' });
-    } catch {
-      resolve(createHumanData({ vertices }));
-      return;
-    }
-    worker.onmessage = (e: MessageEvent<{ data?: HumanData; error?: string }>) => {
-      worker.terminate();
-      if (e.data.data) resolve(e.data.data);
-      else reject(new Error(`could not generate the human: ${e.data.error}`));
-    };
-    worker.onerror = (e) => {
-      e.preventDefault();
-      worker.terminate();
-      try { resolve(createHumanData({ vertices })); } catch (err) { reject(err); }
-    };
-    worker.postMessage({ vertices });
-  });
-}
-
 function clampCount(n: number): number {
   return Math.max(1, Math.min(MAX_CROWD, Math.round(Number.isFinite(n) ? n : 100)));
 }
@@ -182,7 +168,8 @@ export async function startCrowd(): Promise<void> {
   const kind = rendererKind();
   const renderer = await createRenderer(kind);
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-  renderer.setSize(window.innerWidth, window.innerHeight);
+  // The picture left of the control column (opaque), as in the comparison views.
+  renderer.setSize(applySidebar(), window.innerHeight);
   renderer.shadowMap.enabled = params.shadows;
   document.body.prepend(renderer.domElement);
   const counter = new UploadCounter(renderer);
@@ -201,7 +188,7 @@ export async function startCrowd(): Promise<void> {
   ground.rotation.x = -Math.PI / 2;
   ground.receiveShadow = true;
   scene.add(ground);
-  const camera = new THREE.PerspectiveCamera(40, window.innerWidth / window.innerHeight, 0.1, 200);
+  const camera = new THREE.PerspectiveCamera(40, (window.innerWidth - sidebarWidth()) / window.innerHeight, 0.1, 200);
   const controls = new OrbitControls(camera, renderer.domElement);
   controls.enableDamping = true;
   const stats = new Stats();
@@ -213,7 +200,7 @@ export async function startCrowd(): Promise<void> {
   document.getElementById('readouts')!.append(readout);
 
   const vertices = query.has('vertices') ? Number(query.get('vertices')) : undefined;
-  const [gcs, data] = await Promise.all([initGcsSkin(), humanData(vertices)]) as [GcsSkin, HumanData];
+  const [gcs, data] = await Promise.all([initGcsSkin(), humanDataInWorker({ vertices })]) as [GcsSkin, HumanData];
   const human: Human = humanFromData(data);
   const source = human.mesh;
   const material = new THREE.MeshStandardMaterial({ color: 0xd9a58a, roughness: 0.62, metalness: 0 });
@@ -264,14 +251,54 @@ export async function startCrowd(): Promise<void> {
       scene.add(cpuCrowd.group);
     }
     const side = Math.ceil(Math.sqrt(count)) * SPACING;
-    camera.position.set(side * 0.55 + 1.5, 1.2 + side * 0.45, side * 0.95 + 3.2);
-    controls.target.set(0, 0.9, 0);
-    controls.update();
+    frameCrowd();
     sun.shadow.camera.left = sun.shadow.camera.bottom = -side;
     sun.shadow.camera.right = sun.shadow.camera.top = side;
     sun.shadow.camera.updateProjectionMatrix();
     renderer.shadowMap.enabled = params.shadows;
     samples.length = 0;
+    steadyMs.reset();
+    steadyBytes.reset();
+    readoutDue = true;
+  };
+
+  /** Every character's box (its ground square, its height), world units. */
+  const characterBoxes = (each: (box: THREE.Box3) => void) => {
+    const p = new THREE.Vector3(), box = new THREE.Box3();
+    for (let i = 0; i < count; i++) {
+      positionOf(i, count, p);
+      box.min.set(p.x - CHARACTER_RADIUS, 0, p.z - CHARACTER_RADIUS);
+      box.max.set(p.x + CHARACTER_RADIUS, CHARACTER_HEIGHT, p.z + CHARACTER_RADIUS);
+      each(box);
+    }
+  };
+
+  /** Points the camera at the crowd and backs off until every character fits the picture (left of the controls). */
+  const frameCrowd = () => {
+    const all = new THREE.Box3();
+    characterBoxes((b) => all.union(b));
+    const centre = all.getCenter(new THREE.Vector3());
+    const tanV = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.9;
+    const distance = distanceToFit(all, VIEW_DIRECTION, tanV * camera.aspect * 0.95, tanV);
+    camera.position.copy(centre).addScaledVector(VIEW_DIRECTION, distance);
+    controls.target.copy(centre);
+    controls.update();
+  };
+
+  /** The characters' extent on the page (px), their boxes projected by the camera onto the canvas. */
+  const screenBounds = () => {
+    camera.updateMatrixWorld();
+    const canvas = renderer.domElement.getBoundingClientRect();
+    const p = new THREE.Vector3();
+    let left = Infinity, right = -Infinity, top = Infinity, bottom = -Infinity;
+    characterBoxes((b) => {
+      for (let i = 0; i < 8; i++) {
+        p.set(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z).project(camera);
+        const px = canvas.left + (p.x + 1) / 2 * canvas.width, py = canvas.top + (1 - p.y) / 2 * canvas.height;
+        left = Math.min(left, px); right = Math.max(right, px); top = Math.min(top, py); bottom = Math.max(bottom, py);
+      }
+    });
+    return { left, right, top, bottom };
   };
 
   // Per frame: pose every character at its own time, then the backend's skinning. Timed (CPU).
@@ -293,7 +320,9 @@ export async function startCrowd(): Promise<void> {
 
   const samples: { ms: number; bytes: number }[] = [];
   let frame = 0;
-  let smoothedMs = NaN, smoothedBytes = NaN; // the readout's figures
+  // The readout's figures: steady medians, "warming up" before (the first frames upload whole buffers).
+  const steadyMs = new SteadyFigure(), steadyBytes = new SteadyFigure();
+  let readoutDue = true; // a rebuild shows its settings at once, its figures when steady
   const waiters: { frames: number; resolve: (r: CrowdMeasure) => void; start: number }[] = [];
   const fmtBytes = (b: number) => (b >= 1e6 ? `${(b / 1e6).toFixed(2)} MB` : b >= 1e3 ? `${(b / 1e3).toFixed(1)} KB` : `${b.toFixed(0)} B`);
   const clock = new THREE.Timer();
@@ -312,9 +341,11 @@ export async function startCrowd(): Promise<void> {
   status.hidden = true;
 
   const onResize = () => {
-    camera.aspect = window.innerWidth / window.innerHeight;
+    const width = applySidebar();
+    camera.aspect = width / window.innerHeight;
     camera.updateProjectionMatrix();
-    renderer.setSize(window.innerWidth, window.innerHeight);
+    renderer.setSize(width, window.innerHeight);
+    frameCrowd();
   };
   window.addEventListener('resize', onResize);
 
@@ -338,17 +369,18 @@ export async function startCrowd(): Promise<void> {
         w.resolve(measureLast(w.frames));
       }
     }
-    if (frame % 10 === 1) {
-      // Medians of the last frames since the crowd was built (start-up uploads do not linger).
-      const m = measureLast(Math.min(samples.length, 60));
-      smoothedMs = m.msPerFrame;
-      smoothedBytes = m.bytesPerFrame;
-      const vertices = m.vertices;
-      readout.innerHTML = `<b>${count}</b> characters × ${vertices.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
-        `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}` +
-        `${params.smooth ? ' (smooth)' : ''}<br>skinning CPU <b>${smoothedMs.toFixed(2)} ms</b>/frame (median) (${(smoothedMs / count * 1000).toFixed(1)} µs per character)` +
-        ` · uploaded <b>${fmtBytes(smoothedBytes)}</b>/frame (${fmtBytes(smoothedBytes / count)} per character)` +
-        `${note ? `<br><span class="criterion">${note}</span>` : ''}`;
+    steadyMs.add(ms);
+    steadyBytes.add(bytes);
+    if (readoutDue || frame % 10 === 1) {
+      readoutDue = false;
+      const head = `<b>${count}</b> characters × ${source.geometry.getAttribute('position').count.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
+        `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}${params.smooth ? ' (smooth)' : ''}`;
+      const perFrame = steadyMs.value(), uploaded = steadyBytes.value();
+      const figures = Number.isNaN(perFrame) || Number.isNaN(uploaded)
+        ? 'skinning CPU and uploads per frame: <b>warming up…</b>'
+        : `skinning CPU <b>${perFrame.toFixed(2)} ms</b>/frame (${(perFrame / count * 1000).toFixed(1)} µs per character)` +
+          ` · uploaded <b>${fmtBytes(uploaded)}</b>/frame (${fmtBytes(uploaded / count)} per character)`;
+      readout.innerHTML = `${head}<br>${figures}${note ? `<br><span class="criterion">${note}</span>` : ''}`;
     }
     stats.update();
   });
@@ -376,6 +408,8 @@ export async function startCrowd(): Promise<void> {
       /** Medians over the next `frames` frames: skinning CPU ms and bytes uploaded, per frame and per character. */
       measure: (frames: number) => new Promise<CrowdMeasure>((resolve) => waiters.push({ frames, resolve, start: frame })),
       pause: (t?: number) => { params.paused = true; if (t !== undefined) time = t; },
+      /** The characters' extent on the page (px): their boxes as the camera projects them. */
+      screenBounds,
     },
   });
   await new Promise<void>((resolve) => { const f = frame; const wait = () => (frame > f + 1 ? resolve() : setTimeout(wait, 16)); wait(); });

@@ -1,0 +1,61 @@
+// The demo's steady per-frame figure (web/demo/steady-figure.ts): no figure while warming up (the
+// first frames dropped, the window not full, the figure still falling), then the mean of the
+// window's middle half; a reset starts over.
+import { describe, expect, test } from 'vitest';
+import { SteadyFigure } from '../../web/demo/steady-figure.js';
+
+describe('SteadyFigure', () => {
+  test('NaN until the dropped frames and a full window have passed', () => {
+    const f = new SteadyFigure(8, 3);
+    for (let i = 0; i < 3 + 7; i++) {
+      f.add(1);
+      expect(f.value()).toBeNaN();
+    }
+    f.add(1);
+    expect(f.value()).toBe(1);
+  });
+
+  test('the slow first frames never count', () => {
+    const f = new SteadyFigure(8, 3);
+    for (const ms of [50, 20, 10]) f.add(ms);
+    for (let i = 0; i < 8; i++) f.add(0.2);
+    expect(f.value()).toBeCloseTo(0.2, 12);
+  });
+
+  test('warming up while the figure still falls (cold code getting hot), steady once the halves agree', () => {
+    const f = new SteadyFigure(8, 0);
+    for (const ms of [1, 1, 1, 1, 0.5, 0.5, 0.5, 0.5]) f.add(ms);
+    expect(f.value(), 'older half 1 ms, newer 0.5 ms').toBeNaN();
+    for (let i = 0; i < 4; i++) f.add(0.5);
+    expect(f.value()).toBeCloseTo(0.5, 12);
+    // Steady stays steady: noise later does not bring "warming up" back.
+    for (const ms of [0.9, 0.9, 0.9, 0.9]) f.add(ms);
+    expect(f.value()).not.toBeNaN();
+  });
+
+  test('the mean of the middle half: a spike drops out, the clock\'s 0.1 ms steps average out', () => {
+    const f = new SteadyFigure(8, 0);
+    for (const ms of [0.2, 0.3, 0.2, 30, 0.2, 0.3, 0.2, 0.3]) f.add(ms);
+    // Sorted: 0.2 ×4, 0.3 ×3, 30; the middle half: 0.2, 0.2, 0.3, 0.3.
+    expect(f.value()).toBeCloseTo(0.25, 12);
+  });
+
+  test('a figure that never settles is shown after six windows', () => {
+    const f = new SteadyFigure(8, 0);
+    let ms = 1;
+    const falling = () => f.add((ms *= 0.9)); // the newer half always a third below the older
+    for (let i = 0; i < 8 * 6; i++) { falling(); expect(f.value()).toBeNaN(); }
+    falling();
+    expect(f.value()).toBeGreaterThan(0);
+  });
+
+  test('reset starts over', () => {
+    const f = new SteadyFigure(8, 2);
+    for (let i = 0; i < 10; i++) f.add(1);
+    expect(f.value()).toBe(1);
+    f.reset();
+    expect(f.value()).toBeNaN();
+    for (let i = 0; i < 10; i++) f.add(2);
+    expect(f.value()).toBe(2);
+  });
+});
