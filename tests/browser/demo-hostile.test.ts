@@ -6,7 +6,7 @@ import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
 import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
-import { launchChromium, skipReason, startDemo, type DemoServer } from './harness.js';
+import { launchChromium, openDemoPage, skipReason, startDemo, type DemoServer } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -31,13 +31,7 @@ describe.skipIf(!!reason)('demo page: hostile names and files (headless Chromium
 
   /** A page at `query`, ready and idle, with its page errors collected. */
   async function open(query: string): Promise<{ page: Page; errors: string[] }> {
-    const page = await context.newPage();
-    const errors: string[] = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    page.on('dialog', (d) => { errors.push(`dialog: ${d.message()}`); void d.dismiss(); });
-    await page.goto(`${server.url}${query}`);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
+    const { page, errors } = await openDemoPage(context, server, query, { dialogs: true });
     await page.evaluate(() => window.__demo.idle());
     return { page, errors };
   }

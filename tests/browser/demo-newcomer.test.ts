@@ -6,7 +6,7 @@
 // (The note beside the criterion menu under the paper's criteria: demo.test.ts, with the criteria.)
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
-import { analyse, launchChromium, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { analyse, launchChromium, openDemoPage, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -32,12 +32,7 @@ describe.skipIf(!!reason)('the demo as a newcomer meets it (headless Chromium)',
   });
 
   async function open(query: string): Promise<{ page: Page; errors: string[] }> {
-    const page = await context.newPage();
-    const errors: string[] = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(`${server.url}${query}`);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
+    const { page, errors } = await openDemoPage(context, server, query);
     expect(await page.evaluate(() => window.__demo.error())).toBe('');
     return { page, errors };
   }

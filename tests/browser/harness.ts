@@ -74,6 +74,21 @@ export async function launchChromium(): Promise<BrowserContext> {
   });
 }
 
+/**
+ * A new page of the served demo at `query`, its page errors collected (and, with `dialogs`, any
+ * dialog recorded as an error and dismissed), once the demo's hook exists and its first build is ready.
+ */
+export async function openDemoPage(context: BrowserContext, server: DemoServer, query: string, options: { dialogs?: boolean } = {}): Promise<{ page: Page; errors: string[] }> {
+  const page = await context.newPage();
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  if (options.dialogs) page.on('dialog', (d) => { errors.push(`dialog: ${d.message()}`); void d.dismiss(); });
+  await page.goto(`${server.url}${query}`);
+  await page.waitForFunction(() => (window as unknown as { __demo?: unknown }).__demo !== undefined);
+  await page.evaluate(() => (window as unknown as { __demo: { ready: Promise<unknown> } }).__demo.ready);
+  return { page, errors };
+}
+
 /** A fixture page (tests/browser/<folder>/index.html) served by Vite's dev server and open in Chromium. */
 export interface FixturePage {
   page: Page;

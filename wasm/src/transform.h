@@ -414,8 +414,9 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 
 // Smooth mode when every joint's scale is the same uniform s (the common case: then a section's
 // normal matrix is its position matrix's 3×3 divided by s): one lerp of the position matrices serves
-// the normals too, scaled by invS, and the near-rotation cubic length fix as blendRunT<true>. Fewer
-// live SIMD values than blendRunT (12 constants instead of 18), so no spills. Same results up to rounding.
+// the normals too, and their length fixed by 1/|v| as a polynomial in |v|² (the near-rotation cubic of
+// blendRunT<true> with the 1/s folded in). Eleven loop constants (8 matrix columns, 3 coefficients)
+// instead of blendRunT's 18, so no spills. Same results up to rounding.
 inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS, const float* f, const float* inPos,
                             const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
