@@ -22,7 +22,8 @@ if (reason) console.log(reason);
 /** The bound: GPU positions within 1e-5 of the height of the CPU's. */
 const POSITION_TOLERANCE = 1e-5;
 /**
- * Normals: the CPU fixes the length of smooth-mode normals by a cubic (error < 3e-4, docs/gpu.md);
+ * Normals: the CPU fixes the length of smooth-mode normals by a cubic, or not at all between rotations
+ * under 2.8° apart (either way within 3e-4 of unit, docs/gpu.md);
  * the section-level shader normalises exactly; plain mode agrees to float rounding.
  */
 const NORMAL_TOLERANCE = 1e-3;

@@ -106,7 +106,8 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
   return { p, n: Float64Array.from(nm.n), renorm: nm.renorm };
 }
 
-/** Every vertex as the shader moves it: plain, or smooth (lerp of two sections, the CPU's normal length fix). */
+/** Every vertex as the shader moves it: plain, or smooth (lerp of two sections, the CPU's normal length fix: none
+ * for rotations under 2.8° apart, the cubic under 35°, else exact). */
 function shade(d: GcsDeformer, poses: Float32Array, base: number, rest: { p: Float32Array; n: Float32Array }, outP: Float64Array, outN: Float64Array): void {
   const table = d.sectionInfluences()!;
   const sectionOf = d.sectionOfVertex(), other = d.blendOther(), factor = d.blendFactor();
@@ -127,14 +128,16 @@ function shade(d: GcsDeformer, poses: Float32Array, base: number, rest: { p: Flo
       outN[3 * v + r] = n;
       len2 += n * n;
     }
-    let near = false;
+    let near = false, almostEqual = false;
     if (blending && !a.renorm && !b.renorm) {
       let trace = 0;
       for (let i = 0; i < 9; i++) trace += a.n[i] * b.n[i];
       near = trace > 1 + 2 * 0.82;
+      almostEqual = trace > 1 + 2 * 0.9988;
     }
     let scale = 1;
-    if (near) { const e = len2 - 1; scale = 1 + e * (-0.5 + 0.375 * e); }
+    if (almostEqual) scale = 1;
+    else if (near) { const e = len2 - 1; scale = 1 + e * (-0.5 + 0.375 * e); }
     else if (blending || a.renorm) scale = len2 > 0 ? 1 / Math.sqrt(len2) : 0;
     for (let r = 0; r < 3; r++) outN[3 * v + r] = scale === 0 ? rest.n[3 * v + r] : outN[3 * v + r] * scale;
   }

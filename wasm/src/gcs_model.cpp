@@ -995,9 +995,14 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
     for (const BlendRun& run : blendRuns) {
       size_t o = size_t(run.first) * 3;
       const uint32_t a = run.section, b = run.other;
-      if (a != b && uniform && nearRotations(normalMatrices[a], normalMatrices[b]))
-        blendRunUniform(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
-                        &restNormals[o], &positions[o], &normals[o], run.count);
+      const NormalFix fix = a != b && uniform ? rotationBlendFix(rotationTrace(normalMatrices[a], normalMatrices[b]))
+                                              : NormalFix::Exact;
+      if (fix == NormalFix::None)
+        blendRunUniformT<false>(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
+                                &restNormals[o], &positions[o], &normals[o], run.count);
+      else if (fix == NormalFix::Cubic)
+        blendRunUniformT<true>(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
+                               &restNormals[o], &positions[o], &normals[o], run.count);
       else if (a == b)
         transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
                      &positions[o], &normals[o], run.count);

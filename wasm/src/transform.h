@@ -358,12 +358,29 @@ inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormali
   else transformRunT<false>(m, nm, inPos, inNrm, outPos, outNrm, count);
 }
 
+// How a blended normal's length is restored: exactly (sqrt and division), by a cubic approximation
+// of 1/sqrt around 1 (both normal matrices rotations less than 35° apart: error < 3e-4), or not at
+// all (rotations less than 2.8° apart: the blend's length falls short of 1 by at most
+// (1 − cos θ)/4 < 3e-4, the cubic's own bound, so the fix would change nothing visible).
+enum class NormalFix { Exact, Cubic, None };
+
+constexpr float kNearTrace = 1.0f + 2.0f * 0.82f;            // trace of Ra^T Rb = 1 + 2 cos θ: θ < 35°
+constexpr float kAlmostEqualTrace = 1.0f + 2.0f * 0.9988f;   // θ < 2.8°
+
+// The trace of na^T nb (3×3 parts): 1 + 2 cos θ when both are rotations θ apart.
+inline float rotationTrace(const glm::mat4& na, const glm::mat4& nb) {
+  return glm::dot(glm::vec3(na[0]), glm::vec3(nb[0])) + glm::dot(glm::vec3(na[1]), glm::vec3(nb[1])) +
+         glm::dot(glm::vec3(na[2]), glm::vec3(nb[2]));
+}
+
+// The fix for a blend of two normal matrices that are rotations (trace: rotationTrace).
+inline NormalFix rotationBlendFix(float trace) {
+  return trace > kAlmostEqualTrace ? NormalFix::None : trace > kNearTrace ? NormalFix::Cubic : NormalFix::Exact;
+}
+
 // Smooth mode, a run of vertices that all blend transform A with the same transform B: vertex i
-// takes lerp(A, B, f[i]) for its position and normal.
-//   Near-rotation blends (NearRotation: both normal matrices rotations less than 35° apart) fix the
-//   normal's length by a cubic approximation of 1/sqrt around 1 (error < 3e-4 there) instead of a
-//   square root and a division. Otherwise the normal is normalised exactly.
-template <bool NearRotation>
+// takes lerp(A, B, f[i]) for its position and normal, the normal's length restored as Fix says.
+template <NormalFix Fix>
 inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4& pb, const glm::mat4& nb,
                       const float* f, const float* inPos, const float* inNrm, float* outPos, float* outNrm,
                       uint32_t count) {
@@ -385,7 +402,9 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
     const v128_t n2 = wasm_f32x4_add(m2, wasm_f32x4_mul(t, e2));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));
     v128_t rn = affine(n0, n1, n2, zero, inNrm + 3 * i);
-    if (NearRotation) {
+    if (Fix == NormalFix::None) {
+      wasm_v128_store(outNrm + 3 * i, rn);
+    } else if (Fix == NormalFix::Cubic) {
       wasm_v128_store(outNrm + 3 * i, nearUnit(rn, one, half, c38));
     } else {
       wasm_v128_store(outNrm + 3 * i, normalise3(rn));
@@ -406,8 +425,7 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
       outPos[3 * i + r] = v + pa[3][r] + t * (pb[3][r] - pa[3][r]);
       outNrm[3 * i + r] = w;
     }
-    normaliseInPlace(outNrm + 3 * i);
-    keepUnit(outNrm + 3 * i, n);
+    if (Fix != NormalFix::None) normaliseInPlace(outNrm + 3 * i), keepUnit(outNrm + 3 * i, n);
   }
 #endif
 }
@@ -415,10 +433,12 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 // Smooth mode when every joint's scale is the same uniform s (the common case: then a section's
 // normal matrix is its position matrix's 3×3 divided by s): one lerp of the position matrices serves
 // the normals too, and their length fixed by 1/|v| as a polynomial in |v|² (the near-rotation cubic of
-// blendRunT<true> with the 1/s folded in). Eleven loop constants (8 matrix columns, 3 coefficients)
-// instead of blendRunT's 18, so no spills. Same results up to rounding.
-inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS, const float* f, const float* inPos,
-                            const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+// blendRunT with the 1/s folded in). Eleven loop constants (8 matrix columns, 3 coefficients)
+// instead of blendRunT's 18, so no spills. Same results up to rounding. FixLength false (rotations
+// almost equal, see kAlmostEqualTrace): the normal is only divided by s.
+template <bool FixLength>
+inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float invS, const float* f, const float* inPos,
+                             const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
   const v128_t a0 = wasm_v128_load(&pa[0][0]), a1 = wasm_v128_load(&pa[1][0]);
   const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
@@ -429,6 +449,7 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
   const float k = invS * invS;
   const v128_t p0 = wasm_f32x4_splat(1.875f * invS), p1 = wasm_f32x4_splat(-1.25f * invS * k);
   const v128_t p2 = wasm_f32x4_splat(0.375f * invS * k * k);
+  const v128_t s0 = wasm_f32x4_splat(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i);
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
@@ -439,6 +460,10 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
                                                     wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
                                      wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3)), inPos + 3 * i));
+    if (!FixLength) {
+      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, s0));
+      continue;
+    }
     v128_t sq = wasm_f32x4_mul(rn, rn);
     sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
     sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
@@ -446,26 +471,20 @@ inline void blendRunUniform(const glm::mat4& pa, const glm::mat4& pb, float invS
   }
 #else
   // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
-  blendRunT<false>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm, outPos, outNrm, count);
+  blendRunT<FixLength ? NormalFix::Exact : NormalFix::None>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm, outPos,
+                                                             outNrm, count);
 #endif
 }
 
-// True when the rotations na and nb are at most 35° apart: a blend's length² then stays above 0.91
-// and the cubic length fix errs by less than 3e-4.
-inline bool nearRotations(const glm::mat4& na, const glm::mat4& nb) {
-  float trace = glm::dot(glm::vec3(na[0]), glm::vec3(nb[0])) + glm::dot(glm::vec3(na[1]), glm::vec3(nb[1])) +
-                glm::dot(glm::vec3(na[2]), glm::vec3(nb[2]));  // 1 + 2 cos θ
-  return trace > 1.0f + 2.0f * 0.82f;                          // cos θ > 0.82
-}
-
-// Chooses the kernel: the cubic length fix when both normal matrices are rotations (no
-// renormalisation flagged) at most 35° apart, so a blend's length² stays above 0.91.
+// Chooses the kernel: a rotation blend's fix (rotationBlendFix) when neither normal matrix is
+// flagged for renormalisation, else the exact one.
 inline void blendRun(const glm::mat4& pa, const glm::mat4& na, bool renormA, const glm::mat4& pb, const glm::mat4& nb,
                      bool renormB, const float* f, const float* inPos, const float* inNrm, float* outPos,
                      float* outNrm, uint32_t count) {
-  const bool near = !renormA && !renormB && nearRotations(na, nb);
-  if (near) blendRunT<true>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
-  else blendRunT<false>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
+  const NormalFix fix = renormA || renormB ? NormalFix::Exact : rotationBlendFix(rotationTrace(na, nb));
+  if (fix == NormalFix::None) blendRunT<NormalFix::None>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
+  else if (fix == NormalFix::Cubic) blendRunT<NormalFix::Cubic>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
+  else blendRunT<NormalFix::Exact>(pa, na, pb, nb, f, inPos, inNrm, outPos, outNrm, count);
 }
 
 }  // namespace gcs

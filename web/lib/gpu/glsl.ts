@@ -5,7 +5,7 @@
  */
 import { GcsError } from '../errors.js';
 import {
-  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
+  ALMOST_EQUAL_TRACE, BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
   SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
 } from './layout.js';
 
@@ -186,11 +186,13 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 	M = rot * K;
 	N = gcsNormalMatrix( rot, K, renorm );
 }
-// A normal or tangent as the CPU turns it: blended (smooth) normals get the cubic length fix when
-// both sides are rotations less than 35° apart, else are normalised (a vanished one keeps its rest
-// direction); unblended ones are normalised only when the scale asks for it.
-vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool normalise ) {
+// A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
+// sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else
+// are normalised (a vanished one keeps its rest direction); unblended ones are normalised only when
+// the scale asks for it.
+vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool almostEqual, const in bool normalise ) {
 	vec3 n = N * v;
+	if ( almostEqual ) return n;
 	if ( near ) { float e = dot( n, n ) - 1.0; return n * ( 1.0 + e * ( ${f(LENGTH_FIX[0])} + ${f(LENGTH_FIX[1])} * e ) ); }
 	if ( normalise ) { float l = length( n ); return l > 0.0 ? n / l : v; }
 	return n;
@@ -201,7 +203,7 @@ vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const i
 const JOINT_BASE = /* glsl */ `
 	mat3 gcsM, gcsN;
 	vec3 gcsT;
-	bool gcsNear = false, gcsNormalise;
+	bool gcsNear = false, gcsAlmostEqual = false, gcsNormalise;
 	{
 		#ifdef GCS_SMOOTH
 		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sb = int( ${BLEND_ATTRIBUTE}.y + 0.5 );
@@ -213,6 +215,7 @@ const JOINT_BASE = /* glsl */ `
 			bool ra = gcsNormalise;
 			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
 			gcsNear = ! ra && ! rb && trace > ${f(NEAR_TRACE)};
+			gcsAlmostEqual = gcsNear && trace > ${f(ALMOST_EQUAL_TRACE)};
 			gcsNormalise = true;
 			gcsM = gcsM + f * ( mb - gcsM );
 			gcsT = gcsT + f * ( tb - gcsT );
@@ -224,7 +227,7 @@ const JOINT_BASE = /* glsl */ `
 	}
 `;
 
-const JOINT_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, gcsNear, gcsNormalise )`);
+const JOINT_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, gcsNear, gcsAlmostEqual, gcsNormalise )`);
 
 const JOINT_POSITION = /* glsl */ `
 	transformed = gcsM * transformed + gcsT;

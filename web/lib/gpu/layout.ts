@@ -35,5 +35,10 @@ export const COLLAPSED = 1e-30;
  * 1 + 2·cos 35°; then the CPU fixes a blended normal's length by a cubic rather than normalising.
  */
 export const NEAR_TRACE = 1 + 2 * 0.82;
+/**
+ * Smooth mode: rotations "almost equal" (less than 2.8° apart: trace above 1 + 2·0.9988): the CPU
+ * leaves a blended normal's length as it is (short of 1 by at most (1 − cos θ)/4 < 3e-4).
+ */
+export const ALMOST_EQUAL_TRACE = 1 + 2 * 0.9988;
 /** The cubic length fix n·(1 + e·(a + b·e)), e = |n|² − 1: a ≈ −1/2, b ≈ 3/8 (1/√(1+e) to second order). */
 export const LENGTH_FIX = [-0.5, 0.375] as const;

@@ -11,7 +11,7 @@ import * as THREE from 'three';
 import * as TSL from 'three/tsl';
 import type { Node } from 'three/webgpu';
 import {
-  BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
+  ALMOST_EQUAL_TRACE, BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
   SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import type { GpuSections } from './sections.js';
@@ -147,7 +147,7 @@ interface VertexTransform { position(p: N): N; turn(v: N): N }
 
 /** The joint-level path per vertex (the GLSL's JOINT_BASE and gcsTurnJoint). */
 function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
-  let m: M3, t: N, n: M3, near: N, normalise: N;
+  let m: M3, t: N, n: M3, near: N, almostEqual: N, normalise: N;
   if (smooth) {
     const blend = attribute(BLEND_ATTRIBUTE, 'vec3');
     const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar();
@@ -160,11 +160,13 @@ function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
     t = select(same, a.t, a.t.add(b.t.sub(a.t).mul(f))).toVar();
     n = toVar(pick(same, a.n, lerp(a.n, b.n, f)));
     near = same.not().and(bothRotations).and(trace.greaterThan(NEAR_TRACE)).toVar();
+    almostEqual = near.and(trace.greaterThan(ALMOST_EQUAL_TRACE)).toVar();
     normalise = same.not().or(a.renorm.greaterThan(0.5)).toVar();
   } else {
     const a = sectionBlend(inputs, int(attribute(SECTION_ATTRIBUTE, 'float').add(0.5)));
     ({ m, t, n } = a);
     near = null;
+    almostEqual = null;
     normalise = a.renorm.greaterThan(0.5);
   }
   return {
@@ -175,7 +177,9 @@ function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
       const l = length(x);
       const normalised = select(l.greaterThan(0), x.div(l), v);
       const plain = select(normalise, normalised, x);
-      return near ? select(near, x.mul(float(1).add(e.mul(e.mul(LENGTH_FIX[1]).add(LENGTH_FIX[0])))), plain) : plain;
+      if (!near) return plain;
+      const fixed = select(near, x.mul(float(1).add(e.mul(e.mul(LENGTH_FIX[1]).add(LENGTH_FIX[0])))), plain);
+      return select(almostEqual, x, fixed);
     },
   };
 }
