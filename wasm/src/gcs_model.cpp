@@ -153,9 +153,23 @@ void finishModel(GcsDeformerImpl& m) {
   uint32_t most = 1;
   for (const Section& sec : m.sections) most = std::max(most, sec.influenceCount);
   m.blendPoseScratch.resize(most);
+  // The blended sections ordered by how many joints they blend (so the per-frame accumulation runs
+  // one fixed-length loop per count, with no mispredicted exits), and the rigid cores.
   m.blendedSections.clear();
+  m.rigidSections.clear();
   for (uint32_t i = 0; i < S; ++i)
-    if (m.settings.criterion == GCS_CRITERION_WEIGHTS && !m.sections[i].rigid) m.blendedSections.push_back(i);
+    if (m.settings.criterion == GCS_CRITERION_WEIGHTS) (m.sections[i].rigid ? m.rigidSections : m.blendedSections).push_back(i);
+  std::stable_sort(m.blendedSections.begin(), m.blendedSections.end(), [&](uint32_t a, uint32_t b) {
+    return m.sections[a].influenceCount < m.sections[b].influenceCount;
+  });
+  m.nodeInfluenceFirst.resize(m.blendedSections.size());
+  m.nodesWithCount.assign(kMaxInfluences + 2, 0);
+  for (size_t b = 0; b < m.blendedSections.size(); ++b) {
+    const Section& sec = m.sections[m.blendedSections[b]];
+    m.nodeInfluenceFirst[b] = sec.influenceFirst;
+    ++m.nodesWithCount[sec.influenceCount + 1];
+  }
+  for (uint32_t c = 1; c < kMaxInfluences + 2; ++c) m.nodesWithCount[c] += m.nodesWithCount[c - 1];
   const size_t padded = (m.blendedSections.size() + 3) / 4 * 4;
   m.nodeReal.assign(padded, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   m.nodeDual.assign(padded, glm::vec4(0.0f));
@@ -801,39 +815,57 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const Scal
 
 #if defined(__wasm_simd128__)
 
-// The same blends as sectionTransformsWeights when every scale is s·I (the common case), in SIMD:
-// each blended section's dual quaternion accumulated in two registers, then four sections at a
-// time turned into matrices (one lane each), with the very formulas of blendPoses.
-void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, float s) {
-  const uint32_t S = uint32_t(sections.size());
+namespace {
+// A node's dual quaternion (real part in br, dual part in bd): its joints' weighted sum, each
+// weight negated when the joint's quaternion lies in the other hemisphere from the first's.
+template <uint32_t Count>
+inline void accumulateNode(const JointPose* poses, const Influence* in, uint32_t count, v128_t& br, v128_t& bd) {
   const v128_t signBit = wasm_f32x4_splat(-0.0f);
+  const v128_t pivot = wasm_v128_load(&poses[in[0].joint].real);
+  const v128_t w0 = wasm_f32x4_splat(in[0].weight);
+  br = wasm_f32x4_mul(w0, pivot);
+  bd = wasm_f32x4_mul(w0, wasm_v128_load(&poses[in[0].joint].dual));
+  const uint32_t n = Count ? Count : count;
+  for (uint32_t k = 1; k < n; ++k) {
+    const JointPose& p = poses[in[k].joint];
+    const v128_t r = wasm_v128_load(&p.real);
+    v128_t dot = wasm_f32x4_mul(r, pivot);
+    dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 1, 0, 3, 2));
+    dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 2, 3, 0, 1));
+    const v128_t w = wasm_v128_xor(wasm_f32x4_splat(in[k].weight), wasm_v128_and(dot, signBit));
+    br = wasm_f32x4_add(br, wasm_f32x4_mul(w, r));
+    bd = wasm_f32x4_add(bd, wasm_f32x4_mul(w, wasm_v128_load(&p.dual)));
+  }
+}
+}  // namespace
+
+// The same blends as sectionTransformsWeights when every scale is s·I (the common case), in SIMD:
+// each blended section's dual quaternion accumulated in two registers (nodes grouped by joint
+// count), then four sections at a time turned into matrices (one lane each), with the very formulas
+// of blendPoses. Blended sections' normal matrices are not written: with a uniform scale they are
+// their position matrices over s, and deform() uses them so.
+void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, float s) {
+  std::fill(renormalise.begin(), renormalise.end(), uint8_t(0));
+  for (uint32_t i : rigidSections) {
+    const uint32_t j = sections[i].part;
+    sectionMatrices[i] = skin[j];
+    normalMatrices[i] = poses[j].normal;
+  }
+  const JointPose* pose = poses.data();
+  const Influence* influence = influences.data();
   uint32_t b = 0;
-  for (uint32_t i = 0; i < S; ++i) {
-    const Section& sec = sections[i];
-    renormalise[i] = 0;
-    if (sec.rigid) {
-      sectionMatrices[i] = skin[sec.part];
-      normalMatrices[i] = poses[sec.part].normal;
-      continue;
+  for (uint32_t count = 1; count <= kMaxInfluences; ++count) {
+    const uint32_t end = nodesWithCount[count + 1];
+    for (; b < end; ++b) {
+      v128_t br, bd;
+      const Influence* in = influence + nodeInfluenceFirst[b];
+      if (count == 2) accumulateNode<2>(pose, in, count, br, bd);
+      else if (count == 3) accumulateNode<3>(pose, in, count, br, bd);
+      else if (count == 4) accumulateNode<4>(pose, in, count, br, bd);
+      else accumulateNode<0>(pose, in, count, br, bd);
+      wasm_v128_store(&nodeReal[b], br);
+      wasm_v128_store(&nodeDual[b], bd);
     }
-    const Influence* in = &influences[sec.influenceFirst];
-    const v128_t pivot = wasm_v128_load(&poses[in[0].joint].real);
-    const v128_t w0 = wasm_f32x4_splat(in[0].weight);
-    v128_t br = wasm_f32x4_mul(w0, pivot), bd = wasm_f32x4_mul(w0, wasm_v128_load(&poses[in[0].joint].dual));
-    for (uint32_t k = 1; k < sec.influenceCount; ++k) {
-      const JointPose& p = poses[in[k].joint];
-      const v128_t r = wasm_v128_load(&p.real);
-      v128_t dot = wasm_f32x4_mul(r, pivot);
-      dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 1, 0, 3, 2));
-      dot = wasm_f32x4_add(dot, wasm_i32x4_shuffle(dot, dot, 2, 3, 0, 1));
-      // The weight, negated when the quaternion lies in the other hemisphere (dot < 0).
-      const v128_t w = wasm_v128_xor(wasm_f32x4_splat(in[k].weight), wasm_v128_and(dot, signBit));
-      br = wasm_f32x4_add(br, wasm_f32x4_mul(w, r));
-      bd = wasm_f32x4_add(bd, wasm_f32x4_mul(w, wasm_v128_load(&p.dual)));
-    }
-    wasm_v128_store(&nodeReal[b], br);
-    wasm_v128_store(&nodeDual[b], bd);
-    ++b;
   }
   const uint32_t B = b;
   const v128_t one = wasm_f32x4_splat(1.0f), two = wasm_f32x4_splat(2.0f), scale = wasm_f32x4_splat(s);
@@ -874,14 +906,8 @@ void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, flo
     const v128_t normalCol[3][4] = {{c00, c01, c02, c03}, {c10, c11, c12, c13}, {c20, c21, c22, c23}};
     const v128_t translation[4] = {t0, t1, t2, t3};
     for (uint32_t k = 0; k < 4 && g + k < B; ++k) {
-      const uint32_t i = blendedSections[g + k];
-      float* n = &normalMatrices[i][0][0];
-      float* m = &sectionMatrices[i][0][0];
-      for (int c = 0; c < 3; ++c) {
-        wasm_v128_store(n + 4 * c, normalCol[c][k]);
-        wasm_v128_store(m + 4 * c, wasm_f32x4_mul(scale, normalCol[c][k]));
-      }
-      wasm_v128_store(n + 12, zero);
+      float* m = &sectionMatrices[blendedSections[g + k]][0][0];
+      for (int c = 0; c < 3; ++c) wasm_v128_store(m + 4 * c, wasm_f32x4_mul(scale, normalCol[c][k]));
       wasm_v128_store(m + 12, translation[k]);
     }
   }
@@ -987,37 +1013,53 @@ void GcsDeformerImpl::computeSections(const glm::mat4* skin) {
 void GcsDeformerImpl::deform(const glm::mat4* skin) {
   computeSections(skin);
   const uint32_t S = uint32_t(sections.size());
+  // Every scale the same uniform s (and the weights criterion, whose normal matrices are then the
+  // rotations of the position matrices, and are not written for blended sections): one matrix, or
+  // one lerp, serves positions and normals.
+  const bool uniform = frameScale.uniform && settings.criterion == GCS_CRITERION_WEIGHTS && frameScale.s > 0.0f;
+  const float invS = uniform ? 1.0f / frameScale.s : 1.0f, invS2 = invS * invS;
   if (settings.smooth) {
-    // Every scale the same uniform s (and the weights criterion, whose normal matrices are then the
-    // rotations of the position matrices): one lerp serves positions and normals.
-    const bool uniform = frameScale.uniform && settings.criterion == GCS_CRITERION_WEIGHTS && frameScale.s > 0.0f;
-    const float invS = uniform ? 1.0f / frameScale.s : 1.0f;
     for (const BlendRun& run : blendRuns) {
       size_t o = size_t(run.first) * 3;
       const uint32_t a = run.section, b = run.other;
-      const NormalFix fix = a != b && uniform ? rotationBlendFix(rotationTrace(normalMatrices[a], normalMatrices[b]))
-                                              : NormalFix::Exact;
-      if (fix == NormalFix::None)
-        blendRunUniformT<false>(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
-                                &restNormals[o], &positions[o], &normals[o], run.count);
-      else if (fix == NormalFix::Cubic)
-        blendRunUniformT<true>(sectionMatrices[a], sectionMatrices[b], invS, &blendF[run.first], &restPositions[o],
-                               &restNormals[o], &positions[o], &normals[o], run.count);
-      else if (a == b)
+      if (uniform) {
+        const float* f = &blendF[run.first];
+        const float* p = &restPositions[o];
+        const float* n = &restNormals[o];
+        if (a == b) {
+          transformRunUniform(sectionMatrices[a], invS, p, n, &positions[o], &normals[o], run.count);
+          continue;
+        }
+        const NormalFix fix = rotationBlendFix(rotationTrace(sectionMatrices[a], sectionMatrices[b]) * invS2);
+        if (fix == NormalFix::None)
+          blendRunUniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
+                                            &normals[o], run.count);
+        else if (fix == NormalFix::Cubic)
+          blendRunUniformT<NormalFix::Cubic>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
+                                             &normals[o], run.count);
+        else
+          blendRunUniformT<NormalFix::Exact>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
+                                             &normals[o], run.count);
+      } else if (a == b) {
         transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
                      &positions[o], &normals[o], run.count);
-      else
+      } else {
         blendRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, sectionMatrices[b], normalMatrices[b],
                  renormalise[b] != 0, &blendF[run.first], &restPositions[o], &restNormals[o], &positions[o], &normals[o],
                  run.count);
+      }
     }
     return;
   }
   for (uint32_t i = 0; i < S; ++i) {
     const Section& sec = sections[i];
     size_t o = size_t(sec.first) * 3;
-    transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
-                 &positions[o], &normals[o], sec.count);
+    if (uniform)
+      transformRunUniform(sectionMatrices[i], invS, &restPositions[o], &restNormals[o], &positions[o], &normals[o],
+                          sec.count);
+    else
+      transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
+                   &positions[o], &normals[o], sec.count);
   }
 }
 

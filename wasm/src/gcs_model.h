@@ -95,8 +95,10 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<const JointPose*> blendPoseScratch;
   // Weights criterion, uniform scale: the blended sections' dual quaternions (real, dual), four
   // sections converted to matrices at a time; blendedSections lists them (padded to a multiple of 4).
+  // blendedSections is ordered by joint count: nodesWithCount[c] of them blend fewer than c joints;
+  // nodeInfluenceFirst[b] is blendedSections[b]'s first influence. rigidSections: the rigid cores.
   std::vector<glm::vec4> nodeReal, nodeDual;
-  std::vector<uint32_t> blendedSections;
+  std::vector<uint32_t> blendedSections, rigidSections, nodeInfluenceFirst, nodesWithCount;
   std::vector<glm::mat4> lastSkin;          // the last frame's S_j, for the adjusted statistic
   ScaleState frameScale;                    // what the last frame's scales have in common
   mutable uint32_t adjustedSections = 0;

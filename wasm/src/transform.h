@@ -358,6 +358,28 @@ inline void transformRun(const glm::mat4& m, const glm::mat4& nm, bool renormali
   else transformRunT<false>(m, nm, inPos, inNrm, outPos, outNrm, count);
 }
 
+// A run of vertices under one transform m = s·R (a uniform frame): positions by m, normals by m's
+// 3×3 over s (= R, so they stay unit). Five loop constants instead of transformRunT's seven.
+inline void transformRunUniform(const glm::mat4& m, float invS, const float* inPos, const float* inNrm, float* outPos,
+                                float* outNrm, uint32_t count) {
+#if defined(__wasm_simd128__)
+  const v128_t c0 = wasm_v128_load(&m[0][0]), c1 = wasm_v128_load(&m[1][0]);
+  const v128_t c2 = wasm_v128_load(&m[2][0]), c3 = wasm_v128_load(&m[3][0]);
+  const v128_t s0 = wasm_f32x4_splat(invS);
+  for (uint32_t i = 0; i < count; ++i) {
+    const float* n = inNrm + 3 * i;
+    // The 4th lane of c0..c2 is 0 (affine matrices), so the normal's 4th lane stays 0.
+    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
+                                                    wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
+                                     wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
+    wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));  // lane 4 spills into the next vertex
+    wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, s0));
+  }
+#else
+  transformRunT<false>(m, invS * m, inPos, inNrm, outPos, outNrm, count);
+#endif
+}
+
 // How a blended normal's length is restored: exactly (sqrt and division), by a cubic approximation
 // of 1/sqrt around 1 (both normal matrices rotations less than 35° apart: error < 3e-4), or not at
 // all (rotations less than 2.8° apart: the blend's length falls short of 1 by at most
@@ -432,11 +454,10 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 
 // Smooth mode when every joint's scale is the same uniform s (the common case: then a section's
 // normal matrix is its position matrix's 3×3 divided by s): one lerp of the position matrices serves
-// the normals too, and their length fixed by 1/|v| as a polynomial in |v|² (the near-rotation cubic of
-// blendRunT with the 1/s folded in). Eleven loop constants (8 matrix columns, 3 coefficients)
-// instead of blendRunT's 18, so no spills. Same results up to rounding. FixLength false (rotations
-// almost equal, see kAlmostEqualTrace): the normal is only divided by s.
-template <bool FixLength>
+// the normals too. The cubic fix is 1/|v| as a polynomial in |v|² with the 1/s folded in: eleven
+// loop constants (8 matrix columns, 3 coefficients) instead of blendRunT's 18, so no spills. Same
+// results as blendRunT on the normal matrices up to rounding.
+template <NormalFix Fix>
 inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float invS, const float* f, const float* inPos,
                              const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
@@ -447,9 +468,8 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
   // 1/|v| for |v|² = x near s²: invS·(1 − e/2 + 3e²/8), e = x/s² − 1, as a polynomial in x (three
   // constants, so that the loop's live values fit the registers).
   const float k = invS * invS;
-  const v128_t p0 = wasm_f32x4_splat(1.875f * invS), p1 = wasm_f32x4_splat(-1.25f * invS * k);
-  const v128_t p2 = wasm_f32x4_splat(0.375f * invS * k * k);
-  const v128_t s0 = wasm_f32x4_splat(invS);
+  const v128_t p0 = wasm_f32x4_splat(Fix == NormalFix::Cubic ? 1.875f * invS : invS);
+  const v128_t p1 = wasm_f32x4_splat(-1.25f * invS * k), p2 = wasm_f32x4_splat(0.375f * invS * k * k);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i);
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
@@ -460,19 +480,23 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
                                                     wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
                                      wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3)), inPos + 3 * i));
-    if (!FixLength) {
-      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, s0));
-      continue;
+    if (Fix == NormalFix::None) {
+      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, p0));
+    } else if (Fix == NormalFix::Cubic) {
+      v128_t sq = wasm_f32x4_mul(rn, rn);
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
+      wasm_v128_store(outNrm + 3 * i,
+                      wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
+    } else {
+      wasm_v128_store(outNrm + 3 * i, normalise3(rn));
+      keepUnit(outNrm + 3 * i, n);
     }
-    v128_t sq = wasm_f32x4_mul(rn, rn);
-    sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
-    sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
-    wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
   }
 #else
   // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
-  blendRunT<FixLength ? NormalFix::Exact : NormalFix::None>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm, outPos,
-                                                             outNrm, count);
+  blendRunT<Fix == NormalFix::None ? NormalFix::None : NormalFix::Exact>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm,
+                                                                         outPos, outNrm, count);
 #endif
 }
 
