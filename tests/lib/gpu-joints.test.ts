@@ -111,14 +111,16 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
 function shade(d: GcsDeformer, poses: Float32Array, base: number, rest: { p: Float32Array; n: Float32Array }, outP: Float64Array, outN: Float64Array): void {
   const table = d.sectionInfluences()!;
   const sectionOf = d.sectionOfVertex(), other = d.blendOther(), factor = d.blendFactor();
+  const third = d.blendThird(), thirdFactor = d.blendThirdFactor();
   const blends = Array.from({ length: d.sectionCount }, (_, s) => sectionBlend(poses, base, table, s));
   const M = new Float64Array(12), N = new Float64Array(9);
+  const traceOf = (x: { n: Float64Array }, y: { n: Float64Array }) => { let t = 0; for (let i = 0; i < 9; i++) t += x.n[i] * y.n[i]; return t; };
   for (let v = 0; v < sectionOf.length; v++) {
-    const a = blends[sectionOf[v]], b = other ? blends[other[v]] : a;
-    const f = factor ? factor[v] : 0;
-    const blending = a !== b;
-    for (let i = 0; i < 12; i++) M[i] = a.p[i] + f * (b.p[i] - a.p[i]);
-    for (let i = 0; i < 9; i++) N[i] = a.n[i] + f * (b.n[i] - a.n[i]);
+    const a = blends[sectionOf[v]], b = other ? blends[other[v]] : a, c = third ? blends[third[v]] : a;
+    const f = factor ? factor[v] : 0, g = thirdFactor ? thirdFactor[v] : 0;
+    const blending = a !== b, three = c !== a;
+    for (let i = 0; i < 12; i++) M[i] = a.p[i] + f * (b.p[i] - a.p[i]) + g * (c.p[i] - a.p[i]);
+    for (let i = 0; i < 9; i++) N[i] = a.n[i] + f * (b.n[i] - a.n[i]) + g * (c.n[i] - a.n[i]);
     const x = rest.p[3 * v], y = rest.p[3 * v + 1], z = rest.p[3 * v + 2];
     const nx = rest.n[3 * v], ny = rest.n[3 * v + 1], nz = rest.n[3 * v + 2];
     let len2 = 0;
@@ -129,9 +131,13 @@ function shade(d: GcsDeformer, poses: Float32Array, base: number, rest: { p: Flo
       len2 += n * n;
     }
     let near = false, almostEqual = false;
-    if (blending && !a.renorm && !b.renorm) {
-      let trace = 0;
-      for (let i = 0; i < 9; i++) trace += a.n[i] * b.n[i];
+    if (three && !a.renorm && !b.renorm && !c.renorm) {
+      // A three-joint lattice cell: the least pairwise trace, the three-node thresholds (25°, 2.4°).
+      const least = Math.min(traceOf(a, b), traceOf(a, c), traceOf(b, c));
+      near = least > 1 + 2 * 0.9063;
+      almostEqual = least > 1 + 2 * 0.9991;
+    } else if (!three && blending && !a.renorm && !b.renorm) {
+      const trace = traceOf(a, b);
       near = trace > 1 + 2 * 0.82;
       almostEqual = trace > 1 + 2 * 0.9988;
     }

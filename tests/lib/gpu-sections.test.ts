@@ -30,28 +30,31 @@ function restOf(d: GcsDeformer): { p: Float32Array; n: Float32Array } {
 }
 
 /** The shader's work for one vertex, in float64: M = A + f(B − A); p' = M(p, 1); n' from the cofactors. */
-function applyPacked(texels: Float32Array, base: number, sectionOf: Uint32Array, other: Uint32Array | null,
-  factor: Float32Array | null, rest: { p: Float32Array; n: Float32Array }, outP: Float64Array, outN: Float64Array): void {
-  const A = new Float64Array(12), B = new Float64Array(12), M = new Float64Array(12);
+/** A smooth vertex's other sections and factors: B by f (blendOther/blendFactor), C by g (blendThird/blendThirdFactor). */
+interface Blends { other: Uint32Array; factor: Float32Array; third: Uint32Array; thirdFactor: Float32Array }
+
+function applyPacked(texels: Float32Array, base: number, sectionOf: Uint32Array, blends: Blends | null,
+  rest: { p: Float32Array; n: Float32Array }, outP: Float64Array, outN: Float64Array): void {
+  const A = new Float64Array(12), B = new Float64Array(12), C = new Float64Array(12), M = new Float64Array(12);
   const load = (s: number, out: Float64Array) => {
     const o = (base + s * GPU_TEXELS_PER_SECTION) * 4;
     for (let k = 0; k < 12; k++) out[k] = texels[o + k];
   };
   for (let v = 0; v < sectionOf.length; v++) {
     load(sectionOf[v], A);
-    const f = factor ? factor[v] : 0;
-    const b = other ? other[v] : sectionOf[v];
-    load(b, B);
-    for (let k = 0; k < 12; k++) M[k] = A[k] + f * (B[k] - A[k]);
+    const f = blends ? blends.factor[v] : 0, g = blends ? blends.thirdFactor[v] : 0;
+    load(blends ? blends.other[v] : sectionOf[v], B);
+    load(blends ? blends.third[v] : sectionOf[v], C);
+    for (let k = 0; k < 12; k++) M[k] = A[k] + f * (B[k] - A[k]) + g * (C[k] - A[k]);
     const x = rest.p[3 * v], y = rest.p[3 * v + 1], z = rest.p[3 * v + 2];
     for (let r = 0; r < 3; r++) outP[3 * v + r] = M[4 * r] * x + M[4 * r + 1] * y + M[4 * r + 2] * z + M[4 * r + 3];
     // Normal matrix: plain, cof(A); smooth, the blend of each side's cof(X)/|det X|^(2/3).
-    const na = normalMatrix(A, !!factor), nb = normalMatrix(B, !!factor);
+    const na = normalMatrix(A, !!blends), nb = normalMatrix(B, !!blends), nc = normalMatrix(C, !!blends);
     const nx = rest.n[3 * v], ny = rest.n[3 * v + 1], nz = rest.n[3 * v + 2];
     let len = 0;
     for (let r = 0; r < 3; r++) {
       let s = 0;
-      for (let c = 0; c < 3; c++) s += (na[3 * r + c] + f * (nb[3 * r + c] - na[3 * r + c])) * [nx, ny, nz][c];
+      for (let c = 0; c < 3; c++) s += (na[3 * r + c] + f * (nb[3 * r + c] - na[3 * r + c]) + g * (nc[3 * r + c] - na[3 * r + c])) * [nx, ny, nz][c];
       outN[3 * v + r] = s;
       len += s * s;
     }
@@ -92,8 +95,11 @@ describe('packed section transforms = gcs_deformer_deform', () => {
       const d = rig.buildGcs(options);
       const rest = restOf(d);
       const sectionOf = d.sectionOfVertex(), other = d.blendOther(), factor = d.blendFactor();
+      const third = d.blendThird(), thirdFactor = d.blendThirdFactor();
       const smooth = options.smooth ?? (options.criterion ?? 'weights') === 'weights';
       expect(other !== null).toBe(smooth);
+      expect(third !== null).toBe(smooth);
+      const blends = other && factor && third && thirdFactor ? { other, factor, third, thirdFactor } : null;
       const st = new SectionTransforms(d, 1);
       const V = d.vertexCount, H = rig.height;
       const outP = new Float64Array(3 * V), outN = new Float64Array(3 * V);
@@ -110,7 +116,7 @@ describe('packed section transforms = gcs_deformer_deform', () => {
               for (let r = 0; r < 3; r++)
                 for (let c = 0; c < 4; c++) expect(t[12 * s + 4 * r + c]).toBe(m[16 * s + 4 * c + r]);
           }
-          applyPacked(st.texels, 0, sectionOf, other, factor, rest, outP, outN);
+          applyPacked(st.texels, 0, sectionOf, blends, rest, outP, outN);
           const dp = maxDistance(outP, d.positions) / H, dn = maxDistance(outN, d.normals, true);
           if (k === 0) { worstP = Math.max(worstP, dp); worstN = Math.max(worstN, dn); }
           else { worstScaledP = Math.max(worstScaledP, dp); worstScaledN = Math.max(worstScaledN, dn); }

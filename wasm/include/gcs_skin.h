@@ -155,7 +155,11 @@ typedef enum GcsDeformerKind {
  * weights (level 0: the rigid core, exactly S_d; the even split of two joints: one node for both).
  * A vertex belongs to the node at the level below its s (its run in the output) and blends with the
  * node above by its fraction (gcs_gcs_blend_other / gcs_gcs_blend_factor); a node only blended
- * towards may hold no vertex (count 0). Up to two nodes per welded vertex.
+ * towards may hold no vertex (count 0). A vertex of exactly three joints instead blends the three
+ * corners of its cell on the lattice of weights in steps of 1/Q (the Kuhn triangle in the partial
+ * sums of its weights, joints by index; barycentric factors; gcs_gcs_blend_third /
+ * gcs_gcs_blend_third_factor): continuous in every weight, and the corners are shared by the cell's
+ * vertices (corners with a zero weight are two-joint nodes). Up to three nodes per welded vertex.
  * Y / axial criteria (the paper, design.md §2b–3): parts by dominant weight, shared sections from
  * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
  * transform S_p · D_j^α · D_k^β on the rigid parts of the S_j (scale applied first).
@@ -261,11 +265,17 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
  * shader applies them.
  *
  * Smooth mode only (null for a GCS deformer built without smooth mode, and for other deformers):
- *   gcs_gcs_blend_other    output vertexCount uint32: the section each output vertex blends with
- *                          (its own section when it does not blend).
- *   gcs_gcs_blend_factor   output vertexCount floats in [0, 1]: the factor towards that section.
- * A vertex p of own section A, other section B and factor f (plain mode: f = 0) moves to
- *   p' = (A + f·(B − A))·(p, 1)   (entrywise on the 3×4 affine matrices packed below),
+ *   gcs_gcs_blend_other          output vertexCount uint32: the section each output vertex blends
+ *                                with (its own section when it does not blend).
+ *   gcs_gcs_blend_factor         output vertexCount floats in [0, 1]: the factor towards that section.
+ *   gcs_gcs_blend_third          output vertexCount uint32: a third section (weights criterion, a
+ *                                vertex of three joints: its lattice cell's third node); its own
+ *                                section otherwise.
+ *   gcs_gcs_blend_third_factor   output vertexCount floats in [0, 1]: the factor towards it (0 when
+ *                                there is none); the two factors sum to at most 1.
+ * A vertex p of own section A, other sections B and C and factors f and g (plain mode: f = g = 0)
+ * moves to
+ *   p' = (A + f·(B − A) + g·(C − A))·(p, 1)   (entrywise on the 3×4 affine matrices packed below),
  * which is what gcs_deformer_deform computes. Its normal turns by the cofactor of the 3×3 part
  * (docs/gpu.md: the same direction as gcs_deformer_deform's normal matrix).
  */
@@ -273,6 +283,8 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
 #define GCS_MAX_INSTANCES 65536
 const uint32_t* gcs_gcs_blend_other(const GcsDeformer* deformer);
 const float* gcs_gcs_blend_factor(const GcsDeformer* deformer);
+const uint32_t* gcs_gcs_blend_third(const GcsDeformer* deformer);
+const float* gcs_gcs_blend_third_factor(const GcsDeformer* deformer);
 /*
  * Section transforms only, for instanceCount poses of the same model (a crowd), packed for an
  * RGBA32F texture; no per-vertex work.

@@ -238,6 +238,14 @@ const float* gcs_gcs_blend_factor(const GcsDeformer* d) {
   const gcs::GcsDeformerImpl* g = asGcs(d);
   return g && g->settings.smooth ? g->blendF.data() : nullptr;
 }
+const uint32_t* gcs_gcs_blend_third(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g && g->settings.smooth ? g->blendThird.data() : nullptr;
+}
+const float* gcs_gcs_blend_third_factor(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g && g->settings.smooth ? g->blendThirdF.data() : nullptr;
+}
 
 // The checks both GPU-path calls make before writing anything: pointers, counts, sizes (the input
 // and `outBytesPerInstance` per instance within 4 GiB) and every skin matrix finite.

@@ -69,7 +69,9 @@ void groupBlendRuns(GcsDeformerImpl& m) {
   for (uint32_t i = 0; i < N; ++i) order[i] = i;
   for (const Section& sec : m.sections) {
     auto begin = order.begin() + sec.first, end = begin + sec.count;
-    std::stable_sort(begin, end, [&](uint32_t a, uint32_t b) { return m.blendOther[a] < m.blendOther[b]; });
+    std::stable_sort(begin, end, [&](uint32_t a, uint32_t b) {
+      return std::make_pair(m.blendOther[a], m.blendThird[a]) < std::make_pair(m.blendOther[b], m.blendThird[b]);
+    });
   }
   std::vector<uint32_t> newIndex(N);
   for (uint32_t i = 0; i < N; ++i) newIndex[order[i]] = i;
@@ -90,14 +92,17 @@ void groupBlendRuns(GcsDeformerImpl& m) {
   permute(m.sectionOfVertex);
   permute(m.blendOther);
   permute(m.blendF);
+  permute(m.blendThird);
+  permute(m.blendThirdF);
   for (uint32_t& index : m.indices) index = newIndex[index];
   m.blendRuns.clear();
   for (uint32_t i = 0; i < uint32_t(m.sections.size()); ++i) {
     const Section& sec = m.sections[i];
     for (uint32_t o = sec.first; o < sec.first + sec.count;) {
       uint32_t end = o;
-      while (end < sec.first + sec.count && m.blendOther[end] == m.blendOther[o]) ++end;
-      m.blendRuns.push_back({o, end - o, i, m.blendOther[o]});
+      while (end < sec.first + sec.count && m.blendOther[end] == m.blendOther[o] && m.blendThird[end] == m.blendThird[o])
+        ++end;
+      m.blendRuns.push_back({o, end - o, i, m.blendOther[o], m.blendThird[o]});
       o = end;
     }
   }
@@ -356,6 +361,25 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
 }
 
+// The cell of the weight lattice (steps of 1/Q) holding three weights that sum to 1: with partial
+// sums z1 = Q·w0, z2 = Q·(w0 + w1), the Kuhn triangle of the unit square of (z1, z2) around them.
+// Calls cell(x, mu): x[c] the c-th corner's weights in units of 1/Q (they sum to Q), mu[c] its
+// barycentric factor (they sum to 1; corner 0 is the square's lower corner).
+template <class Cell>
+void latticeCell(const uint32_t (&)[kMaxInfluences], const float (&weight)[kMaxInfluences], uint32_t Q, Cell cell) {
+  const double z1 = double(weight[0]) * Q, z2 = (double(weight[0]) + double(weight[1])) * Q;
+  const double f1 = std::floor(z1), f2 = std::min(std::floor(z2), double(Q) - 1.0);
+  const double r1 = glm::clamp(z1 - f1, 0.0, 1.0), r2 = glm::clamp(z2 - f2, 0.0, 1.0);
+  const uint32_t b1 = uint32_t(f1), b2 = uint32_t(f2);
+  // Corners in (z1, z2): (b1, b2), then one step along the larger fraction first, then (b1+1, b2+1).
+  const bool firstZ1 = r1 >= r2;
+  const uint32_t zc[3][2] = {{b1, b2}, {firstZ1 ? b1 + 1 : b1, firstZ1 ? b2 : b2 + 1}, {b1 + 1, b2 + 1}};
+  const float mu[3] = {float(1.0 - std::max(r1, r2)), float(std::fabs(r1 - r2)), float(std::min(r1, r2))};
+  uint32_t x[3][3];
+  for (int c = 0; c < 3; ++c) x[c][0] = zc[c][0], x[c][1] = zc[c][1] - zc[c][0], x[c][2] = Q - zc[c][1];
+  cell(x, mu);
+}
+
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
 // d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
 // (the other joints' shares of s, summing to 1). Sections are NODES on the rays leaving each rigid
@@ -365,9 +389,16 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
 // to 1/(8Q) of weight (1/64 at the default 6 sections), so no step between bins (design.md §2a;
 // creases measured in §7). The even split of two joints is one key from either side, so their rays
 // share that node.
+//   A vertex of exactly three joints instead blends the three nodes of its cell on the lattice of
+// weights in steps of 1/Q (the triangle of lattice points around it, barycentric factors): the
+// result is continuous in all its weights, and its nodes are shared by every vertex of the cell
+// (on the human: ~250 nodes instead of ~1,150 for its 1,469 three-joint vertices). Lattice points
+// with a zero weight are the two-joint nodes above (the same keys), so the skin stays seamless
+// where a third joint's weight fades out.
 void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
                       std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
-                      std::vector<float>& blendOfGroup) {
+                      std::vector<float>& blendOfGroup, std::vector<uint32_t>& thirdOfGroup,
+                      std::vector<float>& blendThirdOfGroup) {
   const uint32_t G = uint32_t(representative.size());
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
@@ -384,12 +415,31 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     }
     return it->second;
   };
-  std::vector<uint32_t> lowKey(G), highKey(G);
+  std::vector<uint32_t> lowKey(G), highKey(G), thirdKey(G);
   blendOfGroup.assign(G, 0.0f);
+  blendThirdOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
     uint32_t joint[kMaxInfluences] = {};
     float weight[kMaxInfluences] = {};
     const uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    if (n == 3) {
+      // One triangulation per joint triple: the joints in a fixed order (by index).
+      for (uint32_t i = 1; i < 3; ++i)
+        for (uint32_t k = i; k > 0 && joint[k] < joint[k - 1]; --k) std::swap(joint[k], joint[k - 1]), std::swap(weight[k], weight[k - 1]);
+      latticeCell(joint, weight, Q, [&](const uint32_t (&x)[3][3], const float (&mu)[3]) {
+        uint32_t ids[3];
+        for (int c = 0; c < 3; ++c) {
+          WeightKey key;
+          key.n = 3;
+          for (int i = 0; i < 3; ++i) key.joint[i] = joint[i], key.q[i] = 8 * x[c][i];
+          ids[c] = keyId(key);
+        }
+        lowKey[g] = ids[0], highKey[g] = ids[1], thirdKey[g] = ids[2];
+        blendOfGroup[g] = mu[1];
+        blendThirdOfGroup[g] = mu[2];
+      });
+      continue;
+    }
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
@@ -422,7 +472,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
       return keyId(key);
     };
     lowKey[g] = nodeKey(level);
-    highKey[g] = lowKey[g];
+    highKey[g] = thirdKey[g] = lowKey[g];
     if (frac > 1e-6f && level < Q) {
       highKey[g] = nodeKey(level + 1);
       blendOfGroup[g] = frac;
@@ -435,9 +485,11 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   const uint32_t K = uint32_t(keys.size());
   sectionOfGroup.resize(G);
   otherOfGroup.resize(G);
+  thirdOfGroup.resize(G);
   for (uint32_t g = 0; g < G; ++g) {
     sectionOfGroup[g] = sectionOfKey[lowKey[g]];
     otherOfGroup[g] = sectionOfKey[highKey[g]];
+    thirdOfGroup[g] = sectionOfKey[thirdKey[g]];
   }
   m.partCount = 0;
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
@@ -489,17 +541,23 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     std::vector<uint32_t> group = weldByPosition(rig, representative);
     const uint32_t G = uint32_t(representative.size());
     if (settings.criterion == GCS_CRITERION_WEIGHTS) {
-      std::vector<uint32_t> sectionOfGroup, otherOfGroup;
-      std::vector<float> blendOfGroup;
-      if (settings.smooth) buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup);
+      std::vector<uint32_t> sectionOfGroup, otherOfGroup, thirdOfGroup;
+      std::vector<float> blendOfGroup, blendThirdOfGroup;
+      if (settings.smooth)
+        buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
+                         blendThirdOfGroup);
       else buildWeightSections(rig, m, representative, sectionOfGroup);
       std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
       if (settings.smooth) {
         m.blendOther.resize(rig.vertexCount);
         m.blendF.resize(rig.vertexCount);
+        m.blendThird.resize(rig.vertexCount);
+        m.blendThirdF.resize(rig.vertexCount);
         for (uint32_t v = 0; v < rig.vertexCount; ++v) {
           m.blendOther[outputOf[v]] = otherOfGroup[group[v]];
           m.blendF[outputOf[v]] = blendOfGroup[group[v]];
+          m.blendThird[outputOf[v]] = thirdOfGroup[group[v]];
+          m.blendThirdF[outputOf[v]] = blendThirdOfGroup[group[v]];
         }
       }
       finishModel(m);
@@ -725,6 +783,8 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     if (settings.smooth) {
       m.blendOther.resize(rig.vertexCount);
       m.blendF.assign(rig.vertexCount, 0.0f);
+      m.blendThird = m.sectionOfVertex;  // two sections at most per vertex here
+      m.blendThirdF.assign(rig.vertexCount, 0.0f);
       for (uint32_t o = 0; o < rig.vertexCount; ++o) m.blendOther[o] = m.sectionOfVertex[o];
       std::vector<std::pair<float, uint32_t>> chain;
       for (size_t bi = 0; bi < branches.size(); ++bi) {
@@ -1026,6 +1086,24 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
         const float* f = &blendF[run.first];
         const float* p = &restPositions[o];
         const float* n = &restNormals[o];
+        if (run.third != a) {  // a three-joint lattice cell
+          const uint32_t c = run.third;
+          const float* g = &blendThirdF[run.first];
+          const float least = std::min({rotationTrace(sectionMatrices[a], sectionMatrices[b]),
+                                        rotationTrace(sectionMatrices[a], sectionMatrices[c]),
+                                        rotationTrace(sectionMatrices[b], sectionMatrices[c])}) * invS2;
+          const NormalFix fix3 = rotationBlendFix3(least);
+          if (fix3 == NormalFix::None)
+            blendRun3UniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p,
+                                               n, &positions[o], &normals[o], run.count);
+          else if (fix3 == NormalFix::Cubic)
+            blendRun3UniformT<NormalFix::Cubic>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g,
+                                                p, n, &positions[o], &normals[o], run.count);
+          else
+            blendRun3UniformT<NormalFix::Exact>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g,
+                                                p, n, &positions[o], &normals[o], run.count);
+          continue;
+        }
         if (a == b) {
           transformRunUniform(sectionMatrices[a], invS, p, n, &positions[o], &normals[o], run.count);
           continue;
@@ -1040,6 +1118,16 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
         else
           blendRunUniformT<NormalFix::Exact>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
                                              &normals[o], run.count);
+      } else if (run.third != a) {
+        const uint32_t c = run.third;
+        const NormalFix fix = renormalise[a] || renormalise[b] || renormalise[c]
+                                  ? NormalFix::Exact
+                                  : rotationBlendFix3(std::min({rotationTrace(normalMatrices[a], normalMatrices[b]),
+                                                                rotationTrace(normalMatrices[a], normalMatrices[c]),
+                                                                rotationTrace(normalMatrices[b], normalMatrices[c])}));
+        blendRun3(sectionMatrices[a], normalMatrices[a], sectionMatrices[b], normalMatrices[b], sectionMatrices[c],
+                  normalMatrices[c], fix, &blendF[run.first], &blendThirdF[run.first], &restPositions[o],
+                  &restNormals[o], &positions[o], &normals[o], run.count);
       } else if (a == b) {
         transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
                      &positions[o], &normals[o], run.count);

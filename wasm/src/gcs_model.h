@@ -77,10 +77,14 @@ class GcsDeformerImpl final : public Deformer {
   // (its own section is the run it sits in).
   std::vector<uint32_t> blendOther;
   std::vector<float> blendF;
+  // Smooth weights criterion, a vertex of three joints: the third node of its lattice cell and the
+  // factor towards it (M = A + f·(B − A) + g·(C − A)); others: their own section and 0.
+  std::vector<uint32_t> blendThird;
+  std::vector<float> blendThirdF;
   // Smooth mode: runs of vertices of one section that blend with the same other section (vertices
   // are sorted by it within their section at build time), so the kernel loads both transforms once.
   struct BlendRun {
-    uint32_t first = 0, count = 0, section = 0, other = 0;
+    uint32_t first = 0, count = 0, section = 0, other = 0, third = 0;
   };
   std::vector<BlendRun> blendRuns;
   float adjustTolerance = 0.0f;

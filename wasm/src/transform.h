@@ -388,6 +388,16 @@ enum class NormalFix { Exact, Cubic, None };
 
 constexpr float kNearTrace = 1.0f + 2.0f * 0.82f;            // trace of Ra^T Rb = 1 + 2 cos θ: θ < 35°
 constexpr float kAlmostEqualTrace = 1.0f + 2.0f * 0.9988f;   // θ < 2.8°
+// Three rotations pairwise θ apart: a convex blend of three unit vectors lies within a cap of
+// radius θ/√3 (Jung), so it falls short of 1 by at most 1 − cos(θ/√3) ≈ (1 − cos θ)/3: under 3e-4
+// for θ < 2.4° (no fix), and its length² stays above 0.93 for θ < 25° (the cubic errs < 1.5e-4).
+constexpr float kAlmostEqualTrace3 = 1.0f + 2.0f * 0.9991f;  // θ < 2.4°
+constexpr float kNearTrace3 = 1.0f + 2.0f * 0.9063f;         // θ < 25°
+
+// The fix for a blend of three rotations, from the least of their three pairwise traces.
+inline NormalFix rotationBlendFix3(float leastTrace) {
+  return leastTrace > kAlmostEqualTrace3 ? NormalFix::None : leastTrace > kNearTrace3 ? NormalFix::Cubic : NormalFix::Exact;
+}
 
 // The trace of na^T nb (3×3 parts): 1 + 2 cos θ when both are rotations θ apart.
 inline float rotationTrace(const glm::mat4& na, const glm::mat4& nb) {
@@ -497,6 +507,73 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
   // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
   blendRunT<Fix == NormalFix::None ? NormalFix::None : NormalFix::Exact>(pa, invS * pa, pb, invS * pb, f, inPos, inNrm,
                                                                          outPos, outNrm, count);
+#endif
+}
+
+// Smooth mode, a run of vertices that blend three transforms (positions pa/pb/pc, normals na/nb/nc)
+// by f and g: M = A + f·(B − A) + g·(C − A), normals likewise, their length restored as `fix` says
+// (a vanished normal keeps its rest direction). Scalar: for frames with non-uniform scales only.
+inline void blendRun3(const glm::mat4& pa, const glm::mat4& na, const glm::mat4& pb, const glm::mat4& nb,
+                      const glm::mat4& pc, const glm::mat4& nc, NormalFix fix, const float* f, const float* g,
+                      const float* inPos, const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
+  for (uint32_t i = 0; i < count; ++i) {
+    const glm::mat4 m = pa + f[i] * (pb - pa) + g[i] * (pc - pa);
+    const glm::mat3 nm = glm::mat3(na + f[i] * (nb - na) + g[i] * (nc - na));
+    const float* p = inPos + 3 * i;
+    const float* n = inNrm + 3 * i;
+    const glm::vec3 q = glm::vec3(m * glm::vec4(p[0], p[1], p[2], 1.0f));
+    glm::vec3 r = nm * glm::vec3(n[0], n[1], n[2]);
+    if (fix == NormalFix::Cubic) {
+      const float e = glm::dot(r, r) - 1.0f;
+      r *= 1.0f + e * (-0.5f + 0.375f * e);
+    }
+    for (int k = 0; k < 3; ++k) outPos[3 * i + k] = q[k], outNrm[3 * i + k] = r[k];
+    if (fix == NormalFix::Exact) normaliseInPlace(outNrm + 3 * i), keepUnit(outNrm + 3 * i, n);
+  }
+}
+
+// Smooth mode, a run of vertices that blend three transforms A, B, C (a three-joint lattice cell)
+// when every scale is the same uniform s: vertex i takes A + f[i]·(B − A) + g[i]·(C − A) for its
+// position and, over s, its normal, whose length is restored as Fix says (rotationBlendFix3).
+template <NormalFix Fix>
+inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const glm::mat4& pc, float invS,
+                              const float* f, const float* g, const float* inPos, const float* inNrm, float* outPos,
+                              float* outNrm, uint32_t count) {
+#if defined(__wasm_simd128__)
+  v128_t a[4], d[4], e[4];
+  for (int c = 0; c < 4; ++c) {
+    a[c] = wasm_v128_load(&pa[c][0]);
+    d[c] = wasm_f32x4_sub(wasm_v128_load(&pb[c][0]), a[c]);
+    e[c] = wasm_f32x4_sub(wasm_v128_load(&pc[c][0]), a[c]);
+  }
+  // As in blendRunUniformT: 1/|v| as a polynomial in |v|² with the 1/s folded in.
+  const float k2 = invS * invS;
+  const v128_t p0 = wasm_f32x4_splat(Fix == NormalFix::Cubic ? 1.875f * invS : invS);
+  const v128_t p1 = wasm_f32x4_splat(-1.25f * invS * k2), p2 = wasm_f32x4_splat(0.375f * invS * k2 * k2);
+  for (uint32_t i = 0; i < count; ++i) {
+    const v128_t t = wasm_v128_load32_splat(f + i), u = wasm_v128_load32_splat(g + i);
+    v128_t c[4];
+    for (int k = 0; k < 4; ++k) c[k] = wasm_f32x4_add(wasm_f32x4_add(a[k], wasm_f32x4_mul(t, d[k])), wasm_f32x4_mul(u, e[k]));
+    const float* n = inNrm + 3 * i;
+    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c[0], wasm_v128_load32_splat(n)),
+                                                    wasm_f32x4_mul(c[1], wasm_v128_load32_splat(n + 1))),
+                                     wasm_f32x4_mul(c[2], wasm_v128_load32_splat(n + 2)));
+    wasm_v128_store(outPos + 3 * i, affine(c[0], c[1], c[2], c[3], inPos + 3 * i));
+    if (Fix == NormalFix::None) {
+      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, p0));
+    } else if (Fix == NormalFix::Cubic) {
+      v128_t sq = wasm_f32x4_mul(rn, rn);
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
+      wasm_v128_store(outNrm + 3 * i,
+                      wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
+    } else {
+      wasm_v128_store(outNrm + 3 * i, normalise3(rn));
+      keepUnit(outNrm + 3 * i, n);
+    }
+  }
+#else
+  blendRun3(pa, invS * pa, pb, invS * pb, pc, invS * pc, Fix, f, g, inPos, inNrm, outPos, outNrm, count);
 #endif
 }
 

@@ -27,4 +27,4 @@ export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JointPoses, SectionTransf
 export type { GpuPath } from './gpu/layout.js';
 export { patchVertexShader } from './gpu/glsl.js';
 export { gcsMaterial, gcsShadowMaterials, gpuMaterialSupport } from './gpu/webgl-materials.js';
-export { GpuSections, sectionAttributes, type GcsUniforms } from './gpu/sections.js';
+export { GpuSections, sectionAttributes, type GcsUniforms, type SectionAttribute } from './gpu/sections.js';

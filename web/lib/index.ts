@@ -611,6 +611,23 @@ export class GcsDeformer extends Deformer {
     return ptr ? this.gcs.viewF32(ptr, this.vertexCount).slice() : null;
   }
   /**
+   * Smooth mode: for each output vertex a third section it blends with (a vertex of three joints:
+   * its weight-lattice cell's third node; otherwise its own section), a copy; null in plain mode.
+   */
+  blendThird(): Uint32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_blend_third(this.live());
+    return ptr ? this.gcs.viewU32(ptr, this.vertexCount).slice() : null;
+  }
+  /**
+   * Smooth mode: for each output vertex the factor towards blendThird() (0..1; 0 without one), a
+   * copy; null in plain mode. The vertex moves by A + f·(B − A) + g·(C − A) (A its section, B and
+   * f blendOther() and blendFactor(), C and g these).
+   */
+  blendThirdFactor(): Float32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_blend_third_factor(this.live());
+    return ptr ? this.gcs.viewF32(ptr, this.vertexCount).slice() : null;
+  }
+  /**
    * The GPU path's per-frame work: section transforms only, for `instanceCount` poses at once,
    * written as texels (GPU_TEXELS_PER_SECTION RGBA32F texels per section: the rows of its affine
    * 3×4) at byte offset `outPtr` in wasm memory; `skinPtr` holds instanceCount × J × 16 floats.

@@ -49,7 +49,7 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
   const points = new THREE.BufferGeometry(); // not indexed: gl_VertexID is the vertex
-  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend']) {
+  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend', 'gcsBlendThird']) {
     const a = src.getAttribute(name);
     if (a) points.setAttribute(name, a);
   }

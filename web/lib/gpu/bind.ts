@@ -33,8 +33,7 @@ export function bindGeometry(deformer: GcsDeformer, jointCount: number, source: 
   deformer.deform(identitySkin(jointCount));
   geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
   geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
-  const { name, attribute } = sectionAttributes(deformer);
-  geometry.setAttribute(name, attribute);
+  for (const { name, attribute } of sectionAttributes(deformer)) geometry.setAttribute(name, attribute);
   const sourceVertex = deformer.sourceVertex;
   if (!sourceVertex) return geometry;
   for (const [key, attr] of Object.entries(source.attributes))

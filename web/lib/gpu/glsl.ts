@@ -5,8 +5,8 @@
  */
 import { GcsError } from '../errors.js';
 import {
-  ALMOST_EQUAL_TRACE, BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
-  SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
+  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -18,6 +18,7 @@ uniform int gcsBase;
 uniform int gcsStride;
 #ifdef GCS_SMOOTH
 attribute vec3 ${BLEND_ATTRIBUTE};
+attribute vec2 ${BLEND_THIRD_ATTRIBUTE};
 #else
 attribute float ${SECTION_ATTRIBUTE};
 #endif
@@ -64,7 +65,8 @@ const BASE = /* glsl */ `
 	{
 		#ifdef GCS_SMOOTH
 		vec4 a0, a1, a2, b0, b1, b2;
-		gcsRows( int( ${BLEND_ATTRIBUTE}.x + 0.5 ), a0, a1, a2 );
+		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sc = int( ${BLEND_THIRD_ATTRIBUTE}.x + 0.5 );
+		gcsRows( sa, a0, a1, a2 );
 		gcsRows( int( ${BLEND_ATTRIBUTE}.y + 0.5 ), b0, b1, b2 );
 		float f = ${BLEND_ATTRIBUTE}.z;
 		gcsR0 = a0 + f * ( b0 - a0 ); gcsR1 = a1 + f * ( b1 - a1 ); gcsR2 = a2 + f * ( b2 - a2 );
@@ -72,6 +74,15 @@ const BASE = /* glsl */ `
 		gcsNormalRows( a0, a1, a2, true, p0, p1, p2 );
 		gcsNormalRows( b0, b1, b2, true, q0, q1, q2 );
 		gcsN0 = p0 + f * ( q0 - p0 ); gcsN1 = p1 + f * ( q1 - p1 ); gcsN2 = p2 + f * ( q2 - p2 );
+		if ( sc != sa ) {
+			// A three-joint lattice cell: + g·(C − A).
+			float g = ${BLEND_THIRD_ATTRIBUTE}.y;
+			vec4 c0, c1, c2;
+			gcsRows( sc, c0, c1, c2 );
+			gcsR0 += g * ( c0 - a0 ); gcsR1 += g * ( c1 - a1 ); gcsR2 += g * ( c2 - a2 );
+			gcsNormalRows( c0, c1, c2, true, q0, q1, q2 );
+			gcsN0 += g * ( q0 - p0 ); gcsN1 += g * ( q1 - p1 ); gcsN2 += g * ( q2 - p2 );
+		}
 		#else
 		gcsRows( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsR0, gcsR1, gcsR2 );
 		gcsNormalRows( gcsR0, gcsR1, gcsR2, false, gcsN0, gcsN1, gcsN2 );
@@ -207,6 +218,7 @@ const JOINT_BASE = /* glsl */ `
 	{
 		#ifdef GCS_SMOOTH
 		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sb = int( ${BLEND_ATTRIBUTE}.y + 0.5 );
+		int sc = int( ${BLEND_THIRD_ATTRIBUTE}.x + 0.5 );
 		gcsSectionBlend( sa, gcsM, gcsT, gcsN, gcsNormalise );
 		if ( sb != sa ) {
 			mat3 mb, nb; vec3 tb; bool rb;
@@ -214,12 +226,27 @@ const JOINT_BASE = /* glsl */ `
 			float f = ${BLEND_ATTRIBUTE}.z;
 			bool ra = gcsNormalise;
 			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
-			gcsNear = ! ra && ! rb && trace > ${f(NEAR_TRACE)};
-			gcsAlmostEqual = gcsNear && trace > ${f(ALMOST_EQUAL_TRACE)};
+			mat3 ma = gcsM, na = gcsN; vec3 ta = gcsT;
+			gcsM = ma + f * ( mb - ma );
+			gcsT = ta + f * ( tb - ta );
+			gcsN = na + f * ( nb - na );
+			if ( sc != sa ) {
+				// A three-joint lattice cell: + g·(C − A); the least pairwise trace decides the fix.
+				mat3 mc, nc; vec3 tc; bool rc;
+				gcsSectionBlend( sc, mc, tc, nc, rc );
+				float g = ${BLEND_THIRD_ATTRIBUTE}.y;
+				gcsM += g * ( mc - ma );
+				gcsT += g * ( tc - ta );
+				gcsN += g * ( nc - na );
+				trace = min( trace, min( dot( na[ 0 ], nc[ 0 ] ) + dot( na[ 1 ], nc[ 1 ] ) + dot( na[ 2 ], nc[ 2 ] ),
+					dot( nb[ 0 ], nc[ 0 ] ) + dot( nb[ 1 ], nc[ 1 ] ) + dot( nb[ 2 ], nc[ 2 ] ) ) );
+				gcsNear = ! ra && ! rb && ! rc && trace > ${f(NEAR_TRACE3)};
+				gcsAlmostEqual = gcsNear && trace > ${f(ALMOST_EQUAL_TRACE3)};
+			} else {
+				gcsNear = ! ra && ! rb && trace > ${f(NEAR_TRACE)};
+				gcsAlmostEqual = gcsNear && trace > ${f(ALMOST_EQUAL_TRACE)};
+			}
 			gcsNormalise = true;
-			gcsM = gcsM + f * ( mb - gcsM );
-			gcsT = gcsT + f * ( tb - gcsT );
-			gcsN = gcsN + f * ( nb - gcsN );
 		}
 		#else
 		gcsSectionBlend( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );

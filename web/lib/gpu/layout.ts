@@ -25,6 +25,11 @@ export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2;
 export const SECTION_ATTRIBUTE = 'gcsSection';
 /** Per-vertex attribute, smooth mode: (section, other section, factor towards the other). */
 export const BLEND_ATTRIBUTE = 'gcsBlend';
+/**
+ * Per-vertex attribute, smooth mode: (third section, factor towards it): a vertex of three joints
+ * blends its weight-lattice cell's three nodes, A + f·(B − A) + g·(C − A); others (own section, 0).
+ */
+export const BLEND_THIRD_ATTRIBUTE = 'gcsBlendThird';
 
 /** The CPU's test for "the scale part K is a positive uniform scale": every entry within this × s of s·I. */
 export const UNIFORM_SCALE_TOLERANCE = 1e-4;
@@ -40,5 +45,12 @@ export const NEAR_TRACE = 1 + 2 * 0.82;
  * leaves a blended normal's length as it is (short of 1 by at most (1 − cos θ)/4 < 3e-4).
  */
 export const ALMOST_EQUAL_TRACE = 1 + 2 * 0.9988;
+/**
+ * Smooth mode, three sections: the least of their three pairwise traces decides, over 1 + 2·0.9991
+ * (2.4°) no length fix, over 1 + 2·cos 25° the cubic, else exact normalisation (a convex blend of
+ * three unit vectors θ apart falls short of 1 by at most 1 − cos(θ/√3)).
+ */
+export const ALMOST_EQUAL_TRACE3 = 1 + 2 * 0.9991;
+export const NEAR_TRACE3 = 1 + 2 * 0.9063;
 /** The cubic length fix n·(1 + e·(a + b·e)), e = |n|² − 1: a ≈ −1/2, b ≈ 3/8 (1/√(1+e) to second order). */
 export const LENGTH_FIX = [-0.5, 0.375] as const;

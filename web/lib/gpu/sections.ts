@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
-import { BLEND_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath, type TableSlots } from './layout.js';
+import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath, type TableSlots } from './layout.js';
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
@@ -108,19 +108,32 @@ function floatTexture(data: Float32Array, width: number, height: number): THREE.
   return texture;
 }
 
+/** A static per-vertex attribute of the GPU backend's geometry. */
+export interface SectionAttribute {
+  name: typeof SECTION_ATTRIBUTE | typeof BLEND_ATTRIBUTE | typeof BLEND_THIRD_ATTRIBUTE;
+  attribute: THREE.BufferAttribute;
+}
+
 /**
- * Static per-vertex section data of a GCS deformer's output mesh: `gcsSection` (plain mode) or
- * `gcsBlend` = (section, other section, factor) (smooth mode), as float attributes.
+ * Static per-vertex section data of a GCS deformer's output mesh, as float attributes:
+ * `gcsSection` (plain mode), or `gcsBlend` = (section, other section, factor) and `gcsBlendThird`
+ * = (third section, factor) (smooth mode).
  */
-export function sectionAttributes(deformer: GcsDeformer): { name: typeof SECTION_ATTRIBUTE | typeof BLEND_ATTRIBUTE; attribute: THREE.BufferAttribute } {
+export function sectionAttributes(deformer: GcsDeformer): SectionAttribute[] {
   const section = deformer.sectionOfVertex();
   const other = deformer.blendOther(), factor = deformer.blendFactor();
-  if (!other || !factor) return { name: SECTION_ATTRIBUTE, attribute: new THREE.BufferAttribute(Float32Array.from(section), 1) };
-  const blend = new Float32Array(3 * section.length);
+  const third = deformer.blendThird(), thirdFactor = deformer.blendThirdFactor();
+  if (!other || !factor || !third || !thirdFactor) return [{ name: SECTION_ATTRIBUTE, attribute: new THREE.BufferAttribute(Float32Array.from(section), 1) }];
+  const blend = new Float32Array(3 * section.length), blendThird = new Float32Array(2 * section.length);
   for (let o = 0; o < section.length; o++) {
     blend[3 * o] = section[o];
     blend[3 * o + 1] = other[o];
     blend[3 * o + 2] = factor[o];
+    blendThird[2 * o] = third[o];
+    blendThird[2 * o + 1] = thirdFactor[o];
   }
-  return { name: BLEND_ATTRIBUTE, attribute: new THREE.BufferAttribute(blend, 3) };
+  return [
+    { name: BLEND_ATTRIBUTE, attribute: new THREE.BufferAttribute(blend, 3) },
+    { name: BLEND_THIRD_ATTRIBUTE, attribute: new THREE.BufferAttribute(blendThird, 2) },
+  ];
 }

@@ -11,8 +11,8 @@ import * as THREE from 'three';
 import * as TSL from 'three/tsl';
 import type { Node } from 'three/webgpu';
 import {
-  ALMOST_EQUAL_TRACE, BLEND_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE,
-  SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
+  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import type { GpuSections } from './sections.js';
 
@@ -21,7 +21,7 @@ import type { GpuSections } from './sections.js';
 // eslint-disable-next-line @typescript-eslint/no-explicit-any
 type N = any;
 const {
-  abs, attribute, cross, dot, float, Fn, instanceIndex, int, ivec2, length, max, normalGeometry, normalLocal, pow,
+  abs, attribute, cross, dot, float, Fn, instanceIndex, int, ivec2, length, max, min, normalGeometry, normalLocal, pow,
   positionGeometry, positionLocal, referenceAttribute, select, tangentGeometry, tangentLocal, texture, textureSize,
   transformNormal, uniform, vec3, vec4,
 } = TSL as N;
@@ -33,7 +33,9 @@ const mulMM = (a: M3, b: M3): M3 => [mulMV(a, b[0]), mulMV(a, b[1]), mulMV(a, b[
 const transpose = (m: M3): M3 => [vec3(m[0].x, m[1].x, m[2].x), vec3(m[0].y, m[1].y, m[2].y), vec3(m[0].z, m[1].z, m[2].z)];
 const scale = (m: M3, s: N): M3 => [m[0].mul(s), m[1].mul(s), m[2].mul(s)];
 const add = (a: M3, b: M3): M3 => [a[0].add(b[0]), a[1].add(b[1]), a[2].add(b[2])];
-const lerp = (a: M3, b: M3, f: N): M3 => [a[0].add(b[0].sub(a[0]).mul(f)), a[1].add(b[1].sub(a[1]).mul(f)), a[2].add(b[2].sub(a[2]).mul(f))];
+/** a + f·(b − a) + g·(c − a), column by column (a lattice cell's three nodes; g = 0 and c = a: a lerp). */
+const blend3 = (a: M3, b: M3, c: M3, f: N, g: N): M3 => [0, 1, 2].map((i) => a[i].add(b[i].sub(a[i]).mul(f)).add(c[i].sub(a[i]).mul(g))) as M3;
+const trace = (a: M3, b: M3): N => dot(a[0], b[0]).add(dot(a[1], b[1])).add(dot(a[2], b[2]));
 const pick = (c: N, a: M3, b: M3): M3 => [select(c, a[0], b[0]), select(c, a[1], b[1]), select(c, a[2], b[2])];
 const toVar = (m: M3): M3 => [m[0].toVar(), m[1].toVar(), m[2].toVar()];
 const largest = (m: M3): N => { const e = max(max(abs(m[0]), abs(m[1])), abs(m[2])); return max(max(e.x, e.y), e.z); };
@@ -149,18 +151,20 @@ interface VertexTransform { position(p: N): N; turn(v: N): N }
 function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
   let m: M3, t: N, n: M3, near: N, almostEqual: N, normalise: N;
   if (smooth) {
-    const blend = attribute(BLEND_ATTRIBUTE, 'vec3');
-    const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar();
-    const a = sectionBlend(inputs, sa), b = sectionBlend(inputs, sb);
-    const f = blend.z;
-    const same = sa.equal(sb);
-    const trace = dot(a.n[0], b.n[0]).add(dot(a.n[1], b.n[1])).add(dot(a.n[2], b.n[2]));
-    const bothRotations = a.renorm.lessThan(0.5).and(b.renorm.lessThan(0.5));
-    m = toVar(pick(same, a.m, lerp(a.m, b.m, f)));
-    t = select(same, a.t, a.t.add(b.t.sub(a.t).mul(f))).toVar();
-    n = toVar(pick(same, a.n, lerp(a.n, b.n, f)));
-    near = same.not().and(bothRotations).and(trace.greaterThan(NEAR_TRACE)).toVar();
-    almostEqual = near.and(trace.greaterThan(ALMOST_EQUAL_TRACE)).toVar();
+    const blend = attribute(BLEND_ATTRIBUTE, 'vec3'), third = attribute(BLEND_THIRD_ATTRIBUTE, 'vec2');
+    const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar(), sc = int(third.x.add(0.5)).toVar();
+    // A third section (a three-joint lattice cell) is blended in by g; without one, c is a and g is 0.
+    const a = sectionBlend(inputs, sa), b = sectionBlend(inputs, sb), c = sectionBlend(inputs, sc);
+    const f = blend.z, g = third.y;
+    const same = sa.equal(sb), three = sc.notEqual(sa);
+    const traceAB = trace(a.n, b.n).toVar();
+    const least = min(traceAB, min(trace(a.n, c.n), trace(b.n, c.n)));
+    const rotations = a.renorm.lessThan(0.5).and(b.renorm.lessThan(0.5)).and(three.not().or(c.renorm.lessThan(0.5)));
+    m = toVar(pick(same, a.m, blend3(a.m, b.m, c.m, f, g)));
+    t = select(same, a.t, a.t.add(b.t.sub(a.t).mul(f)).add(c.t.sub(a.t).mul(g))).toVar();
+    n = toVar(pick(same, a.n, blend3(a.n, b.n, c.n, f, g)));
+    near = same.not().and(rotations).and(select(three, least.greaterThan(NEAR_TRACE3), traceAB.greaterThan(NEAR_TRACE))).toVar();
+    almostEqual = near.and(select(three, least.greaterThan(ALMOST_EQUAL_TRACE3), traceAB.greaterThan(ALMOST_EQUAL_TRACE))).toVar();
     normalise = same.not().or(a.renorm.greaterThan(0.5)).toVar();
   } else {
     const a = sectionBlend(inputs, int(attribute(SECTION_ATTRIBUTE, 'float').add(0.5)));
@@ -202,11 +206,11 @@ function sectionVertex(sections: N, first: N, smooth: boolean): VertexTransform 
   };
   let r: [N, N, N], n: M3;
   if (smooth) {
-    const blend = attribute(BLEND_ATTRIBUTE, 'vec3');
-    const a = rows(int(blend.x.add(0.5))), b = rows(int(blend.y.add(0.5)));
-    const f = blend.z;
-    r = [a[0].add(b[0].sub(a[0]).mul(f)), a[1].add(b[1].sub(a[1]).mul(f)), a[2].add(b[2].sub(a[2]).mul(f))];
-    n = toVar(lerp(normalRows(a, true), normalRows(b, true), f));
+    const blend = attribute(BLEND_ATTRIBUTE, 'vec3'), third = attribute(BLEND_THIRD_ATTRIBUTE, 'vec2');
+    const a = rows(int(blend.x.add(0.5))), b = rows(int(blend.y.add(0.5))), c = rows(int(third.x.add(0.5)));
+    const f = blend.z, g = third.y;
+    r = [0, 1, 2].map((i) => a[i].add(b[i].sub(a[i]).mul(f)).add(c[i].sub(a[i]).mul(g))) as [N, N, N];
+    n = toVar(blend3(normalRows(a, true), normalRows(b, true), normalRows(c, true), f, g));
   } else {
     r = rows(int(attribute(SECTION_ATTRIBUTE, 'float').add(0.5)));
     n = normalRows(r, false);

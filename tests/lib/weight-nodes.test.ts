@@ -1,0 +1,117 @@
+// The default GCS's nodes in weight space (wasm/src/gcs_model.cpp, buildWeightNodes): each vertex's
+// blend of its nodes reproduces its own skin weights. Two-joint vertices blend two nodes on a ray
+// from a rigid core; three-joint vertices the three corners of their weight-lattice cell. A wrong
+// corner or barycentric factor, or a cell of the wrong triangulation, shows as a weight mismatch;
+// corners shared across a cell edge make the result continuous in the weights.
+import { beforeAll, describe, expect, test } from 'vitest';
+import { initGcsSkin, type GcsDeformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
+import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
+import { createHuman } from '../../web/lib/human/index.js';
+import { loadGlb, sharedModels } from '../helpers/models.js';
+
+let gcs: GcsSkin;
+beforeAll(async () => {
+  gcs = await initGcsSkin();
+});
+
+/** A vertex's weights as the builder reads them: under 0.5 % dropped (but the largest), the same joint merged, summing to 1. */
+function cleanWeights(input: RigInput, v: number): Map<number, number> {
+  const slots = input.influences ?? 4;
+  const raw = new Map<number, number>();
+  for (let i = 0; i < slots; i++) {
+    const w = input.weights[slots * v + i];
+    if (w > 0) raw.set(input.joints[slots * v + i], (raw.get(input.joints[slots * v + i]) ?? 0) + w);
+  }
+  const biggest = Math.max(...raw.values());
+  const kept = [...raw].filter(([, w]) => w >= Math.fround(0.005) || w === biggest);  // the builder compares in float32
+  const sum = kept.reduce((s, [, w]) => s + w, 0);
+  return new Map(kept.map(([j, w]) => [j, w / sum]));
+}
+
+/** Section s's blend weights from the joint-level table. */
+function nodeWeights(table: Float32Array, slots: number, s: number): Map<number, number> {
+  const out = new Map<number, number>();
+  for (let k = 0; k < slots; k++) {
+    const texels = 2 * slots * s + 8 * (k >> 2);
+    const joint = table[texels + (k & 3)];
+    if (joint < 0) break;
+    out.set(joint, table[texels + 4 + (k & 3)]);
+  }
+  return out;
+}
+
+interface Reproduction { byJoints: Map<number, { vertices: number; worst: number }>; cells: number; nodes: number }
+
+/** The vertices at each rest position: the builder welds them (a UV seam never opens) and reads one's weights. */
+function weldedGroups(input: RigInput): Map<string, number[]> {
+  const groups = new Map<string, number[]>();
+  for (let v = 0; v < input.positions.length / 3; v++) {
+    const key = `${input.positions[3 * v]},${input.positions[3 * v + 1]},${input.positions[3 * v + 2]}`;
+    const group = groups.get(key);
+    if (group) group.push(v);
+    else groups.set(key, [v]);
+  }
+  return groups;
+}
+
+/** For every output vertex: |Σ factor · node weights − the weights of a vertex it is welded to|, worst per joint count. */
+function reproduce(input: RigInput, d: GcsDeformer): Reproduction {
+  const groups = weldedGroups(input);
+  const table = d.sectionInfluences()!, slots = d.sectionInfluenceSlots;
+  const section = d.sectionOfVertex(), source = d.sourceVertex!;
+  const other = d.blendOther()!, f = d.blendFactor()!, third = d.blendThird()!, g = d.blendThirdFactor()!;
+  const byJoints = new Map<number, { vertices: number; worst: number }>();
+  const cells = new Set<string>();
+  for (let o = 0; o < d.vertexCount; o++) {
+    const blended = new Map<number, number>();
+    const parts: [number, number][] = [[section[o], 1 - f[o] - g[o]], [other[o], f[o]], [third[o], g[o]]];
+    for (const [s, factor] of parts)
+      for (const [j, w] of nodeWeights(table, slots, s)) blended.set(j, (blended.get(j) ?? 0) + factor * w);
+    const v = source[o];
+    const welded = groups.get(`${input.positions[3 * v]},${input.positions[3 * v + 1]},${input.positions[3 * v + 2]}`)!;
+    let own = cleanWeights(input, v), worst = Infinity;
+    for (const u of welded) {
+      const w = cleanWeights(input, u);
+      let e = 0;
+      for (const j of new Set([...w.keys(), ...blended.keys()])) e = Math.max(e, Math.abs((w.get(j) ?? 0) - (blended.get(j) ?? 0)));
+      if (e < worst) worst = e, own = w;
+    }
+    const entry = byJoints.get(own.size) ?? { vertices: 0, worst: 0 };
+    entry.vertices++;
+    entry.worst = Math.max(entry.worst, worst);
+    byJoints.set(own.size, entry);
+    if (third[o] !== section[o]) cells.add(`${section[o]},${other[o]},${third[o]}`);
+  }
+  return { byJoints, cells: cells.size, nodes: d.sectionCount };
+}
+
+function check(name: string, input: RigInput): void {
+  const rig = gcs.createRig(input);
+  const d = rig.buildGcs({});
+  const r = reproduce(input, d);
+  const summary = [...r.byJoints].sort(([a], [b]) => a - b).map(([n, e]) => `${n} joints: ${e.vertices} vertices, worst ${e.worst.toExponential(1)}`);
+  console.log(`${name}: ${r.nodes} nodes, ${r.cells} three-node cells; ${summary.join('; ')}`);
+  // One, two and three joints: the blend is exactly the vertex's weights (float rounding only).
+  for (const n of [1, 2, 3]) if (r.byJoints.has(n)) expect(r.byJoints.get(n)!.worst).toBeLessThan(2e-6);
+  // Four or more: the shape of the small weights is kept to 1/(8Q) = 1/64 of weight at the default.
+  for (const [n, e] of r.byJoints) if (n > 3) expect(e.worst).toBeLessThanOrEqual(1 / 64 + 1e-6);
+  if ((r.byJoints.get(3)?.vertices ?? 0) > 0) expect(r.cells).toBeGreaterThan(0);
+  d.dispose();
+  rig.dispose();
+}
+
+describe('the default nodes reproduce every vertex\'s skin weights', () => {
+  test('our human (1,469 three-joint vertices)', () => {
+    const human = createHuman();
+    check('human', rigInputFromSkinnedMesh(human.mesh));
+  });
+
+  const { files, reason } = sharedModels();
+  if (reason) console.log(reason);
+  for (const file of files) {
+    test(`${file.split('/').pop()}: every skinned mesh`, async () => {
+      const model = await loadGlb(file);
+      for (const mesh of model.skinnedMeshes) check(`${file.split('/').pop()} ${mesh.name}`, rigInputFromSkinnedMesh(mesh));
+    });
+  }
+});
