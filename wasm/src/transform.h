@@ -462,9 +462,39 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 #endif
 }
 
+#if defined(__wasm_simd128__)
+// Stores a blended normal v of a uniform frame (v = s × a blend of rotations) with its length
+// restored as Fix says: times 1/s (None); times 1/|v| for |v|² near s², invS·(1 − e/2 + 3e²/8) with
+// e = |v|²/s² − 1, as a polynomial in |v|² (Cubic: three constants, so that a kernel's live values
+// fit the registers); or normalised exactly (a vanished one keeps its rest direction).
+template <NormalFix Fix>
+struct UniformNormalStore {
+  v128_t p0, p1, p2;
+  explicit UniformNormalStore(float invS) {
+    const float k = invS * invS;
+    p0 = wasm_f32x4_splat(Fix == NormalFix::Cubic ? 1.875f * invS : invS);
+    p1 = wasm_f32x4_splat(-1.25f * invS * k);
+    p2 = wasm_f32x4_splat(0.375f * invS * k * k);
+  }
+  void operator()(float* out, v128_t v, const float* rest) const {
+    if (Fix == NormalFix::None) {
+      wasm_v128_store(out, wasm_f32x4_mul(v, p0));
+    } else if (Fix == NormalFix::Cubic) {
+      v128_t sq = wasm_f32x4_mul(v, v);
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
+      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
+      wasm_v128_store(out, wasm_f32x4_mul(v, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
+    } else {
+      wasm_v128_store(out, normalise3(v));
+      keepUnit(out, rest);
+    }
+  }
+};
+#endif
+
 // Smooth mode when every joint's scale is the same uniform s (the common case: then a section's
 // normal matrix is its position matrix's 3×3 divided by s): one lerp of the position matrices serves
-// the normals too. The cubic fix is 1/|v| as a polynomial in |v|² with the 1/s folded in: eleven
+// the normals too (stored by UniformNormalStore: the cubic fix has the 1/s folded in): eleven
 // loop constants (8 matrix columns, 3 coefficients) instead of blendRunT's 18, so no spills. Same
 // results as blendRunT on the normal matrices up to rounding.
 template <NormalFix Fix>
@@ -475,11 +505,7 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
   const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
   const v128_t d0 = wasm_f32x4_sub(wasm_v128_load(&pb[0][0]), a0), d1 = wasm_f32x4_sub(wasm_v128_load(&pb[1][0]), a1);
   const v128_t d2 = wasm_f32x4_sub(wasm_v128_load(&pb[2][0]), a2), d3 = wasm_f32x4_sub(wasm_v128_load(&pb[3][0]), a3);
-  // 1/|v| for |v|² = x near s²: invS·(1 − e/2 + 3e²/8), e = x/s² − 1, as a polynomial in x (three
-  // constants, so that the loop's live values fit the registers).
-  const float k = invS * invS;
-  const v128_t p0 = wasm_f32x4_splat(Fix == NormalFix::Cubic ? 1.875f * invS : invS);
-  const v128_t p1 = wasm_f32x4_splat(-1.25f * invS * k), p2 = wasm_f32x4_splat(0.375f * invS * k * k);
+  const UniformNormalStore<Fix> storeNormal(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i);
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
@@ -490,18 +516,7 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
                                                     wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
                                      wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3)), inPos + 3 * i));
-    if (Fix == NormalFix::None) {
-      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, p0));
-    } else if (Fix == NormalFix::Cubic) {
-      v128_t sq = wasm_f32x4_mul(rn, rn);
-      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
-      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
-      wasm_v128_store(outNrm + 3 * i,
-                      wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
-    } else {
-      wasm_v128_store(outNrm + 3 * i, normalise3(rn));
-      keepUnit(outNrm + 3 * i, n);
-    }
+    storeNormal(outNrm + 3 * i, rn, n);
   }
 #else
   // Without SIMD: the general kernel, with the normal matrices the position matrices over s.
@@ -546,10 +561,7 @@ inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const gl
     d[c] = wasm_f32x4_sub(wasm_v128_load(&pb[c][0]), a[c]);
     e[c] = wasm_f32x4_sub(wasm_v128_load(&pc[c][0]), a[c]);
   }
-  // As in blendRunUniformT: 1/|v| as a polynomial in |v|² with the 1/s folded in.
-  const float k2 = invS * invS;
-  const v128_t p0 = wasm_f32x4_splat(Fix == NormalFix::Cubic ? 1.875f * invS : invS);
-  const v128_t p1 = wasm_f32x4_splat(-1.25f * invS * k2), p2 = wasm_f32x4_splat(0.375f * invS * k2 * k2);
+  const UniformNormalStore<Fix> storeNormal(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i), u = wasm_v128_load32_splat(g + i);
     v128_t c[4];
@@ -559,18 +571,7 @@ inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const gl
                                                     wasm_f32x4_mul(c[1], wasm_v128_load32_splat(n + 1))),
                                      wasm_f32x4_mul(c[2], wasm_v128_load32_splat(n + 2)));
     wasm_v128_store(outPos + 3 * i, affine(c[0], c[1], c[2], c[3], inPos + 3 * i));
-    if (Fix == NormalFix::None) {
-      wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, p0));
-    } else if (Fix == NormalFix::Cubic) {
-      v128_t sq = wasm_f32x4_mul(rn, rn);
-      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
-      sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 2, 3, 0, 1));
-      wasm_v128_store(outNrm + 3 * i,
-                      wasm_f32x4_mul(rn, wasm_f32x4_add(p0, wasm_f32x4_mul(sq, wasm_f32x4_add(p1, wasm_f32x4_mul(p2, sq))))));
-    } else {
-      wasm_v128_store(outNrm + 3 * i, normalise3(rn));
-      keepUnit(outNrm + 3 * i, n);
-    }
+    storeNormal(outNrm + 3 * i, rn, n);
   }
 #else
   blendRun3(pa, invS * pa, pb, invS * pb, pc, invS * pc, Fix, f, g, inPos, inNrm, outPos, outNrm, count);
