@@ -1093,7 +1093,10 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
                                         rotationTrace(sectionMatrices[a], sectionMatrices[c]),
                                         rotationTrace(sectionMatrices[b], sectionMatrices[c])}) * invS2;
           const NormalFix fix3 = rotationBlendFix3(least);
-          if (fix3 == NormalFix::None)
+          if (fix3 == NormalFix::None && invS == 1.0f)
+            blendRun3UniformT<NormalFix::None, true>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f,
+                                                     g, p, n, &positions[o], &normals[o], run.count);
+          else if (fix3 == NormalFix::None)
             blendRun3UniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p,
                                                n, &positions[o], &normals[o], run.count);
           else if (fix3 == NormalFix::Cubic)
@@ -1109,7 +1112,10 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
           continue;
         }
         const NormalFix fix = rotationBlendFix(rotationTrace(sectionMatrices[a], sectionMatrices[b]) * invS2);
-        if (fix == NormalFix::None)
+        if (fix == NormalFix::None && invS == 1.0f)
+          blendRunUniformT<NormalFix::None, true>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
+                                                  &normals[o], run.count);
+        else if (fix == NormalFix::None)
           blendRunUniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
                                             &normals[o], run.count);
         else if (fix == NormalFix::Cubic)

@@ -476,8 +476,9 @@ inline void blendRunT(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 // Stores a blended normal v of a uniform frame (v = s × a blend of rotations) with its length
 // restored as Fix says: times 1/s (None); times 1/|v| for |v|² near s², invS·(1 − e/2 + 3e²/8) with
 // e = |v|²/s² − 1, as a polynomial in |v|² (Cubic: three constants, so that a kernel's live values
-// fit the registers); or normalised exactly (a vanished one keeps its rest direction).
-template <NormalFix Fix>
+// fit the registers); or normalised exactly (a vanished one keeps its rest direction). UnitScale:
+// s is exactly 1 (rigs in metres), so None stores v as it is.
+template <NormalFix Fix, bool UnitScale = false>
 struct UniformNormalStore {
   v128_t p0, p1, p2;
   explicit UniformNormalStore(float invS) {
@@ -488,7 +489,7 @@ struct UniformNormalStore {
   }
   void operator()(float* out, v128_t v, const float* rest) const {
     if (Fix == NormalFix::None) {
-      wasm_v128_store(out, wasm_f32x4_mul(v, p0));
+      wasm_v128_store(out, UnitScale ? v : wasm_f32x4_mul(v, p0));
     } else if (Fix == NormalFix::Cubic) {
       v128_t sq = wasm_f32x4_mul(v, v);
       sq = wasm_f32x4_add(sq, wasm_i32x4_shuffle(sq, sq, 1, 0, 3, 2));
@@ -507,7 +508,7 @@ struct UniformNormalStore {
 // the normals too (stored by UniformNormalStore: the cubic fix has the 1/s folded in): eleven
 // loop constants (8 matrix columns, 3 coefficients) instead of blendRunT's 18, so no spills. Same
 // results as blendRunT on the normal matrices up to rounding.
-template <NormalFix Fix>
+template <NormalFix Fix, bool UnitScale = false>
 inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float invS, const float* f, const float* inPos,
                              const float* inNrm, float* outPos, float* outNrm, uint32_t count) {
 #if defined(__wasm_simd128__)
@@ -515,7 +516,7 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
   const v128_t a2 = wasm_v128_load(&pa[2][0]), a3 = wasm_v128_load(&pa[3][0]);
   const v128_t d0 = wasm_f32x4_sub(wasm_v128_load(&pb[0][0]), a0), d1 = wasm_f32x4_sub(wasm_v128_load(&pb[1][0]), a1);
   const v128_t d2 = wasm_f32x4_sub(wasm_v128_load(&pb[2][0]), a2), d3 = wasm_f32x4_sub(wasm_v128_load(&pb[3][0]), a3);
-  const UniformNormalStore<Fix> storeNormal(invS);
+  const UniformNormalStore<Fix, UnitScale> storeNormal(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i);
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
@@ -560,7 +561,7 @@ inline void blendRun3(const glm::mat4& pa, const glm::mat4& na, const glm::mat4&
 // Smooth mode, a run of vertices that blend three transforms A, B, C (a three-joint lattice cell)
 // when every scale is the same uniform s: vertex i takes A + f[i]·(B − A) + g[i]·(C − A) for its
 // position and, over s, its normal, whose length is restored as Fix says (rotationBlendFix3).
-template <NormalFix Fix>
+template <NormalFix Fix, bool UnitScale = false>
 inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const glm::mat4& pc, float invS,
                               const float* f, const float* g, const float* inPos, const float* inNrm, float* outPos,
                               float* outNrm, uint32_t count) {
@@ -571,7 +572,7 @@ inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const gl
     d[c] = wasm_f32x4_sub(wasm_v128_load(&pb[c][0]), a[c]);
     e[c] = wasm_f32x4_sub(wasm_v128_load(&pc[c][0]), a[c]);
   }
-  const UniformNormalStore<Fix> storeNormal(invS);
+  const UniformNormalStore<Fix, UnitScale> storeNormal(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const v128_t t = wasm_v128_load32_splat(f + i), u = wasm_v128_load32_splat(g + i);
     v128_t c[4];
