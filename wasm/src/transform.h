@@ -301,7 +301,7 @@ inline v128_t normalise3(v128_t v) {
   return wasm_f32x4_div(v, wasm_f32x4_sqrt(wasm_f32x4_max(sum, wasm_f32x4_splat(1e-30f))));
 }
 // v (4th lane 0) scaled to unit length when it is already near unit (a blend of rotations less than
-// 35° apart): 1/sqrt(1 + e) ≈ 1 − e/2 + 3e²/8 with e = |v|² − 1 (error < 3e-4 there), no square root
+// 35° apart): 1/sqrt(1 + e) ≈ 1 − e/2 + 3e²/8 with e = |v|² − 1 (error ≤ 3e-4 there), no square root
 // or division. The constants are passed in so that loops keep them in registers.
 inline v128_t nearUnit(v128_t v, v128_t one, v128_t minusHalf, v128_t threeEighths) {
   v128_t sq = wasm_f32x4_mul(v, v);
@@ -381,9 +381,9 @@ inline void transformRunUniform(const glm::mat4& m, float invS, const float* inP
 }
 
 // How a blended normal's length is restored: exactly (sqrt and division), by a cubic approximation
-// of 1/sqrt around 1 (both normal matrices rotations less than 35° apart: error < 3e-4), or not at
+// of 1/sqrt around 1 (both normal matrices rotations less than 35° apart: error ≤ 3e-4), or not at
 // all (rotations less than 2.8° apart: the blend's length falls short of 1 by at most
-// (1 − cos θ)/4 < 3e-4, the cubic's own bound, so the fix would change nothing visible).
+// (1 − cos θ)/4 ≤ 3e-4, the cubic's own bound, so the fix would change nothing visible).
 enum class NormalFix { Exact, Cubic, None };
 
 constexpr float kNearTrace = 1.0f + 2.0f * 0.82f;            // trace of Ra^T Rb = 1 + 2 cos θ: θ < 35°

@@ -42,7 +42,7 @@ export const COLLAPSED = 1e-30;
 export const NEAR_TRACE = 1 + 2 * 0.82;
 /**
  * Smooth mode: rotations "almost equal" (less than 2.8° apart: trace above 1 + 2·0.9988): the CPU
- * leaves a blended normal's length as it is (short of 1 by at most (1 − cos θ)/4 < 3e-4).
+ * leaves a blended normal's length as it is (short of 1 by at most (1 − cos θ)/4 ≤ 3e-4).
  */
 export const ALMOST_EQUAL_TRACE = 1 + 2 * 0.9988;
 /**
