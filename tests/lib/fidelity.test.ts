@@ -12,6 +12,7 @@ import { characterHeight, sampleClip } from '../../web/lib/cli/gltf-node.js';
 import { FidelityProbe, type Fidelity } from '../../web/lib/measure.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
+import { scaledSkin } from '../helpers/skins.js';
 
 const { files, reason } = sharedModels();
 if (reason) console.log(`fidelity.test: ${reason}`);
@@ -240,6 +241,30 @@ describe('default GCS on the default human and on scaled rigs', () => {
 });
 
 describe('finite output for finite input (every method)', () => {
+  test('the whole human scaled ×1e-20 … ×1e20 (uniform frames, blends of two and three nodes): finite, unit normals', () => {
+    // The default's fast path for uniform frames works on s·R matrices (traces over s², the normal
+    // fix's 1/s⁵); outside [1e-6, 1e6] it must hand over to the general path, not overflow.
+    const human = createHuman();
+    const input = rigInputFromSkinnedMesh(human.mesh);
+    const rig = gcs.createRig(input);
+    const d = rig.buildGcs();
+    const frame = sampleClip(human.mesh, human.clips.find((c) => c.name === 'run')!, 5)[2];
+    const report: string[] = [];
+    for (const s of [1e-20, 1e-7, 1e-5, 1, 1e5, 1e7, 1e20]) {
+      d.deform(scaledSkin(frame, s, s, s));
+      const p = d.positions, n = d.normals;
+      let bad = 0, worstNormal = 0;
+      for (let i = 0; i < p.length; i++) if (!Number.isFinite(p[i]) || !Number.isFinite(n[i])) bad++;
+      for (let o = 0; o < d.vertexCount; o++) worstNormal = Math.max(worstNormal, Math.abs(Math.hypot(n[3 * o], n[3 * o + 1], n[3 * o + 2]) - 1));
+      report.push(`×${s}: normals off unit ${worstNormal.toExponential(1)}`);
+      expect(bad, `scale ${s}`).toBe(0);
+      expect(worstNormal, `scale ${s}`).toBeLessThan(NORMAL_TOLERANCE);
+    }
+    console.log(`human scaled uniformly: ${report.join(', ')}`);
+    d.dispose();
+    rig.dispose();
+  });
+
   test('bones scaled by 0, 1e-30, 1e-8, 1e8 and 1e20, and mirrored: no NaN or infinity, unit normals', () => {
     const tube = makeTube({ band: 0.3 });
     const rig = gcs.createRig(tube.input);

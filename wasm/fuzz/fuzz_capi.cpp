@@ -712,9 +712,10 @@ void checkStructure(Built& b, const RigInput& in) {
           "GCS introspection on LBS/DQS");
   }
   if (b.kind == GCS_KIND_GCS) {
-    // Smooth weights nodes: up to two per welded vertex, and a node only blended towards holds none.
+    // Smooth weights nodes: up to three per welded vertex (a three-joint vertex's lattice cell), and a
+    // node only blended towards holds none.
     const bool nodes = b.c == GCS_CRITERION_WEIGHTS && b.smooth != 0;
-    CHECK(statSections >= 1.0f && statSections <= float(nodes ? 2 * N : N) && statSections == std::floor(statSections),
+    CHECK(statSections >= 1.0f && statSections <= float(nodes ? 3 * N : N) && statSections == std::floor(statSections),
           "section count %g (vertices %u)", double(statSections), N);
     CHECK(statParts >= 1.0f && statParts <= float(in.jointCount) && statParts == std::floor(statParts), "part count %g",
           double(statParts));
@@ -981,12 +982,22 @@ void checkGpuSections(const Built& b, const RigInput& in, const Frame& fr) {
   checkJointPoses(b, in, skins);
   const uint32_t* other = gcs_gcs_blend_other(d);
   const float* factor = gcs_gcs_blend_factor(d);
-  CHECK((other != nullptr) == (b.smooth != 0) && (factor != nullptr) == (b.smooth != 0), "blend data present %d, smooth %d",
-        other != nullptr, b.smooth);
+  const uint32_t* third = gcs_gcs_blend_third(d);
+  const uint32_t* sov = gcs_gcs_section_of_vertex(d);
+  const float* thirdFactor = gcs_gcs_blend_third_factor(d);
+  CHECK((other != nullptr) == (b.smooth != 0) && (factor != nullptr) == (b.smooth != 0) &&
+            (third != nullptr) == (b.smooth != 0) && (thirdFactor != nullptr) == (b.smooth != 0),
+        "blend data present %d, smooth %d", other != nullptr, b.smooth);
   if (other)
     for (uint32_t o = 0; o < b.vertexCount; ++o) {
       CHECK(other[o] < S, "output vertex %u blends with section %u of %u", o, other[o], S);
       CHECK(factor[o] >= 0.0f && factor[o] <= 1.0f, "output vertex %u blend factor %g", o, double(factor[o]));
+      CHECK(third[o] < S, "output vertex %u blends with a third section %u of %u", o, third[o], S);
+      CHECK(thirdFactor[o] >= 0.0f && factor[o] + thirdFactor[o] <= 1.0f + 1e-6f, "output vertex %u factors %g and %g", o,
+            double(factor[o]), double(thirdFactor[o]));
+      // A third section exists only with a second (a lattice cell); without one its factor is 0.
+      CHECK(third[o] != sov[o] ? other[o] != sov[o] : thirdFactor[o] == 0.0f, "output vertex %u: third section %u, factor %g",
+            o, third[o], double(thirdFactor[o]));
     }
 }
 

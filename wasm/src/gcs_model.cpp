@@ -850,7 +850,7 @@ glm::mat4 rigidInverse(const glm::mat4& m) {
 // mean weights (a rigid core: S_j itself). O(sections × influences).
 void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale) {
 #if defined(__wasm_simd128__)
-  if (scale.uniform) return sectionTransformsWeightsUniform(skin, scale.s);
+  if (moderateUniform(scale)) return sectionTransformsWeightsUniform(skin, scale.s);
 #endif
   const uint32_t S = uint32_t(sections.size());
   for (uint32_t i = 0; i < S; ++i) {
@@ -1076,7 +1076,7 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
   // Every scale the same uniform s (and the weights criterion, whose normal matrices are then the
   // rotations of the position matrices, and are not written for blended sections): one matrix, or
   // one lerp, serves positions and normals.
-  const bool uniform = frameScale.uniform && settings.criterion == GCS_CRITERION_WEIGHTS && frameScale.s > 0.0f;
+  const bool uniform = moderateUniform(frameScale) && settings.criterion == GCS_CRITERION_WEIGHTS;
   const float invS = uniform ? 1.0f / frameScale.s : 1.0f, invS2 = invS * invS;
   if (settings.smooth) {
     for (const BlendRun& run : blendRuns) {

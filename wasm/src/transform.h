@@ -176,6 +176,11 @@ inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose*
   return st;
 }
 
+// True when every scale is the same s·I with s in [1e-6, 1e6]: the fast uniform path (normal
+// matrices as position matrices over s, rotation traces over s², the cubic's 1/s⁵) stays within
+// float range there; ×1e20 or ×1e-20 rigs take the general path.
+inline bool moderateUniform(const ScaleState& st) { return st.uniform && st.s >= 1e-6f && st.s <= 1e6f; }
+
 // The blend of joint poses with weights w_i (Σ w_i = 1), as dual-quaternion skinning does it:
 // rotation and translation by the normalised linear blend of the dual quaternions (each taken in
 // the hemisphere of the first), scale/shear by the linear blend of the K_i, applied first.
