@@ -363,10 +363,13 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
 
 // The cell of the weight lattice (steps of 1/Q) holding three weights that sum to 1: with partial
 // sums z1 = Q·w0, z2 = Q·(w0 + w1), the Kuhn triangle of the unit square of (z1, z2) around them.
-// Calls cell(x, mu): x[c] the c-th corner's weights in units of 1/Q (they sum to Q), mu[c] its
-// barycentric factor (they sum to 1; corner 0 is the square's lower corner).
-template <class Cell>
-void latticeCell(const uint32_t (&)[kMaxInfluences], const float (&weight)[kMaxInfluences], uint32_t Q, Cell cell) {
+// x[c]: the c-th corner's weights in units of 1/Q (they sum to Q); mu[c]: its barycentric factor
+// (they sum to 1; corner 0 is the square's lower corner).
+struct LatticeCell {
+  uint32_t x[3][3];
+  float mu[3];
+};
+LatticeCell latticeCell(const float (&weight)[kMaxInfluences], uint32_t Q) {
   const double z1 = double(weight[0]) * Q, z2 = (double(weight[0]) + double(weight[1])) * Q;
   const double f1 = std::floor(z1), f2 = std::min(std::floor(z2), double(Q) - 1.0);
   const double r1 = glm::clamp(z1 - f1, 0.0, 1.0), r2 = glm::clamp(z2 - f2, 0.0, 1.0);
@@ -374,10 +377,9 @@ void latticeCell(const uint32_t (&)[kMaxInfluences], const float (&weight)[kMaxI
   // Corners in (z1, z2): (b1, b2), then one step along the larger fraction first, then (b1+1, b2+1).
   const bool firstZ1 = r1 >= r2;
   const uint32_t zc[3][2] = {{b1, b2}, {firstZ1 ? b1 + 1 : b1, firstZ1 ? b2 : b2 + 1}, {b1 + 1, b2 + 1}};
-  const float mu[3] = {float(1.0 - std::max(r1, r2)), float(std::fabs(r1 - r2)), float(std::min(r1, r2))};
-  uint32_t x[3][3];
-  for (int c = 0; c < 3; ++c) x[c][0] = zc[c][0], x[c][1] = zc[c][1] - zc[c][0], x[c][2] = Q - zc[c][1];
-  cell(x, mu);
+  LatticeCell cell{{}, {float(1.0 - std::max(r1, r2)), float(std::fabs(r1 - r2)), float(std::min(r1, r2))}};
+  for (int c = 0; c < 3; ++c) cell.x[c][0] = zc[c][0], cell.x[c][1] = zc[c][1] - zc[c][0], cell.x[c][2] = Q - zc[c][1];
+  return cell;
 }
 
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
@@ -426,18 +428,17 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
       // One triangulation per joint triple: the joints in a fixed order (by index).
       for (uint32_t i = 1; i < 3; ++i)
         for (uint32_t k = i; k > 0 && joint[k] < joint[k - 1]; --k) std::swap(joint[k], joint[k - 1]), std::swap(weight[k], weight[k - 1]);
-      latticeCell(joint, weight, Q, [&](const uint32_t (&x)[3][3], const float (&mu)[3]) {
-        uint32_t ids[3];
-        for (int c = 0; c < 3; ++c) {
-          WeightKey key;
-          key.n = 3;
-          for (int i = 0; i < 3; ++i) key.joint[i] = joint[i], key.q[i] = 8 * x[c][i];
-          ids[c] = keyId(key);
-        }
-        lowKey[g] = ids[0], highKey[g] = ids[1], thirdKey[g] = ids[2];
-        blendOfGroup[g] = mu[1];
-        blendThirdOfGroup[g] = mu[2];
-      });
+      const LatticeCell cell = latticeCell(weight, Q);
+      uint32_t ids[3];
+      for (int c = 0; c < 3; ++c) {
+        WeightKey key;
+        key.n = 3;
+        for (int i = 0; i < 3; ++i) key.joint[i] = joint[i], key.q[i] = 8 * cell.x[c][i];
+        ids[c] = keyId(key);
+      }
+      lowKey[g] = ids[0], highKey[g] = ids[1], thirdKey[g] = ids[2];
+      blendOfGroup[g] = cell.mu[1];
+      blendThirdOfGroup[g] = cell.mu[2];
       continue;
     }
     uint32_t d = 0;
@@ -1089,22 +1090,13 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
         if (run.third != a) {  // a three-joint lattice cell
           const uint32_t c = run.third;
           const float* g = &blendThirdF[run.first];
-          const float least = std::min({rotationTrace(sectionMatrices[a], sectionMatrices[b]),
-                                        rotationTrace(sectionMatrices[a], sectionMatrices[c]),
-                                        rotationTrace(sectionMatrices[b], sectionMatrices[c])}) * invS2;
-          const NormalFix fix3 = rotationBlendFix3(least);
-          if (fix3 == NormalFix::None && invS == 1.0f)
-            blendRun3UniformT<NormalFix::None, true>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f,
-                                                     g, p, n, &positions[o], &normals[o], run.count);
-          else if (fix3 == NormalFix::None)
-            blendRun3UniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p,
-                                               n, &positions[o], &normals[o], run.count);
-          else if (fix3 == NormalFix::Cubic)
-            blendRun3UniformT<NormalFix::Cubic>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g,
-                                                p, n, &positions[o], &normals[o], run.count);
-          else
-            blendRun3UniformT<NormalFix::Exact>(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g,
-                                                p, n, &positions[o], &normals[o], run.count);
+          const NormalFix fix3 =
+              rotationBlendFix3(leastRotationTrace(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c]) * invS2);
+          withUniformFix(fix3, invS == 1.0f, [&](auto fixTag, auto unitTag) {
+            blendRun3UniformT<decltype(fixTag)::value, decltype(unitTag)::value>(
+                sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p, n, &positions[o], &normals[o],
+                run.count);
+          });
           continue;
         }
         if (a == b) {
@@ -1112,25 +1104,15 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
           continue;
         }
         const NormalFix fix = rotationBlendFix(rotationTrace(sectionMatrices[a], sectionMatrices[b]) * invS2);
-        if (fix == NormalFix::None && invS == 1.0f)
-          blendRunUniformT<NormalFix::None, true>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
-                                                  &normals[o], run.count);
-        else if (fix == NormalFix::None)
-          blendRunUniformT<NormalFix::None>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
-                                            &normals[o], run.count);
-        else if (fix == NormalFix::Cubic)
-          blendRunUniformT<NormalFix::Cubic>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
-                                             &normals[o], run.count);
-        else
-          blendRunUniformT<NormalFix::Exact>(sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o],
-                                             &normals[o], run.count);
+        withUniformFix(fix, invS == 1.0f, [&](auto fixTag, auto unitTag) {
+          blendRunUniformT<decltype(fixTag)::value, decltype(unitTag)::value>(
+              sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o], &normals[o], run.count);
+        });
       } else if (run.third != a) {
         const uint32_t c = run.third;
         const NormalFix fix = renormalise[a] || renormalise[b] || renormalise[c]
                                   ? NormalFix::Exact
-                                  : rotationBlendFix3(std::min({rotationTrace(normalMatrices[a], normalMatrices[b]),
-                                                                rotationTrace(normalMatrices[a], normalMatrices[c]),
-                                                                rotationTrace(normalMatrices[b], normalMatrices[c])}));
+                                  : rotationBlendFix3(leastRotationTrace(normalMatrices[a], normalMatrices[b], normalMatrices[c]));
         blendRun3(sectionMatrices[a], normalMatrices[a], sectionMatrices[b], normalMatrices[b], sectionMatrices[c],
                   normalMatrices[c], fix, &blendF[run.first], &blendThirdF[run.first], &restPositions[o],
                   &restNormals[o], &positions[o], &normals[o], run.count);

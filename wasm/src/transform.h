@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 #if defined(__wasm_simd128__)
@@ -292,6 +293,13 @@ inline v128_t affine(v128_t c0, v128_t c1, v128_t c2, v128_t c3, const float* p)
                                        wasm_f32x4_mul(c1, wasm_v128_load32_splat(p + 1))),
                         wasm_f32x4_add(wasm_f32x4_mul(c2, wasm_v128_load32_splat(p + 2)), c3));
 }
+// c0·n[0] + c1·n[1] + c2·n[2]: a normal turned by a 3×3 held in SIMD columns (their 4th lane 0 for
+// affine matrices, so the result's 4th lane is 0 too).
+inline v128_t linear3(v128_t c0, v128_t c1, v128_t c2, const float* n) {
+  return wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
+                                       wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
+                        wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
+}
 // v divided by the length of its xyz lanes (lane 4 must be 0, as normal matrices make it); a zero
 // vector stays zero. All in SIMD: no lane extraction. Divided by its largest component first, so
 // that tiny vectors (a normal through a 1e-20 scale) do not underflow when squared.
@@ -373,10 +381,7 @@ inline void transformRunUniform(const glm::mat4& m, float invS, const float* inP
   const v128_t s0 = wasm_f32x4_splat(invS);
   for (uint32_t i = 0; i < count; ++i) {
     const float* n = inNrm + 3 * i;
-    // The 4th lane of c0..c2 is 0 (affine matrices), so the normal's 4th lane stays 0.
-    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
-                                                    wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
-                                     wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
+    const v128_t rn = linear3(c0, c1, c2, n);
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, c3, inPos + 3 * i));  // lane 4 spills into the next vertex
     wasm_v128_store(outNrm + 3 * i, wasm_f32x4_mul(rn, s0));
   }
@@ -418,6 +423,11 @@ inline float rotationTrace(const glm::mat4& na, const glm::mat4& nb) {
   return glm::dot(glm::vec3(na[0]), glm::vec3(nb[0])) + glm::dot(glm::vec3(na[1]), glm::vec3(nb[1])) +
          glm::dot(glm::vec3(na[2]), glm::vec3(nb[2]));
 #endif
+}
+
+// The least pairwise trace of three normal matrices (a three-node blend's fix: rotationBlendFix3).
+inline float leastRotationTrace(const glm::mat4& na, const glm::mat4& nb, const glm::mat4& nc) {
+  return std::min({rotationTrace(na, nb), rotationTrace(na, nc), rotationTrace(nb, nc)});
 }
 
 // The fix for a blend of two normal matrices that are rotations (trace: rotationTrace).
@@ -527,10 +537,7 @@ inline void blendRunUniformT(const glm::mat4& pa, const glm::mat4& pb, float inv
     const v128_t c0 = wasm_f32x4_add(a0, wasm_f32x4_mul(t, d0)), c1 = wasm_f32x4_add(a1, wasm_f32x4_mul(t, d1));
     const v128_t c2 = wasm_f32x4_add(a2, wasm_f32x4_mul(t, d2));
     const float* n = inNrm + 3 * i;
-    // The 4th lane of c0..c2 is 0 (affine matrices), so the normal's 4th lane stays 0 for the sums below.
-    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c0, wasm_v128_load32_splat(n)),
-                                                    wasm_f32x4_mul(c1, wasm_v128_load32_splat(n + 1))),
-                                     wasm_f32x4_mul(c2, wasm_v128_load32_splat(n + 2)));
+    const v128_t rn = linear3(c0, c1, c2, n);
     wasm_v128_store(outPos + 3 * i, affine(c0, c1, c2, wasm_f32x4_add(a3, wasm_f32x4_mul(t, d3)), inPos + 3 * i));
     storeNormal(outNrm + 3 * i, rn, n);
   }
@@ -583,15 +590,25 @@ inline void blendRun3UniformT(const glm::mat4& pa, const glm::mat4& pb, const gl
     v128_t c[4];
     for (int k = 0; k < 4; ++k) c[k] = wasm_f32x4_add(wasm_f32x4_add(a[k], wasm_f32x4_mul(t, d[k])), wasm_f32x4_mul(u, e[k]));
     const float* n = inNrm + 3 * i;
-    const v128_t rn = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(c[0], wasm_v128_load32_splat(n)),
-                                                    wasm_f32x4_mul(c[1], wasm_v128_load32_splat(n + 1))),
-                                     wasm_f32x4_mul(c[2], wasm_v128_load32_splat(n + 2)));
+    const v128_t rn = linear3(c[0], c[1], c[2], n);
     wasm_v128_store(outPos + 3 * i, affine(c[0], c[1], c[2], c[3], inPos + 3 * i));
     storeNormal(outNrm + 3 * i, rn, n);
   }
 #else
   blendRun3(pa, invS * pa, pb, invS * pb, pc, invS * pc, Fix, f, g, inPos, inNrm, outPos, outNrm, count);
 #endif
+}
+
+// Calls kernel(fix, unit) with both as compile-time constants (std::integral_constant), so each
+// uniform blend kernel is instantiated for the fixes it can meet: unit (s exactly 1) only matters
+// for NormalFix::None, the one fix without a 1/s folded into its constants.
+template <class Kernel>
+inline void withUniformFix(NormalFix fix, bool unitScale, Kernel kernel) {
+  using None = std::integral_constant<NormalFix, NormalFix::None>;
+  if (fix == NormalFix::None && unitScale) kernel(None{}, std::true_type{});
+  else if (fix == NormalFix::None) kernel(None{}, std::false_type{});
+  else if (fix == NormalFix::Cubic) kernel(std::integral_constant<NormalFix, NormalFix::Cubic>{}, std::false_type{});
+  else kernel(std::integral_constant<NormalFix, NormalFix::Exact>{}, std::false_type{});
 }
 
 // Chooses the kernel: a rotation blend's fix (rotationBlendFix) when neither normal matrix is
