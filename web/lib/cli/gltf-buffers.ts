@@ -3,6 +3,7 @@
 // data: URIs decoded here (a malformed one is a BAD_URI GltfError, not the engine's URIError), and
 // external files through a reader the caller gives, asked for at most the declared byteLength.
 // Then the whole file goes through validateGltfJson. Browser-safe: no node module.
+import { checkDracoCounts } from '../gltf/draco-check.js';
 import { GltfError, n, parseGltfContainer, validateGltfJson, type BufferData, type GltfJson } from './gltf-validate.js';
 
 /**
@@ -102,5 +103,6 @@ export async function readValidatedGltf(bytes: Uint8Array, file: string, externa
     keep(await external(uri, i, maxBytes), `its file '${uri}'`);
   }
   validateGltfJson(json, file, data);
+  checkDracoCounts(json, data, file);
   return { json, buffers, glbBin, data };
 }

@@ -144,7 +144,7 @@ const DRACO_MODULE = 'draco3dgltf';
 /** A NodeIO that reads the compression extensions `used` by a file, with their decoders registered. */
 async function decodingIO(used: readonly string[]) {
   const [{ NodeIO }, ext] = await Promise.all([import('@gltf-transform/core'), import('@gltf-transform/extensions')]);
-  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression]);
+  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression, ext.KHRTextureBasisu]);
   const dependencies: Record<string, unknown> = {};
   if (used.includes('EXT_meshopt_compression')) {
     meshoptDecoder ??= import('meshoptimizer').then(async ({ MeshoptDecoder }) => {

@@ -81,8 +81,8 @@ export interface GltfContainer {
   glb: boolean;
 }
 
-/** The required extensions the loader reads (web/lib/cli/gltf-node.ts decodes them); any other is UNSUPPORTED. */
-export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression'];
+/** The required extensions the loaders read (geometry decoded by gltf-node.ts and the demo; KTX2 textures by the demo, dropped in node); any other is UNSUPPORTED. */
+export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression', 'KHR_texture_basisu'];
 
 const GLB_MAGIC = 0x46546c67; // 'glTF'
 const CHUNK_JSON = 0x4e4f534a;
