@@ -88,12 +88,12 @@ export function siteReader(base: URL | null, name: string): ResourceReader {
   return async (uri, kind, index, maxBytes) => {
     const what = `${kind} ${index}`, where = `/${kind}s/${index}/uri`;
     if (isData(uri)) return dataBytes(uri, maxBytes, name, what);
-    if (!base)
+    if (!base && !isUrl(uri))
       throw new GltfError('UNREADABLE', name, where,
         `${name}: ${what} is in the file '${shownName(uri)}', which a data: URI has no folder to read from: embed it as a data: URI, or use a .glb`);
     let url: URL;
     try {
-      url = new URL(uriPath(uri, kind, index, name), base);
+      url = new URL(uriPath(uri, kind, index, name), base ?? location.href); // no base: only //host reaches here
     } catch (e) {
       if (e instanceof GltfError) throw e;
       throw new GltfError('BAD_URI', name, where, `${name}: ${what}'s uri '${shownName(uri)}' is not a URI`);
