@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh, SkinDeformer } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { rootOf, sampleClip } from '../dist/cli/gltf-node.js';
+import { rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { errorInfo, median, timeFrames, timeInterleaved } from '../dist/measure.js';
 import { JsGcs } from './bench/js-gcs.mjs';
 import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';

@@ -15,9 +15,9 @@ import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
 import { initGcsSkin } from '../dist/index.js';
-import { rigInputFromSkinnedMesh } from '../dist/three.js';
+import { rigInputFromSkinnedMesh, writeSkinMatrices } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { characterHeight, loadGltfFile, rootOf, sampleClip, skinMatricesOf } from '../dist/cli/gltf-node.js';
+import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, restOfOutput } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import {
@@ -130,7 +130,7 @@ function shapeOf(mesh, height) {
   const J = bones.length;
   const rest0 = bones.map((b) => b.quaternion.clone());
   const resetPose = () => { bones.forEach((b, j) => b.quaternion.copy(rest0[j])); root.updateMatrixWorld(true); };
-  const skinOf = () => { root.updateMatrixWorld(true); return skinMatricesOf(mesh, new Float32Array(J * 16)); };
+  const skinOf = () => { root.updateMatrixWorld(true); const s = new Float32Array(J * 16); writeSkinMatrices(mesh, s); return s; };
   const dominant = dominantJoints(input);
   const centres = bindCentres(input);
   const meshWorldInv = new THREE.Matrix4().copy(mesh.matrixWorld).invert();

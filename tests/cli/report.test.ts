@@ -8,7 +8,7 @@ import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it, vi } from 'vitest';
 import { Document, NodeIO } from '@gltf-transform/core';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
-import { formatReport, nonFiniteMethods, report, run, type Report } from '../../web/lib/cli/report.js';
+import { formatReport, nonFiniteMethods, report, run, type Report } from '../../packages/cli/src/report.js';
 import { METHODS } from '../../web/lib/measure.js';
 import { sharedModels } from '../helpers/models.js';
 

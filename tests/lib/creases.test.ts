@@ -8,7 +8,7 @@ import { basename } from 'node:path';
 import { initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { characterHeight, sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { characterHeight, sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { FidelityProbe, countCreases, dihedralCosines, interiorEdges, type Fidelity } from '../../web/lib/measure.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
 import type * as THREE from 'three';

@@ -4,13 +4,13 @@
 // over every sampled frame of every clip, distances in % of the character's height), and per clip
 // the frame time. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
-import { GcsError } from '../errors.js';
-import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../index.js';
-import { rigInputFromSkinnedMesh } from '../three.js';
+import { GcsError } from '../../../web/lib/errors.js';
+import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
+import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
-} from '../measure.js';
+} from '../../../web/lib/measure.js';
 
 export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--json]
   Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
