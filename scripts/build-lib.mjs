@@ -59,4 +59,4 @@ copyFileSync(join(dist, 'gcs-skin.wasm'), join(cliDist, 'lib', 'gcs-skin.wasm'))
 // The package's own copies of the licence and the command line's docs (git ignores them).
 copyFileSync(join(root, 'LICENSE'), join(cli, 'LICENSE'));
 mkdirSync(join(cli, 'docs'), { recursive: true });
-for (const doc of ['node.md', 'report-json.md']) copyFileSync(join(root, 'docs', doc), join(cli, 'docs', doc));
+for (const doc of ['node.md', 'report-json.md', 'method.md']) copyFileSync(join(root, 'docs', doc), join(cli, 'docs', doc));

@@ -1,5 +1,5 @@
 // npm run metrics [-- --json] [--markdown] [--no-models] [--vertices N] [--sections N] [--frames N]
-// Fidelity per method (design.md §7) on the default human and on every character in
+// Fidelity per method (docs/method.md §9) on the default human and on every character in
 // ../shared/models (skipped with a reason when absent):
 // - FidelityProbe (web/lib/measure.ts) over every sampled frame of every clip, on every skinned
 //   mesh of the character, in % of the character's height (gltf-node characterHeight): rigid

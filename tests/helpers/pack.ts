@@ -9,7 +9,7 @@ export const ROOT = resolve(__dirname, '../..');
 export const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
 
 /** What the tarballs are packed from: the files both packages' `files`, `prepack` and build read. */
-const SOURCES = ['package.json', 'package-lock.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md',
+const SOURCES = ['package.json', 'package-lock.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md', 'docs/method.md',
   'web/lib', 'wasm/include', 'scripts/build-lib.mjs', 'packages/cli/package.json', 'packages/cli/tsconfig.json', 'packages/cli/src', 'packages/cli/bin', 'packages/cli/README.md'];
 
 export interface Tarballs {

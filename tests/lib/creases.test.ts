@@ -1,4 +1,4 @@
-// Steps between sections, measured by creases (design.md §7; issue "No steps by default"): the
+// Steps between sections, measured by creases (docs/method.md §9; issue "No steps by default"): the
 // metric itself on a hinge, then the default GCS against LBS and DQS on our human (every clip) and
 // on every shared character — creases and flipped triangles no more than 1.1× the more of LBS's and
 // DQS's, within 0.15 % of the height (p95) of DQS, rigid parts exact — and the stepped plain mode

@@ -1,5 +1,5 @@
 // The default GCS (weights criterion) on real characters and on rigs with scaled matrices
-// (design.md §2a, §7; issue "GCS that is right on real characters"): rigid error, distance from an
+// (docs/method.md §2, §9; issue "GCS that is right on real characters"): rigid error, distance from an
 // independent scale-aware DQS, flipped triangles, unit normals, finite output. Every figure is
 // printed, so a run shows the margins.
 import { beforeAll, describe, expect, test } from 'vitest';
@@ -22,7 +22,7 @@ beforeAll(async () => {
   gcs = await initGcsSkin();
 });
 
-// Targets of the issue, in % of the character's height (design.md §7).
+// Targets of the issue, in % of the character's height (docs/method.md §9).
 const RIGID_MAX = 0.01;    // 1e-4 of height
 const DQS_P95_MAX = 1;
 const DQS_MAX_MAX = 4;

@@ -391,7 +391,7 @@ export interface CharacterHeight {
 }
 
 /**
- * The character's height (design.md §7): the largest extent of the world bounding box of all
+ * The character's height (docs/method.md §9): the largest extent of the world bounding box of all
  * `meshes` in their bind pose, then that length in each mesh's own units through the mesh's world
  * scale (the deformers work in mesh space and their output is drawn through the mesh's world
  * matrix, so a distance d in a deformer's output is d × scale in the world).

@@ -1,6 +1,6 @@
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
-// method, build ms, median ms per frame and the fidelity figures of design.md §7 (FidelityProbe
+// method, build ms, median ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe
 // over every sampled frame of every clip, distances in % of the character's height), and per clip
 // the frame time. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
