@@ -5,8 +5,8 @@
 // refuses the rest; the page's Content-Security-Policy (index.html) is the wall behind both.
 // No read is unbounded: a file or a URL's body is cut at its byte limit.
 import * as THREE from 'three';
-import { decodeBufferPath } from '../lib/cli/gltf-buffers.js';
-import { GltfError, n } from '../lib/cli/gltf-validate.js';
+import { decodeBufferPath } from '../lib/gltf/buffers.js';
+import { GltfError, n } from '../lib/gltf/error.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 
 /** The largest file the page reads (a glTF, one of its buffers, or its images together). */

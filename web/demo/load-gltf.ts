@@ -1,5 +1,5 @@
 // Reads a dropped or linked glTF in the page the way `gcs-skin report` reads one in node: the
-// bytes go through the shared validation (web/lib/cli/gltf-buffers.ts, gltf-validate.ts; Draco
+// bytes go through the shared validation (web/lib/gltf/buffers.ts, validate.ts; Draco
 // headers against the accessors: web/lib/gltf/draco-check.ts) before three's GLTFLoader sees
 // them, so a broken or hostile file is one sentence with a code (GltfError). Every buffer and
 // image is read here, from the dropped files, this site or a data: URI only (gltf-sources.ts),
@@ -10,16 +10,17 @@
 // reports them as the CLI does.
 import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { readValidatedGltf, type ValidatedGltf } from '../lib/cli/gltf-buffers.js';
-import { restoreZeroWeights, zeroWeightVertices } from '../lib/cli/gltf-accessors.js';
-import { GltfError, n, type GltfJson } from '../lib/cli/gltf-validate.js';
+import { readValidatedGltf, type ValidatedGltf } from '../lib/gltf/buffers.js';
+import { restoreZeroWeights, zeroWeightVertices } from '../lib/gltf/accessors.js';
+import { GltfError, n } from '../lib/gltf/error.js';
+import type { GltfJson } from '../lib/gltf/json.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 import { addDecoders, decoderFailure } from './gltf-decoders.js';
 import { droppedReader, fetchAtMost, guardedManager, MAX_FILE_BYTES, siteReader, siteUrl, takeRefused, tooLarge, type ResourceReader } from './gltf-sources.js';
 import { imageSize, imageTooLarge } from './image-size.js';
 import { state } from './state.js';
 
-export { GltfError } from '../lib/cli/gltf-validate.js';
+export { GltfError } from '../lib/gltf/error.js';
 
 /** The last part of a path or URL, %-decoded where it decodes. */
 export function basename(path: string): string {

@@ -3,8 +3,8 @@
 // and points its accessors declare (which the validator has bounded by LIMITS), so a decoder never
 // works on a geometry larger than the file says. Run after validateGltfJson (references and
 // buffer view ranges are then known to be sound).
-import type { BufferData, GltfJson } from '../cli/gltf-validate.js';
-import { GltfError, n } from '../cli/gltf-validate.js';
+import { GltfError, n } from './error.js';
+import type { BufferData, GltfJson } from './json.js';
 import { readDracoCounts } from './draco-header.js';
 import { shownName } from './shown-name.js';
 
