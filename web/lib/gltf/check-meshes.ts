@@ -4,6 +4,7 @@ import { n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
 import { isIndex, isObject, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { shownName, shownValue } from './shown-name.js';
 
 /** Meshes: primitives, attributes of one count, Draco references, morph targets. */
 export function checkMeshes(ctx: ValidationContext): void {
@@ -21,7 +22,7 @@ export function checkMeshes(ctx: ValidationContext): void {
       if (!isObject(p) || !isObject(p.attributes)) fail('BAD_STRUCTURE', where, `${prim} has no attributes`);
       let first: [string, number] | undefined;
       for (const [k, a] of Object.entries(p.attributes)) {
-        ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${k}`, true);
+        ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${shownName(k)}`, true);
         const count = accessors[a as number].count;
         if (!first) {
           first = [k, count];
@@ -30,7 +31,7 @@ export function checkMeshes(ctx: ValidationContext): void {
         }
         else if (count !== first[1])
           fail('BAD_STRUCTURE', `${where}/attributes/${k}`,
-            `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
+            `${prim}'s ${shownName(k)} (accessor ${a}) has ${plural(count, 'element')} but its ${shownName(first[0])} has ${n(first[1])}: every attribute has one per vertex`);
       }
       ref(p.indices, accessors, 'accessor', `${where}/indices`, `${prim}'s indices`);
       const draco = p.extensions?.KHR_draco_mesh_compression;
@@ -39,9 +40,9 @@ export function checkMeshes(ctx: ValidationContext): void {
         if (!isObject(draco) || !isObject(draco.attributes)) fail('BAD_STRUCTURE', dw, `the KHR_draco_mesh_compression of ${prim} has no attributes`);
         ref(draco.bufferView, bufferViews, 'buffer view', `${dw}/bufferView`, `the Draco data of ${prim}`, true);
         for (const [k, id] of Object.entries(draco.attributes)) {
-          if (!isIndex(id)) fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `the Draco attribute id of ${prim}'s ${k} is ${JSON.stringify(id)}, not a whole number`);
+          if (!isIndex(id)) fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `the Draco attribute id of ${prim}'s ${shownName(k)} is ${shownValue(id)}, not a whole number`);
           if (p.attributes[k] === undefined)
-            fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${k} but no ${k} attribute`);
+            fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${shownName(k)} but no ${shownName(k)} attribute`);
         }
       }
       ref(p.material, materials, 'material', `${where}/material`, prim);
@@ -49,7 +50,7 @@ export function checkMeshes(ctx: ValidationContext): void {
         if (!Array.isArray(p.targets)) fail('BAD_STRUCTURE', `${where}/targets`, `${prim}'s morph targets are not an array`);
         p.targets.forEach((t: GltfJson, ti: number) => {
           if (!isObject(t)) fail('BAD_STRUCTURE', `${where}/targets/${ti}`, `${prim}'s morph target ${ti} is not an object`);
-          for (const [k, a] of Object.entries(t)) ref(a, accessors, 'accessor', `${where}/targets/${ti}/${k}`, `${prim}'s morph target ${ti} ${k}`, true);
+          for (const [k, a] of Object.entries(t)) ref(a, accessors, 'accessor', `${where}/targets/${ti}/${k}`, `${prim}'s morph target ${ti} ${shownName(k)}`, true);
         });
       }
     });

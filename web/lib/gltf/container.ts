@@ -3,6 +3,8 @@
 import { GltfError, n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
+import { reservedKey } from './reserved-keys.js';
+import { shownName } from './shown-name.js';
 
 /** A split glTF file: the JSON, and the GLB's BIN chunk if any. */
 export interface GltfContainer {
@@ -62,6 +64,10 @@ function parseJsonText(bytes: Uint8Array, file: string, where: string, what: str
   const depth = nestingDepth(json, LIMITS.jsonDepth);
   if (depth > LIMITS.jsonDepth)
     throw new GltfError('TOO_LARGE', file, where, `${what} nests objects or arrays more than ${LIMITS.jsonDepth} deep, past any glTF (loaders would overflow their stack)`);
+  const reserved = reservedKey(json);
+  if (reserved)
+    throw new GltfError('BAD_STRUCTURE', file, `${where}${reserved.path}`,
+      `${what} has a property named '${shownName(reserved.key)}' (at ${shownName(reserved.path)}), a name every JavaScript object already has: refused`);
   return json as GltfJson;
 }
 

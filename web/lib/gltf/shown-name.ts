@@ -25,3 +25,9 @@ export function shownName(s: string, max = SHOWN_NAME_LENGTH): string {
   const chars = Array.from(s.slice(0, 2 * max + 2)); // whole code points: a cut never splits a surrogate pair
   return printable(chars.length > max ? `${chars.slice(0, max - 1).join('')}…` : s);
 }
+
+/** A value from a file as JSON for a message, cut and escaped like a name (undefined stays undefined). */
+export function shownValue(value: unknown): string | undefined {
+  const text = JSON.stringify(value);
+  return text === undefined ? undefined : shownName(text);
+}
