@@ -7,10 +7,11 @@
 import * as THREE from 'three';
 import { decodeBufferPath } from '../lib/gltf/buffers.js';
 import { GltfError, n } from '../lib/gltf/error.js';
+import { LIMITS } from '../lib/gltf/limits.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 
-/** The largest file the page reads (a glTF, one of its buffers, or its images together). */
-export const MAX_FILE_BYTES = 512 * 2 ** 20;
+/** The largest file the page reads (a glTF, one of its buffers, or its images together): the CLI's limit. */
+export const MAX_FILE_BYTES = LIMITS.fileBytes;
 
 /** Reads the file that buffer or image `index`'s `uri` names, at most `maxBytes` of it. Throws a GltfError. */
 export type ResourceReader = (uri: string, kind: 'buffer' | 'image', index: number, maxBytes: number) => Promise<Uint8Array>;

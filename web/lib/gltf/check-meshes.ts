@@ -3,7 +3,7 @@
 import { n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
-import { isIndex, isObject, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { COMPONENT, isIndex, isObject, type Fail, type Ref, type ValidationContext } from './validation-context.js';
 import { shownName, shownValue } from './shown-name.js';
 
 /** Meshes: primitives, attributes of one count, Draco references, morph targets. */
@@ -24,6 +24,7 @@ export function checkMeshes(ctx: ValidationContext): void {
       for (const [k, a] of Object.entries(p.attributes)) {
         ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${shownName(k)}`, true);
         const count = accessors[a as number].count;
+        checkInfluenceType(ctx, k, a as number, `${where}/attributes/${k}`);
         if (!first) {
           first = [k, count];
           if (count > LIMITS.vertices)
@@ -55,6 +56,22 @@ export function checkMeshes(ctx: ValidationContext): void {
       }
     });
   });
+}
+
+/**
+ * JOINTS_n and WEIGHTS_n of glTF's types (JOINTS: VEC4 of UNSIGNED_BYTE or UNSIGNED_SHORT;
+ * WEIGHTS: VEC4 of FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT): read as anything else,
+ * their values would be blamed on a joint ("joint 30608") instead of on the accessor.
+ */
+function checkInfluenceType(ctx: ValidationContext, semantic: string, index: number, where: string): void {
+  const joints = /^JOINTS_\d+$/.test(semantic);
+  if (!joints && !/^WEIGHTS_\d+$/.test(semantic)) return;
+  const a = ctx.accessors[index];
+  const integer = a.componentType === 5121 || a.componentType === 5123;
+  const ok = a.type === 'VEC4' && (joints ? integer : a.componentType === 5126 || (integer && a.normalized === true));
+  if (!ok)
+    ctx.fail('BAD_STRUCTURE', where, `${ctx.accessorName(index)} is ${shownValue(a.type)} of ${COMPONENT[a.componentType].name}${integer && !joints && !a.normalized ? ' (not normalized)' : ''}: ` +
+      (joints ? 'joint indices are VEC4 of UNSIGNED_BYTE or UNSIGNED_SHORT' : 'skin weights are VEC4 of FLOAT, or of normalized UNSIGNED_BYTE or UNSIGNED_SHORT'));
 }
 
 /** Textures, images, materials. */

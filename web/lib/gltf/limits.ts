@@ -8,6 +8,11 @@ export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT
  * work and memory then grow with the bytes a file has, not with the counts its header claims.
  */
 export const LIMITS = {
+  /**
+   * Bytes of a file and its external buffers together, checked on their sizes before they are
+   * read (the loaders then hold several copies: past ~512 MiB a load would pass 1.5 GB).
+   */
+  fileBytes: 512 * 2 ** 20,
   /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
   vertices: 16_777_216,
   /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */
