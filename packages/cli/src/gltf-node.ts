@@ -63,7 +63,7 @@ const tooMuch = (file: string, what: string, bytes: number) => new GltfError('TO
 async function readBufferFile(baseDir: string, uri: string, maxBytes: number, file: string, i: number, budget: Budget): Promise<Uint8Array> {
   const where = `/buffers/${i}/uri`;
   const outside = (why: string) =>
-    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${shownName(uri)}' ${why}: a buffer is read only from a file in the glTF's own folder`);
+    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${shownName(uri)}' ${why}; buffers are read from the glTF's folder only`);
   const path = decodeBufferPath(uri, file, i);
   if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
   if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');

@@ -59,8 +59,9 @@ export async function readRegularFile(path: string, options: ReadOptions): Promi
     const stat = await handle.stat();
     if (!stat.isFile()) throw new FileRefused('type', `it is ${kindOf(stat)}, not a regular file`);
     const wanted = Math.min(stat.size, options.truncateAt ?? Infinity);
-    if (wanted > options.maxBytes) throw new FileRefused('size', `it has ${stat.size.toLocaleString('en-US')} bytes`, stat.size);
-    const bytes = new Uint8Array(wanted);
+    const tooLarge = () => new FileRefused('size', `it has ${stat.size.toLocaleString('en-US')} bytes`, stat.size);
+    if (wanted > options.maxBytes && !options.sniff) throw tooLarge();
+    const bytes = new Uint8Array(Math.min(wanted, options.maxBytes + 1));
     let at = 0;
     const fill = async (end: number) => {
       while (at < end) {
@@ -71,8 +72,10 @@ export async function readRegularFile(path: string, options: ReadOptions): Promi
       return true;
     };
     if (options.sniff) {
+      // What the head says comes first: 1.9 GB of zeros is NOT_GLTF, not TOO_LARGE.
       await fill(Math.min(wanted, HEAD_BYTES));
       options.sniff(bytes.subarray(0, at), stat.size);
+      if (wanted > options.maxBytes) throw tooLarge();
     }
     await fill(wanted);
     return bytes.subarray(0, at);

@@ -330,7 +330,7 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
     else if (a === '--sections') options.sections = integer(3, 256);
     else if (a === '--frames') options.frames = integer(1, 10000);
     else if (a === '--time-ms') options.timeMs = integer(1, 60000);
-    else if (a.startsWith('-')) throw new ReportError(`unknown option '${a}'`);
+    else if (a.startsWith('-') && a !== '-') throw new ReportError(`unknown option '${a}'`); // '-': standard input
     else if (file === undefined) file = a;
     else throw new ReportError(`only one model file, got '${file}' and '${a}'`);
   }

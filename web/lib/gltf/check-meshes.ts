@@ -70,8 +70,8 @@ function checkInfluenceType(ctx: ValidationContext, semantic: string, index: num
   const integer = a.componentType === 5121 || a.componentType === 5123;
   const ok = a.type === 'VEC4' && (joints ? integer : a.componentType === 5126 || (integer && a.normalized === true));
   if (!ok)
-    ctx.fail('BAD_STRUCTURE', where, `${ctx.accessorName(index)} is ${shownValue(a.type)} of ${COMPONENT[a.componentType].name}${integer && !joints && !a.normalized ? ' (not normalized)' : ''}: ` +
-      (joints ? 'joint indices are VEC4 of UNSIGNED_BYTE or UNSIGNED_SHORT' : 'skin weights are VEC4 of FLOAT, or of normalized UNSIGNED_BYTE or UNSIGNED_SHORT'));
+    ctx.fail('BAD_STRUCTURE', where, `${ctx.accessorName(index)} is ${a.type} ${COMPONENT[a.componentType].name}${integer && !joints && !a.normalized ? ' not normalized' : ''}, ` +
+      (joints ? 'not VEC4 UNSIGNED_BYTE/SHORT' : 'not VEC4 FLOAT or normalized UNSIGNED_BYTE/SHORT'));
 }
 
 /** Textures, images, materials. */

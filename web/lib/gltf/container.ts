@@ -67,7 +67,7 @@ function parseJsonText(bytes: Uint8Array, file: string, where: string, what: str
   const reserved = reservedKey(json);
   if (reserved)
     throw new GltfError('BAD_STRUCTURE', file, `${where}${reserved.path}`,
-      `${what} has a property named '${shownName(reserved.key)}' (at ${shownName(reserved.path)}), a name every JavaScript object already has: refused`);
+      `${what} uses the key '${shownName(reserved.key)}' (at ${shownName(reserved.path, 32)}), reserved in JavaScript objects`);
   return json as GltfJson;
 }
 

@@ -1,10 +1,10 @@
-// A name or URI from a file, as our messages show it: at most ~80 characters (a 1 MB node name
-// must not make a 1 MB error line) and with control characters and bidirectional overrides
+// A name or URI from a file, as our messages show it: at most 48 characters (a 1 MB node name
+// must not make a 1 MB error line; with a path and a sentence, a line stays within ~200) and with control characters and bidirectional overrides
 // written as escapes (\x1b, \n, \u202e), so neither a terminal nor the page is steered by them.
 // Browser-safe.
 
 /** Characters shown of a name before it is cut (with "…"). */
-export const SHOWN_NAME_LENGTH = 80;
+export const SHOWN_NAME_LENGTH = 48;
 
 /** Control characters (C0, DEL, C1), line and paragraph separators, bidirectional overrides and isolates. */
 const UNPRINTABLE = /[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]/g;
