@@ -18,6 +18,7 @@ import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
 import { run, type Report } from '../../packages/cli/src/report.js';
 import { loadCharacter } from '../../packages/cli/src/gltf.js';
 import { MODELS_DIR } from '../helpers/models.js';
+import { compressGlb } from '../helpers/compressed-gltf.js';
 
 let dir: string;
 let io: NodeIO;
@@ -132,6 +133,18 @@ describe('compressed copies report the same figures as the original', () => {
         });
       }
     });
+});
+
+describe('KTX2 textures (KHR_texture_basisu, required)', () => {
+  it('read, the texture dropped: the same counts as the original, no warning', async () => {
+    const file = join(dir, 'human-ktx2.glb');
+    writeFileSync(file, await compressGlb(readFileSync(sources[0].file), 'ktx2'));
+    const [a, b] = [await reportJson(file), await reportJson(sources[0].file)];
+    expect(a.code, a.stderr).toBe(0);
+    expect(a.stderr).toBe('');
+    expect(a.report.warnings).toEqual([]);
+    expect(a.report.meshes.map((m) => m.counts)).toEqual(b.report.meshes.map((m) => m.counts));
+  });
 });
 
 describe('8 influences per vertex', () => {
