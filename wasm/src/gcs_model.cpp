@@ -6,6 +6,7 @@
 #include <tuple>
 #include <unordered_map>
 #include "error.h"
+#include "rotation_centres.h"
 
 namespace gcs {
 namespace {
@@ -149,6 +150,13 @@ void finishModel(GcsDeformerImpl& m) {
         texels[4 + k % 4] = used ? m.influences[sec.influenceFirst + k].weight : 0.0f;
       }
     }
+    m.centreTable.assign(size_t(S) * 4, 0.0f);
+    for (uint32_t i = 0; i < S; ++i)
+      if (m.sections[i].aboutCentre) {
+        float* texel = &m.centreTable[size_t(i) * 4];
+        for (int c = 0; c < 3; ++c) texel[c] = m.sections[i].rotationCentre[c];
+        texel[3] = 1.0f;
+      }
   }
   m.poses.resize(m.jointCount);
   m.lastSkin.assign(m.jointCount, glm::mat4(1.0f));
@@ -178,6 +186,11 @@ void finishModel(GcsDeformerImpl& m) {
   const size_t padded = (m.blendedSections.size() + 3) / 4 * 4;
   m.nodeReal.assign(padded, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   m.nodeDual.assign(padded, glm::vec4(0.0f));
+  m.nodeCentre.assign(padded, glm::vec4(0.0f));
+  for (size_t b = 0; b < m.blendedSections.size(); ++b) {
+    const Section& sec = m.sections[m.blendedSections[b]];
+    if (sec.aboutCentre) m.nodeCentre[b] = glm::vec4(sec.rotationCentre, 1.0f);
+  }
   std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
   std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
 }
@@ -268,28 +281,6 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
     sec.t = sec.beta;
   }
   return sectionOfKey;
-}
-
-// A welded vertex's weights as the criterion reads them: influences below 0.5 % dropped, the
-// same joint listed twice merged, the rest normalised to sum 1.
-uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
-  uint32_t n = 0;
-  float sum = 0.0f;
-  for (uint32_t i = 0; i < rig.influenceSlots; ++i) {
-    float w = rig.weightAt(v, i);
-    if (!(w > 0.0f)) continue;
-    uint32_t j = rig.jointAt(v, i), k = 0;
-    while (k < n && joint[k] != j) ++k;
-    if (k == n) joint[n] = j, weight[n] = 0.0f, ++n;
-    weight[k] += w;
-  }
-  uint32_t kept = 0;
-  float biggest = 0.0f;
-  for (uint32_t i = 0; i < n; ++i) biggest = std::max(biggest, weight[i]);
-  for (uint32_t i = 0; i < n; ++i)
-    if (weight[i] >= 0.005f || weight[i] == biggest) joint[kept] = joint[i], weight[kept] = weight[i], sum += weight[i], ++kept;
-  for (uint32_t i = 0; i < kept; ++i) weight[i] /= sum;
-  return kept;
 }
 
 // The weights criterion (design.md §2a): sections are bins of the welded vertices' skin weights on
@@ -496,6 +487,24 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
 }
 
+// Weights criterion with centres: each blended section's centre of rotation from its blend weights
+// (a rigid core needs none: it is S_j; where the integral is empty the section keeps the plain blend).
+bool placeRotationCentres(const Rig& rig, GcsDeformerImpl& m) {
+  const CentreSurface* surface = centreSurfaceOf(rig);
+  if (!surface) return false;
+  uint32_t joints[kMaxInfluences];
+  float weights[kMaxInfluences];
+  for (Section& sec : m.sections) {
+    if (sec.rigid) continue;
+    for (uint32_t k = 0; k < sec.influenceCount; ++k) {
+      joints[k] = m.influences[sec.influenceFirst + k].joint;
+      weights[k] = m.influences[sec.influenceFirst + k].weight;
+    }
+    sec.aboutCentre = rotationCentre(*surface, joints, weights, sec.influenceCount, sec.rotationCentre);
+  }
+  return true;
+}
+
 }  // namespace
 
 float Deformer::stat(GcsStat) const { return std::nanf(""); }
@@ -548,6 +557,10 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
         buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
                          blendThirdOfGroup);
       else buildWeightSections(rig, m, representative, sectionOfGroup);
+      if (settings.centres && !placeRotationCentres(rig, m)) {
+        delete model;
+        return nullptr;
+      }
       std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
       if (settings.smooth) {
         m.blendOther.resize(rig.vertexCount);
@@ -847,8 +860,24 @@ glm::mat4 rigidInverse(const glm::mat4& m) {
 }
 }  // namespace
 
+// A section with a centre of rotation p* (rotation_centres.h): its 3×3 part M (the blend's rotation
+// and scale) stays; its translation makes M p* + t = Σ w_j S_j p*, p* moved by linear blend
+// skinning. Written t = Σ w_j (S_j p* − p*) − (M p* − p*): identity poses give t = 0 exactly.
+void GcsDeformerImpl::turnAboutCentre(const glm::mat4* skin, const Section& sec, glm::mat4& position) const {
+  const glm::vec3 p = sec.rotationCentre;
+  glm::vec3 moved(0.0f);
+  for (uint32_t k = 0; k < sec.influenceCount; ++k) {
+    const Influence& in = influences[sec.influenceFirst + k];
+    const glm::mat4& s = skin[in.joint];
+    moved += in.weight * (glm::vec3(s[0]) * p.x + glm::vec3(s[1]) * p.y + glm::vec3(s[2]) * p.z + glm::vec3(s[3]) - p);
+  }
+  const glm::vec3 turned = glm::vec3(position[0]) * p.x + glm::vec3(position[1]) * p.y + glm::vec3(position[2]) * p.z - p;
+  position[3] = glm::vec4(moved - turned, 1.0f);
+}
+
 // Weights criterion: each section's transform is the dual-quaternion blend of its joints at its
-// mean weights (a rigid core: S_j itself). O(sections × influences).
+// mean weights (a rigid core: S_j itself), or with centres the blend's rotation about its centre of
+// rotation. O(sections × influences).
 void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale) {
 #if defined(__wasm_simd128__)
   if (moderateUniform(scale)) return sectionTransformsWeightsUniform(skin, scale.s);
@@ -869,6 +898,7 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const Scal
         w[k] = in.weight;
       }
       blendPoses(blendPoseScratch.data(), w, sec.influenceCount, scale, sectionMatrices[i], normalMatrices[i], renorm);
+      if (sec.aboutCentre) turnAboutCentre(skin, sec, sectionMatrices[i]);
     }
     renormalise[i] = renorm;
   }
@@ -972,6 +1002,11 @@ void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, flo
       wasm_v128_store(m + 12, translation[k]);
     }
   }
+  for (uint32_t b2 = 0; b2 < B; ++b2)
+    if (nodeCentre[b2].w != 0.0f) {
+      const uint32_t i = blendedSections[b2];
+      turnAboutCentre(skin, sections[i], sectionMatrices[i]);
+    }
 }
 #endif
 
