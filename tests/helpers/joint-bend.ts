@@ -18,6 +18,7 @@ export interface JointBend {
   bindVolume: number;
 }
 
+/** Bulge: distance to the posed bones over the same at bind (p95, max); volume change in % (negative: lost). */
 export interface BendFigures { bulgeP95: number; bulgeMax: number; volumeChange: number }
 
 function bindCentres(input: RigInput): THREE.Vector3[] {
@@ -106,6 +107,6 @@ export function measureBend(bend: JointBend, input: RigInput, d: Deformer): Bend
   return {
     bulgeP95: ratios[Math.floor(0.95 * (ratios.length - 1))],
     bulgeMax: ratios[ratios.length - 1],
-    volumeChange: (100 * (volume - bend.bindVolume)) / Math.abs(bend.bindVolume),
+    volumeChange: 100 * (volume / bend.bindVolume - 1),  // negative: lost, whichever way the triangles wind
   };
 }

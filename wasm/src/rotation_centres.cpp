@@ -100,22 +100,13 @@ std::shared_ptr<CentreSurface> buildCentreSurface(const Rig& rig) {
   }
   while (surface->vj.size() % 4) push(0.0f, 0.0f, glm::vec4(0.0f));
   surface->first.push_back(uint32_t(surface->vj.size()));
+  surface->memoLimit = 4 * size_t(V) + 4096;
   return surface;
 }
 
 // e^y for y ≤ 0: 2^n · 2^f with n = round(y·log2 e), |f| ≤ ½, 2^f by its Taylor series to f⁵
 // (relative error < 3e-6); y below −80 is taken as −80 (e^−80 ≈ 2e-35: nothing next to the rest).
-// The same operations in every lane of expNegative4.
-inline float expNegative(float y) {
-  const float z = std::max(y, -80.0f) * 1.44269504f;
-  const float n = std::nearbyint(z), f = z - n;
-  const float p = 1.0f + f * (0.693147181f + f * (0.240226507f + f * (0.0555041087f + f * (0.00961812911f + f * 0.00133335581f))));
-  const int32_t bits = (int32_t(n) + 127) << 23;
-  float scale;
-  std::memcpy(&scale, &bits, 4);
-  return p * scale;
-}
-
+// The same operations in each lane of the SIMD version.
 #if defined(__wasm_simd128__)
 inline v128_t expNegative4(v128_t y) {
   const v128_t z = wasm_f32x4_mul(wasm_f32x4_max(y, wasm_f32x4_splat(-80.0f)), wasm_f32x4_splat(1.44269504f));
@@ -125,6 +116,16 @@ inline v128_t expNegative4(v128_t y) {
     p = wasm_f32x4_add(wasm_f32x4_splat(c), wasm_f32x4_mul(f, p));
   const v128_t scale = wasm_i32x4_shl(wasm_i32x4_add(wasm_i32x4_trunc_sat_f32x4(n), wasm_i32x4_splat(127)), 23);
   return wasm_f32x4_mul(p, scale);
+}
+#else
+inline float expNegative(float y) {
+  const float z = std::max(y, -80.0f) * 1.44269504f;
+  const float n = std::nearbyint(z), f = z - n;
+  const float p = 1.0f + f * (0.693147181f + f * (0.240226507f + f * (0.0555041087f + f * (0.00961812911f + f * 0.00133335581f))));
+  const int32_t bits = (int32_t(n) + 127) << 23;
+  float scale;
+  std::memcpy(&scale, &bits, 4);
+  return p * scale;
 }
 #endif
 
@@ -170,13 +171,21 @@ bool rotationCentre(const CentreSurface& surface, const uint32_t* joints, const 
   glm::dvec4 sum(0.0);
   for (uint32_t i = 0; i < count; ++i)
     for (uint32_t k = i + 1; k < count; ++k) {
-      const uint64_t key = pairKey(joints[i], joints[k]);
-      auto it = std::lower_bound(surface.pairs.begin(), surface.pairs.end(), key);
-      if (it == surface.pairs.end() || *it != key) continue;
+      const uint64_t pair = pairKey(joints[i], joints[k]);
+      auto it = std::lower_bound(surface.pairs.begin(), surface.pairs.end(), pair);
+      if (it == surface.pairs.end() || *it != pair) continue;
       const size_t p = size_t(it - surface.pairs.begin());
       const bool ordered = joints[i] < joints[k];
       const float wj = ordered ? weights[i] : weights[k], wk = ordered ? weights[k] : weights[i];
-      sum += double(wj) * double(wk) * glm::dvec4(pairSum(surface, surface.first[p], surface.first[p + 1], wj, wk));
+      CentreSurface::MemoKey key{uint32_t(p), 0, 0};
+      std::memcpy(&key.wj, &wj, 4);
+      std::memcpy(&key.wk, &wk, 4);
+      auto memo = surface.memo.find(key);
+      if (memo == surface.memo.end()) {
+        if (surface.memo.size() >= surface.memoLimit) surface.memo.clear();
+        memo = surface.memo.emplace(key, pairSum(surface, surface.first[p], surface.first[p + 1], wj, wk)).first;
+      }
+      sum += double(wj) * double(wk) * glm::dvec4(memo->second);
     }
   if (!(sum.w > 0.0) || !std::isfinite(sum.w)) return false;
   const glm::dvec3 p = glm::dvec3(sum) / sum.w;

@@ -8,6 +8,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 #include <glm/glm.hpp>
 #include "rig.h"
@@ -30,6 +31,21 @@ struct CentreSurface {
   // Per term (structure of arrays, 4 lanes at a time): the weights v_j, v_k, and the moments
   // Σ a_t v_j v_k (c_t, 1). Padding terms have zero moments.
   std::vector<float> vj, vk, mx, my, mz, mass;
+  // Pair sums already computed, by (pair, w_j, w_k): the section slider rebuilds the same rig over
+  // and over, and the nodes of a section count it has seen before cost a lookup. At most
+  // memoLimit entries (then it starts afresh), so its memory stays in proportion to the rig.
+  struct MemoKey {
+    uint32_t pair, wj, wk;  // the weights' bits
+    bool operator==(const MemoKey& o) const { return pair == o.pair && wj == o.wj && wk == o.wk; }
+  };
+  struct MemoHash {
+    size_t operator()(const MemoKey& k) const {
+      uint64_t h = (uint64_t(k.wj) << 32 | k.wk) * 0x9e3779b97f4a7c15ull ^ k.pair;
+      return size_t(h ^ (h >> 29));
+    }
+  };
+  mutable std::unordered_map<MemoKey, glm::vec4, MemoHash> memo;
+  size_t memoLimit = 0;
 };
 
 // The rig's CentreSurface, built by the first call and cached on the rig; null (the error recorded)
