@@ -1068,11 +1068,12 @@ void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, flo
       wasm_v128_store(m + 12, translation[k]);
     }
   }
-  for (uint32_t b2 = 0; b2 < B; ++b2)
-    if (nodeCentre[b2].w != 0.0f) {
-      const uint32_t i = blendedSections[b2];
-      turnAboutCentre(skin, sections[i], sectionMatrices[i]);
-    }
+  if (settings.centres)  // the centres' translations replace the blends' (none otherwise: no pass)
+    for (uint32_t b2 = 0; b2 < B; ++b2)
+      if (nodeCentre[b2].w != 0.0f) {
+        const uint32_t i = blendedSections[b2];
+        turnAboutCentre(skin, sections[i], sectionMatrices[i]);
+      }
 }
 #endif
 
