@@ -8,7 +8,7 @@ import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsDeformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { JointProbe, identitySkin, type Hinge, type JointFigures } from '../../web/lib/measure.js';
 import { cleanWeights } from '../helpers/clean-weights.js';
 import { makeTube } from '../helpers/cylinder.js';
