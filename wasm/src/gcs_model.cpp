@@ -511,22 +511,8 @@ float GcsDeformerImpl::stat(GcsStat which) const {
   return std::nanf("");
 }
 
+// The settings are the C API's, checked there (gcs_build_gcs).
 GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
-  if (settings.sections < GCS_MIN_SECTIONS || settings.sections > GCS_MAX_SECTIONS) {
-    fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
-         GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, settings.sections);
-    return nullptr;
-  }
-  if (!(settings.influenceWidth > 0.0f && settings.influenceWidth <= 1.0f)) {
-    fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(settings.influenceWidth));
-    return nullptr;
-  }
-  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL &&
-      settings.criterion != GCS_CRITERION_WEIGHTS) {
-    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)",
-         unsigned(settings.criterion));
-    return nullptr;
-  }
   GcsDeformerImpl* model = nullptr;
   try {
     model = new GcsDeformerImpl();
