@@ -32,14 +32,20 @@ export function basename(path: string): string {
   }
 }
 
+/** Characters of a file's own name the page shows (its label and menu have room for more than a message). */
+export const FILE_NAME_LENGTH = 80;
+
 /** How the page names a ?model= value: its file name, or the start of a data: URI; capped and escaped. */
 export function modelName(value: string): string {
-  return /^data:/i.test(value) ? shownName(value, 40) : shownName(basename(value));
+  return /^data:/i.test(value) ? shownName(value, 40) : shownName(basename(value), FILE_NAME_LENGTH);
 }
+
+/** How the page names a dropped file. */
+export const fileName = (file: File): string => shownName(file.name, FILE_NAME_LENGTH);
 
 /** A dropped .glb or .gltf with the files dropped beside it (its external buffers and images, found by name). */
 export async function loadDroppedGltf(main: File, companions: readonly File[]): Promise<GLTF> {
-  const name = shownName(main.name);
+  const name = fileName(main);
   if (main.size > MAX_FILE_BYTES) throw tooLarge(name, main.size);
   return loadBytes(new Uint8Array(await main.arrayBuffer()), name, droppedReader(companions, name));
 }

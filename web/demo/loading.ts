@@ -9,7 +9,7 @@ import { playClip } from './animate.js';
 import { applyMaterials, gcsColours } from './colours.js';
 import { setClipOptions, syncModelMenu, updateCredit, type MenuEntry } from './controls.js';
 import { humanDataInWorker } from './human-data.js';
-import { GltfError, loadDroppedGltf, loadGltfUrl, modelName } from './load-gltf.js';
+import { fileName, GltfError, loadDroppedGltf, loadGltfUrl, modelName } from './load-gltf.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 import { buildClassic, buildGcs, classicSummary, scheduleCostMeasure } from './models.js';
 import { clearMessage, DemoError, describeError, hideStatus, shownMessage, showMessage, showStatus, yieldToPage } from './page.js';
@@ -116,7 +116,7 @@ async function loadFiles(files: File[]): Promise<void> {
     const names = shownName(files.map((f) => f.name).join(', ')) || 'That';
     throw new GltfError('NOT_GLTF', names, '', `${names} is not a glTF file: drop a skinned .glb or .gltf`);
   }
-  const name = shownName(main.name);
+  const name = fileName(main);
   showStatus(`building… reading ${name}`);
   await yieldToPage();
   // Validated as the CLI validates (a GltfError: one sentence and a code), then parsed.
