@@ -1,0 +1,91 @@
+#include "classic_rays.h"
+#include <algorithm>
+#include <cmath>
+#include "classic_geometry.h"
+
+namespace gcs {
+namespace classic {
+namespace {
+constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contour's median is a miss
+}  // namespace
+
+// Each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle lies in
+// the segment's angular span are tested. The corners are gathered per part by the caller (the rig's
+// vertices are scattered, and every contour of the part reads every triangle).
+void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
+                 const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius,
+                 uint32_t* hitTriangle) {
+  const float step = 2.0f * kPi / float(k);
+  const float planeD = glm::dot(O, n);
+  for (uint32_t i = 0; i < triCount; ++i) {
+    const glm::vec3* c = &corners[size_t(i) * 3];
+    // Most triangles lie on one side of the plane: sides first, relative positions only if cut.
+    float h[3] = {glm::dot(c[0], n) - planeD, glm::dot(c[1], n) - planeD, glm::dot(c[2], n) - planeD};
+    bool neg0 = h[0] < 0.0f, neg1 = h[1] < 0.0f, neg2 = h[2] < 0.0f;
+    if (neg0 == neg1 && neg1 == neg2) continue;
+    glm::vec3 p[3] = {c[0] - O, c[1] - O, c[2] - O};
+    glm::vec2 seg[2];
+    int s = 0;
+    for (int e = 0; e < 3 && s < 2; ++e) {
+      int a = e, b = (e + 1) % 3;
+      if ((h[a] < 0.0f) == (h[b] < 0.0f)) continue;
+      float f = h[a] / (h[a] - h[b]);
+      glm::vec3 x = p[a] + f * (p[b] - p[a]);
+      seg[s++] = glm::vec2(glm::dot(x, u), glm::dot(x, w));
+    }
+    if (s < 2) continue;
+    glm::vec2 P = seg[0], E = seg[1] - seg[0];
+    float aP = std::atan2(P.y, P.x), aQ = std::atan2(seg[1].y, seg[1].x);
+    float delta = aQ - aP;
+    if (delta > kPi) delta -= 2.0f * kPi;
+    if (delta < -kPi) delta += 2.0f * kPi;
+    float start = delta >= 0.0f ? aP : aQ, span = std::fabs(delta);
+    int r0 = int(std::ceil((start - 1e-5f) / step));
+    int r1 = int(std::floor((start + span + 1e-5f) / step));
+    if (r1 - r0 >= int(k)) r1 = r0 + int(k) - 1;
+    for (int rr = r0; rr <= r1; ++rr) {
+      uint32_t r = uint32_t(((rr % int(k)) + int(k)) % int(k));
+      glm::vec2 d(cosT[r], sinT[r]);
+      float denom = d.x * E.y - d.y * E.x;
+      if (std::fabs(denom) < 1e-12f) continue;
+      float lambda = (P.x * E.y - P.y * E.x) / denom;
+      float mu = (P.x * d.y - P.y * d.x) / denom;
+      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f && lambda > radius[r]) radius[r] = lambda, hitTriangle[r] = i;
+    }
+  }
+}
+
+uint32_t rejectOutliers(float* radius, uint32_t k, std::vector<float>& scratch) {
+  scratch.clear();
+  for (uint32_t r = 0; r < k; ++r)
+    if (radius[r] > 0.0f) scratch.push_back(radius[r]);
+  if (scratch.empty()) return 0;
+  std::nth_element(scratch.begin(), scratch.begin() + scratch.size() / 2, scratch.end());
+  float limit = kOutlierFactor * scratch[scratch.size() / 2];
+  uint32_t hits = 0;
+  for (uint32_t r = 0; r < k; ++r) {
+    if (radius[r] > limit) radius[r] = -1.0f;
+    if (radius[r] > 0.0f) ++hits;
+  }
+  return hits;
+}
+
+bool fillMisses(float* radius, uint32_t k) {
+  int firstHit = -1;
+  for (uint32_t r = 0; r < k; ++r)
+    if (radius[r] > 0.0f) { firstHit = int(r); break; }
+  if (firstHit < 0) return false;
+  for (uint32_t r = 0; r < k; ++r) {
+    if (radius[r] > 0.0f) continue;
+    int before = 1, after = 1;
+    while (radius[(r + k - before) % k] <= 0.0f) ++before;
+    while (radius[(r + after) % k] <= 0.0f) ++after;
+    float a = radius[(r + k - before) % k], b = radius[(r + after) % k];
+    radius[r] = -(a + (b - a) * float(before) / float(before + after));  // negative: filled
+  }
+  for (uint32_t r = 0; r < k; ++r) radius[r] = std::fabs(radius[r]);
+  return true;
+}
+
+}  // namespace classic
+}  // namespace gcs
