@@ -46,6 +46,7 @@ ClassicBuild::ClassicBuild(const Rig& rig, uint32_t contours, uint32_t rays, flo
   countContours();
   sortWeldedEdges();
   analysedParts = model->parts;
+  partTriangles.resize(J);
 }
 
 ClassicModel* ClassicBuild::build(const std::vector<uint8_t>* carry) {
@@ -394,28 +395,51 @@ void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, 
   const ClassicPart& P = m.parts[j];
   out.assign(size_t(count) * k, -1.0f);  // no hit yet
   outTriangles.assign(size_t(count) * k, 0);
-  corners.clear();
-  cornerTriangle.clear();
-  for (uint32_t x = 0; x < J; ++x) {
-    if (x != j && !(P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) continue;
-    for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i) {
-      for (int e = 0; e < 3; ++e) corners.push_back(rig.positions[rig.indices[size_t(triList[i]) * 3 + e]]);
-      cornerTriangle.push_back(triList[i]);
-    }
+  // The triangles it casts against, gathered once per set of parts (a trunk part's set changes as
+  // its branch children are carried) and kept across rebuilds.
+  gathered.clear();
+  for (uint32_t x = 0; x < J; ++x)
+    if (x == j || (P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) gathered.push_back(x);
+  PartTriangles& own = partTriangles[j];
+  if (!own.valid || own.parts != gathered) {
+    own.valid = true;
+    own.parts = gathered;
+    own.corners.clear();
+    own.triangle.clear();
+    own.casts.clear();
+    for (uint32_t x : gathered)
+      for (uint32_t i = triFirst[x]; i < triFirst[x + 1]; ++i) {
+        for (int e = 0; e < 3; ++e) own.corners.push_back(rig.positions[rig.indices[size_t(triList[i]) * 3 + e]]);
+        own.triangle.push_back(triList[i]);
+      }
+    own.slabs.build(own.corners.data(), uint32_t(own.triangle.size()), rig.jointCentres[P.joint], P.axis);
   }
-  const uint32_t triCount = uint32_t(corners.size() / 3);
+  // The same contours were cast before (by an earlier round, or the build before the on-skin
+  // test carried a part elsewhere): the same result.
+  for (const PartTriangles::Cast& c : own.casts)
+    if (c.count == count && c.tLo == P.tLo && c.tHi == P.tHi && c.nProx == nProx && c.nDist == nDist) {
+      out = c.radii, outTriangles = c.triangles;
+      hitCount += c.hitCount, inRangeHits += c.inRangeHits, inRangeRays += c.inRangeRays;
+      return;
+    }
+  PartTriangles::Cast cast{count, P.tLo, P.tHi, nProx, nDist, {}, {}, 0, 0, 0};
   for (uint32_t i = 0; i < count; ++i) {
     float t = P.tLo + (P.tHi - P.tLo) * float(i) / float(count - 1);
     glm::vec3 O, n, u;
     contourFrame(P, t, nProx, nDist, O, n, u);
     float* rad = &out[size_t(i) * k];
     uint32_t* tri = &outTriangles[size_t(i) * k];
-    castContour(corners.data(), triCount, O, n, u, glm::cross(n, u), k, m.cosTable.data(), m.sinTable.data(), rad, tri);
-    for (uint32_t r = 0; r < k; ++r) tri[r] = rad[r] > 0.0f ? cornerTriangle[tri[r]] : 0;
+    own.slabs.candidates(O, n, cut);
+    castContour(own.corners.data(), cut.data(), uint32_t(cut.size()), O, n, u, glm::cross(n, u), k, m.cosTable.data(),
+                m.sinTable.data(), rad, tri);
+    for (uint32_t r = 0; r < k; ++r) tri[r] = rad[r] > 0.0f ? own.triangle[tri[r]] : 0;
     uint32_t h = rejectOutliers(rad, k, scratch);
-    hitCount += h;
-    if (t >= -1e-4f && t <= 1.0001f) inRangeHits += h, inRangeRays += k;
+    cast.hitCount += h;
+    if (t >= -1e-4f && t <= 1.0001f) cast.inRangeHits += h, cast.inRangeRays += k;
   }
+  hitCount += cast.hitCount, inRangeHits += cast.inRangeHits, inRangeRays += cast.inRangeRays;
+  cast.radii = out, cast.triangles = outTriangles;
+  own.casts.push_back(std::move(cast));
 }
 
 // P's distal joint contour is shared with its child.
@@ -856,6 +880,12 @@ void ClassicBuild::contourInfluences() {
     std::vector<uint32_t> cursor(vertexFirst.begin(), vertexFirst.end() - 1);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) vertexList[cursor[partOf[v]]++] = v;
   }
+  // The vertices of a contour's part and its neighbours, sorted along the part's bone: a contour
+  // reads only those that can lie within its window, then takes them in part, vertex order (the
+  // order of the sums: the same rounding whatever is skipped).
+  std::vector<std::pair<float, uint32_t>> along;  // (position along the bone, rig vertex)
+  std::vector<std::pair<uint32_t, uint32_t>> nearby;  // (part, rig vertex)
+  int32_t alongPart = -1, alongProximal = -1;
   for (ClassicContour& c : m.contours) {
     const ClassicPart& P = m.parts[c.part];
     auto near = [&](uint32_t x) {
@@ -863,16 +893,37 @@ void ClassicBuild::contourInfluences() {
         return true;
       return P.split && m.parts[x].isPart && member(c.part, x);
     };
+    const glm::vec3 base = rig.jointCentres[P.joint];
+    if (alongPart != c.part || alongProximal != c.proximal) {
+      along.clear();
+      for (uint32_t x = 0; x < J; ++x)
+        if (m.parts[x].isPart && near(x))
+          for (uint32_t i = vertexFirst[x]; i < vertexFirst[x + 1]; ++i)
+            along.push_back({glm::dot(rig.positions[vertexList[i]] - base, P.axis), vertexList[i]});
+      std::sort(along.begin(), along.end());
+      alongPart = c.part, alongProximal = c.proximal;
+    }
     float reach = 0.0f;
     for (uint32_t r = 0; r < k; ++r) reach = std::max(reach, m.radii[c.radii + r]);
     reach = 1.25f * reach + 1e-6f * m.height;
     float window = 0.5f * P.length * std::max(P.tHi - P.tLo, 1e-3f) / float(std::max<uint32_t>(P.contourCount - 1, 1));
+    const float cosTilt = std::fabs(glm::dot(c.normal, P.axis)), sinTilt = std::sqrt(std::max(0.0f, 1.0f - cosTilt * cosTilt));
+    const float centre = glm::dot(c.centre - base, P.axis);
     float total = 0.0f;
     for (int attempt = 0; attempt < 4 && total <= 0.0f; ++attempt, window *= 2.0f) {
-      for (uint32_t x0 = 0; x0 < J; ++x0) {
-        if (!m.parts[x0].isPart || !near(x0)) continue;
-        for (uint32_t i = vertexFirst[x0]; i < vertexFirst[x0 + 1]; ++i) {
-        const uint32_t v = vertexList[i];
+      // A vertex in the window lies within √(window² + reach²) of the centre, so within
+      // (window + that · sin tilt) / cos tilt of it along the bone.
+      auto lo = along.begin(), hi = along.end();
+      if (cosTilt > 0.2f) {
+        const float extent = (window + std::sqrt(window * window + reach * reach) * sinTilt) / cosTilt * 1.001f + 1e-5f * m.height;
+        lo = std::lower_bound(along.begin(), along.end(), std::make_pair(centre - extent, 0u));
+        hi = std::upper_bound(lo, along.end(), std::make_pair(centre + extent, UINT32_MAX));
+      }
+      nearby.clear();
+      for (auto it = lo; it != hi; ++it) nearby.push_back({partOf[it->second], it->second});
+      std::sort(nearby.begin(), nearby.end());
+      for (const auto& pv : nearby) {
+        const uint32_t v = pv.second;
         glm::vec3 x = rig.positions[v] - c.centre;
         float h = glm::dot(x, c.normal);
         if (std::fabs(h) > window || glm::length(x - h * c.normal) > reach) continue;
@@ -884,7 +935,6 @@ void ClassicBuild::contourInfluences() {
           sum[jj] += f * rig.weightAt(v, i);
         }
         total += f;
-        }
       }
     }
     // The four largest, renormalised; none found: the part's own joint.

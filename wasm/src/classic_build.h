@@ -8,6 +8,7 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "classic_model.h"
+#include "classic_rays.h"
 #include "rig.h"
 
 namespace gcs {
@@ -102,6 +103,24 @@ class ClassicBuild {
   std::vector<std::vector<int32_t>> branchOf;
   std::vector<WeldedEdge> edges;                // sorted by (lo, hi)
   std::vector<ClassicPart> analysedParts;       // the parts as step 3 leaves them
+  // Per part: the triangles its contours are cast against (castPart), kept across rebuilds.
+  struct PartTriangles {
+    bool valid = false;
+    std::vector<uint32_t> parts;                // whose triangles
+    std::vector<glm::vec3> corners;             // 3 per triangle, contiguous
+    std::vector<uint32_t> triangle;             // the rig triangle of each
+    classic::TriangleSlabs slabs;               // along the part's bone
+    struct Cast {                               // contours cast from them, and what they hit
+      uint32_t count;
+      float tLo, tHi;
+      glm::vec3 nProx, nDist;
+      std::vector<float> radii;
+      std::vector<uint32_t> triangles;
+      uint32_t hitCount, inRangeHits, inRangeRays;
+    };
+    std::vector<Cast> casts;
+  };
+  std::vector<PartTriangles> partTriangles;
 
   // One model (steps 4–9).
   std::unique_ptr<ClassicModel> model;
@@ -110,8 +129,7 @@ class ClassicBuild {
   std::vector<uint8_t> dirty;                    // parts whose ray test must run again
   std::vector<float> scratch, probe;
   std::vector<uint32_t> probeTriangles;
-  std::vector<glm::vec3> corners;                // castPart's gathered triangles
-  std::vector<uint32_t> cornerTriangle;          // … and the rig triangle of each
+  std::vector<uint32_t> gathered, cut;           // castPart's parts, and the triangles a contour may cut
   std::vector<Loop> loops;
   std::vector<uint8_t> triCarried;               // per rig triangle: it has a carried vertex
   std::vector<int32_t> gOwner;                   // per welded vertex: the part whose tube replaces it, or −1

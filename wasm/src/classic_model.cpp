@@ -20,7 +20,7 @@ float ClassicModel::stat(GcsStat which) const {
   return std::nanf("");
 }
 
-void ClassicModel::deform(const glm::mat4* skin) {
+ScaleState ClassicModel::poseRings(const glm::mat4* skin) {
   const uint32_t J = jointCount;
   const uint32_t k = rays;
   const ScaleState scale = decomposeAll(skin, J, poses.data());
@@ -58,6 +58,12 @@ void ClassicModel::deform(const glm::mat4* skin) {
     c.posedCentre = glm::vec3(pm * glm::vec4(c.centre, 1.0f));
     c.posedNormal = unitOr(glm::vec3(nm * glm::vec4(c.normal, 0.0f)), glm::vec3(0.0f, 1.0f, 0.0f));
   }
+  return scale;
+}
+
+void ClassicModel::deform(const glm::mat4* skin) {
+  const uint32_t k = rays;
+  const ScaleState scale = poseRings(skin);
   // Caps: rim copies and the centre, normal along the contour normal (outward).
   for (const ClassicCap& cap : caps) {
     const ClassicContour& c = contours[cap.contour];

@@ -89,13 +89,11 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
     if (eight) joints1[i] = rig.joints1[v], weights1[i] = rig.weights1[v];
   }
   std::vector<glm::mat4> skin;
-  std::vector<JointPose> poses(J);
   std::vector<std::vector<float>> distances(J);
   for (int probe = 0; probe < kProbes; ++probe) {  // (at the bind pose each ring vertex is its hit)
     probeSkin(rig, axes[probe], angles[probe], skin);
-    m.deform(skin.data());
-    const ScaleState scale = decomposeAll(skin.data(), J, poses.data());
-    dqsVertices(poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
+    const ScaleState scale = m.poseRings(skin.data());  // (the rings only: the rest is not tested)
+    dqsVertices(m.poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
                 eight ? weights1.data() : nullptr, rest.data(), restNormals.data(), posed.data(), posedNormals.data(), C);
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
@@ -123,7 +121,7 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
     if (worst > maxOff || p99 > p99Off) failed[j] = 1;
   }
   std::vector<glm::mat4> identity(J, glm::mat4(1.0f));
-  m.deform(identity.data());
+  m.poseRings(identity.data());
   return failed;
 }
 

@@ -12,12 +12,13 @@ constexpr float kOutlierFactor = 3.0f;     // a hit farther than 3 × the contou
 // Each triangle crossing the plane is cut into a 2D segment, and only the rays whose angle lies in
 // the segment's angular span are tested. The corners are gathered per part by the caller (the rig's
 // vertices are scattered, and every contour of the part reads every triangle).
-void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O, const glm::vec3& n,
-                 const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT, const float* sinT, float* radius,
-                 uint32_t* hitTriangle) {
+void castContour(const glm::vec3* corners, const uint32_t* triangles, uint32_t count, const glm::vec3& O,
+                 const glm::vec3& n, const glm::vec3& u, const glm::vec3& w, uint32_t k, const float* cosT,
+                 const float* sinT, float* radius, uint32_t* hitTriangle) {
   const float step = 2.0f * kPi / float(k);
   const float planeD = glm::dot(O, n);
-  for (uint32_t i = 0; i < triCount; ++i) {
+  for (uint32_t ti = 0; ti < count; ++ti) {
+    const uint32_t i = triangles[ti];
     const glm::vec3* c = &corners[size_t(i) * 3];
     // Most triangles lie on one side of the plane: sides first, relative positions only if cut.
     float h[3] = {glm::dot(c[0], n) - planeD, glm::dot(c[1], n) - planeD, glm::dot(c[2], n) - planeD};
@@ -50,9 +51,67 @@ void castContour(const glm::vec3* corners, uint32_t triCount, const glm::vec3& O
       if (std::fabs(denom) < 1e-12f) continue;
       float lambda = (P.x * E.y - P.y * E.x) / denom;
       float mu = (P.x * d.y - P.y * d.x) / denom;
-      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f && lambda > radius[r]) radius[r] = lambda, hitTriangle[r] = i;
+      if (lambda > 0.0f && mu >= -1e-4f && mu <= 1.0001f &&
+          (lambda > radius[r] || (lambda == radius[r] && i < hitTriangle[r])))
+        radius[r] = lambda, hitTriangle[r] = i;
     }
   }
+}
+
+void TriangleSlabs::build(const glm::vec3* corners, uint32_t count, const glm::vec3& o, const glm::vec3& a) {
+  origin = o, axis = a, triCount = count;
+  triLo.resize(count), triHi.resize(count);
+  float hi = -INFINITY;
+  lo = INFINITY, rmax = 0.0f;
+  for (uint32_t i = 0; i < count; ++i) {
+    float s0 = INFINITY, s1 = -INFINITY;
+    for (int e = 0; e < 3; ++e) {
+      const glm::vec3 d = corners[size_t(i) * 3 + e] - origin;
+      const float s = glm::dot(d, axis);
+      s0 = std::min(s0, s), s1 = std::max(s1, s);
+      const glm::vec3 r = d - s * axis;
+      rmax = std::max(rmax, glm::dot(r, r));  // (squared until the end)
+    }
+    triLo[i] = s0, triHi[i] = s1;
+    lo = std::min(lo, s0), hi = std::max(hi, s1);
+  }
+  rmax = std::sqrt(rmax);
+  // (a float margin: the cut test works on other rounded products than these)
+  margin = 1e-4f * (std::fabs(lo) + std::fabs(hi) + rmax) + 1e-30f;
+  slabCount = std::max<uint32_t>(1, std::min<uint32_t>(256, count / 16));
+  width = count && hi > lo ? (hi - lo) / float(slabCount) : 1.0f;
+  first.assign(slabCount + 1, 0);
+  for (uint32_t i = 0; i < count; ++i)
+    for (uint32_t b = slabOf(triLo[i]), e = slabOf(triHi[i]); b <= e; ++b) ++first[b + 1];
+  for (uint32_t b = 0; b < slabCount; ++b) first[b + 1] += first[b];
+  members.resize(first[slabCount]);
+  std::vector<uint32_t> cursor(first.begin(), first.end() - 1);
+  for (uint32_t i = 0; i < count; ++i)
+    for (uint32_t b = slabOf(triLo[i]), e = slabOf(triHi[i]); b <= e; ++b) members[cursor[b]++] = i;
+}
+
+uint32_t TriangleSlabs::slabOf(float s) const {
+  float x = (s - lo) / width;
+  return x <= 0.0f ? 0u : x >= float(slabCount - 1) ? slabCount - 1 : uint32_t(x);
+}
+
+void TriangleSlabs::candidates(const glm::vec3& O, const glm::vec3& n, std::vector<uint32_t>& out) const {
+  out.clear();
+  const float c = glm::dot(n, axis);
+  if (!(c > 0.2f)) {  // a plane far from perpendicular to the bone: every triangle
+    for (uint32_t i = 0; i < triCount; ++i) out.push_back(i);
+    return;
+  }
+  const float reach = rmax * std::sqrt(std::max(0.0f, 1.0f - c * c)) / c + margin;
+  const float s = glm::dot(O - origin, axis), s0 = s - reach, s1 = s + reach;
+  const uint32_t b0 = slabOf(s0), b1 = slabOf(s1);
+  for (uint32_t b = b0; b <= b1; ++b)
+    for (uint32_t m = first[b]; m < first[b + 1]; ++m) {
+      const uint32_t i = members[m];
+      // (a triangle in several slabs is taken from the first of them that the range reads)
+      if (std::max(slabOf(triLo[i]), b0) != b || triHi[i] < s0 || triLo[i] > s1) continue;
+      out.push_back(i);
+    }
 }
 
 uint32_t rejectOutliers(float* radius, uint32_t k, std::vector<float>& scratch) {
