@@ -169,14 +169,14 @@ void ClassicBuild::findChains() {
   }
 }
 
-  // Trunk parts that branch (pelvis, chest): resampled along the child that continues the trunk,
-  // on the side away from the other children (the branches), whose region stays carried.
-  // The continuing child: after a resampled-candidate parent, the one child whose own direction
-  // turns by at most 45° from the parent's bone (a chest's neck, not its shoulders); with no such
-  // parent, the one child whose siblings' joints lie behind a quarter of the bone to it and whose
-  // siblings' own directions all point away from its own (a pelvis's spine, the thighs below).
-  // branchOf[j][x]: for a split part j, the child of j whose subtree holds part x (−1: none or
-  // the continuing child's).
+// Trunk parts that branch (pelvis, chest): resampled along the child that continues the trunk,
+// on the side away from the other children (the branches), whose region stays carried.
+// The continuing child: after a resampled-candidate parent, the one child whose own direction
+// turns by at most 45° from the parent's bone (a chest's neck, not its shoulders); with no such
+// parent, the one child whose siblings' joints lie behind a quarter of the bone to it and whose
+// siblings' own directions all point away from its own (a pelvis's spine, the thighs below).
+// branchOf[j][x]: for a split part j, the child of j whose subtree holds part x (−1: none or
+// the continuing child's).
 void ClassicBuild::splitTrunk() {
   ClassicModel& m = *model;
   const float minBone = kMinBoneFraction * m.height;
@@ -223,8 +223,8 @@ void ClassicBuild::splitTrunk() {
   }
 }
 
-  // Reference directions: parallel-transported down each chain of candidates, so that the
-  // contour frames agree at shared contours; a chain starts from +Z (or +Y) projected.
+// Reference directions: parallel-transported down each chain of candidates, so that the
+// contour frames agree at shared contours; a chain starts from +Z (or +Y) projected.
 void ClassicBuild::transportFrames() {
   ClassicModel& m = *model;
     std::vector<uint8_t> done(J, 0);
@@ -864,11 +864,11 @@ void ClassicBuild::fillEmptyContours() {
     if (empty[c]) std::fill(m.radii.begin() + m.contours[c].radii, m.radii.begin() + m.contours[c].radii + k, 0.0f);
 }
 
-  // The skin each contour resamples, as influences: the mean weights of the input vertices of its
-  // part and its neighbours that lie around its plane (within half the contour spacing, widened
-  // where the mesh is coarse) and no farther from its centre than its rays reached. A ring then
-  // moves as that skin does, not as its bone's straight line (a twisting spine, a thigh whose
-  // skin the hip's weights bend).
+// The skin each contour resamples, as influences: the mean weights of the input vertices of its
+// part and its neighbours that lie around its plane (within half the contour spacing, widened
+// where the mesh is coarse) and no farther from its centre than its rays reached. A ring then
+// moves as that skin does, not as its bone's straight line (a twisting spine, a thigh whose
+// skin the hip's weights bend).
 void ClassicBuild::contourInfluences() {
   ClassicModel& m = *model;
   std::vector<float> sum(J, 0.0f);
@@ -976,9 +976,9 @@ void ClassicBuild::contourInfluences() {
   }
 }
 
-  // Caps: a tube end that meets neither a resampled neighbour nor the carried mesh is closed by a
-  // flat fan when the part's input skin has no border (a robot's finger plate); an open input
-  // (a sleeve) stays open.
+// Caps: a tube end that meets neither a resampled neighbour nor the carried mesh is closed by a
+// flat fan when the part's input skin has no border (a robot's finger plate); an open input
+// (a sleeve) stays open.
 void ClassicBuild::addCaps() {
   ClassicModel& m = *model;
   std::vector<uint8_t> bordered(J, 0);
@@ -1006,8 +1006,8 @@ void ClassicBuild::addCaps() {
 
 // ---------------------------------------------------------------- 6–9: the output
 
-  // 6. Carried triangles (those with a carried vertex): their vertices are copied and move
-  // by dual-quaternion skinning of their own weights; the copies are grouped by part (ranges per part).
+// 6. Carried triangles (those with a carried vertex): their vertices are copied and move
+// by dual-quaternion skinning of their own weights; the copies are grouped by part (ranges per part).
 void ClassicBuild::copyCarriedVertices() {
   ClassicModel& m = *model;
   outputOf.assign(rig.vertexCount, -1);
@@ -1055,8 +1055,8 @@ void ClassicBuild::copyCarriedVertices() {
   }
 }
 
-  // 7. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
-  // about the contour normal, which points distally), then the bands, then the carried triangles.
+// 7. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
+// about the contour normal, which points distally), then the bands, then the carried triangles.
 void ClassicBuild::buildTriangles() {
   ClassicModel& m = *model;
   for (uint32_t j = 0; j < J; ++j) {
@@ -1092,11 +1092,11 @@ void ClassicBuild::buildTriangles() {
   }
 }
 
-  // A band zips an end ring (traversed against the tube's use of its edges: decreasing angle at
-  // a proximal end, increasing at a distal one) to its loop (traversed as the carried triangles
-  // use its edges, which turns the same way on an outward-wound mesh), always advancing on the
-  // side whose next vertex comes first by angle: ring + loop vertices triangles, every edge of
-  // both used once, so the seam is closed whatever the two sides' vertex counts.
+// A band zips an end ring (traversed against the tube's use of its edges: decreasing angle at
+// a proximal end, increasing at a distal one) to its loop (traversed as the carried triangles
+// use its edges, which turns the same way on an outward-wound mesh), always advancing on the
+// side whose next vertex comes first by angle: ring + loop vertices triangles, every edge of
+// both used once, so the seam is closed whatever the two sides' vertex counts.
 void ClassicBuild::zipBand(const Loop& L) {
   ClassicModel& m = *model;
   std::vector<float> beta;
@@ -1154,8 +1154,8 @@ void ClassicBuild::zipBand(const Loop& L) {
   m.bands.push_back(band);
 }
 
-  // 8. The report (parts in joint order), contours per vertex, and the detail-loss inputs: the
-  // input vertices the tubes and bands replace.
+// 8. The report (parts in joint order), contours per vertex, and the detail-loss inputs: the
+// input vertices the tubes and bands replace.
 void ClassicBuild::writeReport() {
   ClassicModel& m = *model;
   for (uint32_t j = 0; j < J; ++j) {
