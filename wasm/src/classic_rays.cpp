@@ -80,6 +80,7 @@ void TriangleSlabs::build(const glm::vec3* corners, uint32_t count, const glm::v
   margin = 1e-4f * (std::fabs(lo) + std::fabs(hi) + rmax) + 1e-30f;
   slabCount = std::max<uint32_t>(1, std::min<uint32_t>(256, count / 16));
   width = count && hi > lo ? (hi - lo) / float(slabCount) : 1.0f;
+  if (!(std::isfinite(width) && width > 0.0f && std::isfinite(margin))) slabCount = 1, width = 1.0f;
   first.assign(slabCount + 1, 0);
   for (uint32_t i = 0; i < count; ++i)
     for (uint32_t b = slabOf(triLo[i]), e = slabOf(triHi[i]); b <= e; ++b) ++first[b + 1];
@@ -91,19 +92,21 @@ void TriangleSlabs::build(const glm::vec3* corners, uint32_t count, const glm::v
 }
 
 uint32_t TriangleSlabs::slabOf(float s) const {
-  float x = (s - lo) / width;
-  return x <= 0.0f ? 0u : x >= float(slabCount - 1) ? slabCount - 1 : uint32_t(x);
+  const float x = (s - lo) / width;
+  if (!(x > 0.0f)) return 0;  // (NaN too: a rig at the edge of float range)
+  return x < float(slabCount - 1) ? uint32_t(x) : slabCount - 1;
 }
 
 void TriangleSlabs::candidates(const glm::vec3& O, const glm::vec3& n, std::vector<uint32_t>& out) const {
   out.clear();
   const float c = glm::dot(n, axis);
-  if (!(c > 0.2f)) {  // a plane far from perpendicular to the bone: every triangle
+  const float reach = rmax * std::sqrt(std::max(0.0f, 1.0f - c * c)) / c + margin;
+  const float s = glm::dot(O - origin, axis), s0 = s - reach, s1 = s + reach;
+  // A plane far from perpendicular to the bone, one slab, or figures past float range: every triangle.
+  if (!(c > 0.2f) || slabCount == 1 || !std::isfinite(s0) || !std::isfinite(s1)) {
     for (uint32_t i = 0; i < triCount; ++i) out.push_back(i);
     return;
   }
-  const float reach = rmax * std::sqrt(std::max(0.0f, 1.0f - c * c)) / c + margin;
-  const float s = glm::dot(O - origin, axis), s0 = s - reach, s1 = s + reach;
   const uint32_t b0 = slabOf(s0), b1 = slabOf(s1);
   for (uint32_t b = b0; b <= b1; ++b)
     for (uint32_t m = first[b]; m < first[b + 1]; ++m) {
