@@ -113,6 +113,7 @@ class GcsDeformerImpl final : public Deformer {
   void sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale);
   void sectionTransformsWeightsUniform(const glm::mat4* skin, float s);
   void sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale);
+  void transformVertices(const float* inNrm, float* outPos, float* outNrm);
 };
 
 // Builds the GCS model of a rig. Returns null with the error recorded on failure.

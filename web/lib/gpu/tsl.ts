@@ -12,7 +12,7 @@
  */
 import {
   abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, mat4, max, min, normalGeometry, normalLocal,
-  positionGeometry, positionLocal, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
+  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
   uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
@@ -296,12 +296,23 @@ function sectionVertex(sections: TextureNode, first: Int, smooth: boolean): Vert
   };
 }
 
+/** How each vertex moves under one per-frame texture (joint poses or section transforms). */
+function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int): VertexTransform {
+  return sections.path === 'joints'
+    ? jointVertex({ joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first }, sections.smooth)
+    : sectionVertex(perFrame, first, sections.smooth);
+}
+
 /**
  * A node material's `positionNode` running GCS from `sections`: the deformed position, with
  * `normalLocal` and `tangentLocal` turned. Single mesh: it reads the morphed position and normal
  * (three.js morphs before positionNode). Crowd (`instanced`): three.js has already placed the
  * instance by then, so it starts from the bind-pose attributes and places the instance itself
  * with the mesh's own `instanceMatrix` (each instance's pose at `instanceIndex`).
+ *
+ * Velocity (a render pass whose MRT has `velocity`): `positionPrevious` gets the same vertex under
+ * the previous frame's texels (GpuSections.previousTexture), as three.js's skinning does with its
+ * previous bone matrices; a crowd places it with the current instance matrix.
  */
 export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node<'vec3'> {
   const perFrame = texture(sections.texture);
@@ -311,10 +322,14 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node
   return Fn((builder: NodeBuilder) => {
     const has = (name: string) => builder.geometry?.getAttribute(name) !== undefined;
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
-    const vertex = sections.path === 'joints'
-      ? jointVertex({ joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first }, sections.smooth)
-      : sectionVertex(perFrame, first, sections.smooth);
+    const vertex = vertexTransform(sections, perFrame, first);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
+    const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
+    if ((builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData()) {
+      OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
+      const previous = vertexTransform(sections, texture(sections.previousTexture()), first);
+      positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
+    }
     if (has('normal')) {
       const n = vertex.turn(instanced ? normalGeometry : normalLocal);
       normalLocal.assign(placement ? transformNormal(n, placement) : n);
@@ -323,7 +338,6 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node
       const t = vertex.turn(instanced ? tangentGeometry.xyz : tangentLocal);
       tangentLocal.assign(placement ? placement.mul(vec4(t, 0)).xyz : t);
     }
-    const p = vertex.position(instanced ? positionGeometry : positionLocal);
-    return placement ? placement.mul(vec4(p, 1)).xyz : p;
+    return place(vertex.position(instanced ? positionGeometry : positionLocal));
   })();
 }
