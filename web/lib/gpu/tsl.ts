@@ -18,7 +18,7 @@ import {
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import type { GpuSections } from './sections.js';
 
@@ -296,6 +296,20 @@ function sectionVertex(sections: TextureNode, first: Int, smooth: boolean): Vert
   };
 }
 
+/** Whether this build writes velocity (three.js asks for previous positions then). */
+const needsPreviousData = (builder: NodeBuilder): boolean => (builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData();
+
+/**
+ * The CPU backend's `positionNode` on WebGPURenderer: the deformed position as it is (wasm wrote
+ * it), and, in a velocity pass, `positionPrevious` from the deformer's previous positions.
+ */
+export function previousPositionNode(): Node<'vec3'> {
+  return Fn((builder: NodeBuilder) => {
+    if (needsPreviousData(builder)) positionPrevious.assign(attribute<'vec3'>(PREVIOUS_POSITION_ATTRIBUTE, 'vec3'));
+    return positionLocal;
+  })();
+}
+
 /** How each vertex moves under one per-frame texture (joint poses or section transforms). */
 function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int): VertexTransform {
   return sections.path === 'joints'
@@ -325,7 +339,7 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node
     const vertex = vertexTransform(sections, perFrame, first);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
-    if ((builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData()) {
+    if (needsPreviousData(builder)) {
       OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
       const previous = vertexTransform(sections, texture(sections.previousTexture()), first);
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
