@@ -231,8 +231,9 @@ describe.skipIf(!!reason || !!noCesium8)('velocity on WebGPURenderer: a velocity
   // A crowd in plain mode: with velocity, three.js adds the previous instance matrices (4 vertex
   // attributes) to the crowd's 4 + 4, and the smooth mode's two section attributes would pass
   // WebGL2's 16 (docs/gpu.md).
-  for (const kind of ['joints', 'sections', 'crowd'] as const) {
-    test(`CesiumMan walking, ${kind === 'crowd' ? 'a crowd of one (plain)' : `GPU backend, ${kind} path`}: velocity as three.js's skinning writes it; paused, zero`, async () => {
+  for (const kind of ['joints', 'sections', 'cpu', 'crowd'] as const) {
+    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : `GPU backend, ${kind} path`;
+    test(`CesiumMan walking, ${what}: velocity as three.js's skinning writes it; paused, zero`, async () => {
       const r = await call<{ backends: string[]; vsThree: number; moving: number; largest: number; pausedLargest: number; threePausedLargest: number }>(
         'velocity', `/@fs${CESIUM_8_SOURCE}`, kind, 0.5, 1 / 30, kind === 'crowd' ? { smooth: false } : {});
       console.log(`velocity ${kind}: ${(100 * r.vsThree).toFixed(2)} % of the pixels differ from three.js's skinning (> 1 px or 10 %); ${(100 * r.moving).toFixed(1)} % of ours move > 1 px, the most ${r.largest.toFixed(2)} px; paused: ours ${r.pausedLargest.toExponential(2)} px, three's ${r.threePausedLargest.toExponential(2)} px`);
