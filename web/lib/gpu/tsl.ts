@@ -91,20 +91,25 @@ const gcsTrace = Fn(([a, b]: [Mat3, Mat3]) =>
  * A section's blended pose, in a joint's texel layout: columns 0–2 the rows of [M | t], column 3
  * the blended rotation quaternion (not normalised). The dual-quaternion blend of `slots` joint
  * poses at their weights (a joint past the last has weight 0: it adds nothing), each joint's scale
- * part K_j = R_jᵀ S_j blended linearly and applied first: M = R·K, the CPU's blendPoses.
+ * part K_j = R_jᵀ S_j blended linearly and applied first: M = R·K, the CPU's blendPoses. With a
+ * centre of rotation p (`centre`, w = 1; w = 0: none) it turns about p, moved where LBS moves it:
+ * t = Σ w_i (S_i p + t_i − p) − (M p − p).
  */
 function sectionBlendFunction(slots: TableSlots) {
   const lanes = ['x', 'y', 'z', 'w'] as const;
   const inputs = [
     ...Array.from({ length: slots }, (_, c) => ({ name: `p${c}`, type: 'mat4' })),
     ...Array.from({ length: slots / 4 }, (_, g) => ({ name: `w${g}`, type: 'vec4' })),
+    { name: 'centre', type: 'vec4' },
   ];
   return Fn((args: Node[]) => {
     const all = [...args]; // TSL hands the parameters as an iterable proxy
-    const poses = all.slice(0, slots) as Mat4[], weights = all.slice(slots) as Vec4[];
+    const poses = all.slice(0, slots) as Mat4[], weights = all.slice(slots, slots + slots / 4) as Vec4[];
+    const centre = all[slots + slots / 4] as Vec4;
     const pivot = column(poses[0], 3);
     const br = vec4(0).toVar(), bd = vec4(0).toVar();
     const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
+    const moved = vec3(0).toVar();
     for (let c = 0; c < slots; c++) {
       const p = poses[c], w = weights[c >> 2][lanes[c & 3]];
       const r0 = column(p, 0), r1 = column(p, 1), r2 = column(p, 2), q = column(p, 3);
@@ -114,10 +119,15 @@ function sectionBlendFunction(slots: TableSlots) {
       br.addAssign(q.mul(sw));
       bd.addAssign(d.mul(sw));
       k.addAssign(gcsRotation(q, float(2)).transpose().mul(s).mul(w));
+      moved.addAssign(s.mul(centre.xyz).add(t).sub(centre.xyz).mul(w));
     }
     const inv2 = float(1).div(dot(br, br)).toVar();
-    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2));
-    const rows = gcsRotation(br, inv2.mul(2)).mul(k).transpose().toVar();
+    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
+    const m = gcsRotation(br, inv2.mul(2)).mul(k).toVar();
+    If(centre.w.greaterThan(0.5), () => {
+      t.assign(moved.sub(m.mul(centre.xyz).sub(centre.xyz)));
+    });
+    const rows = m.transpose().toVar();
     return mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), br);
   }).setLayout({ name: `gcsSectionBlend${slots}`, type: 'mat4', inputs });
 }
@@ -203,8 +213,9 @@ interface Section { m: Mat3; t: Vec3; n: Mat3; renorm: Bool }
  * poses blended (gcsSectionBlend). Its normal matrix from the pose's rotation R and scale part K = Rᵀ M.
  */
 function section(inputs: JointInputs, s: Int): Section {
-  // Per 4 slots, a texel of joints (−1 past the last) then one of weights.
-  const row = s.mul(tableTexelsPerSection(inputs.slots)).toVar();
+  // Per 4 slots, a texel of joints (−1 past the last) then one of weights; last, the centre.
+  const texels = tableTexelsPerSection(inputs.slots);
+  const row = s.mul(texels).toVar();
   const joints: Vec4[] = [], weights: Vec4[] = [];
   for (let g = 0; g < inputs.slots / 4; g++) {
     joints.push(texel(inputs.table, row.add(2 * g)).toVar());
@@ -217,7 +228,8 @@ function section(inputs: JointInputs, s: Int): Section {
     for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(joints[c >> 2][lanes[c & 3]], 0))));
     // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
     const used = weights.map((w, g) => step(vec4(0), joints[g]).mul(w));
-    pose.assign(gcsSectionBlend[inputs.slots](...poses, ...used));
+    const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
+    pose.assign(gcsSectionBlend[inputs.slots](...poses, ...used, centre));
   });
   const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
   const m = mat3(r0.xyz, r1.xyz, r2.xyz).transpose().toVar();
