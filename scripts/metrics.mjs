@@ -322,17 +322,17 @@ if (args.json) {
 
 // ---------------------------------------------------------------- tables
 if (args.jointsMarkdown) {
-  // README: per character and joint at 135°, bulge p95 / max and volume change per method.
-  const keys = reports[0].joints.methods.map((m) => m.key);
-  const rows = [['character, joint', ...keys.map((k) => `bulge p95 / max ${k}`), `volume change % ${keys.join(' / ')}`]];
+  // README: per character and joint at 135°, bulge p95 / max per method, then the volume changes.
+  const methods = reports[0].joints.methods;
+  const rows = [['character, joint (135°)', ...methods.map((m) => `bulge p95 / max: ${m.key}`), `volume change %: ${methods.map((m) => m.key).join(' / ')}`]];
   for (const rep of reports) {
     const j = rep.joints;
     const at = j.angles.indexOf(135);
-    if (!j.joints.length) rows.push([`${rep.name}: ${j.notes.join('; ') || 'no knee or elbow found'}`, ...keys.map(() => ''), '']);
+    if (!j.joints.length) rows.push([`${rep.name}: ${j.notes.join('; ') || 'no knee or elbow found'}`, ...methods.map(() => ''), '']);
     for (const joint of j.joints) {
-      const f = (k) => (joint.methods[k].error ? null : joint.methods[k][at]);
-      rows.push([`${rep.name}, ${joint.hinge.label}`, ...keys.map((k) => (f(k) ? `${num(f(k).bulgeP95, 2)} / ${num(f(k).bulgeMax, 2)}` : 'n/a')),
-        keys.map((k) => (f(k) ? f(k).volumeChange.toFixed(1) : 'n/a')).join(' / ')]);
+      const f = ({ key }) => (joint.methods[key].error ? null : joint.methods[key][at]);
+      rows.push([`${rep.name}, ${joint.hinge.label}`, ...methods.map((m) => (f(m) ? `${num(f(m).bulgeP95, 2)} / ${num(f(m).bulgeMax, 2)}` : 'n/a')),
+        methods.map((m) => (f(m) ? f(m).volumeChange.toFixed(1) : 'n/a')).join(' / ')]);
     }
   }
   console.log(markdownTable(rows));

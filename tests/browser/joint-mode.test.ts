@@ -106,6 +106,23 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
     }
   }, 300000);
 
+  test('the comparison page\'s joint close-up button opens ?joint on the character on screen', async () => {
+    const { page, errors } = await openDemoPage(context, server, '?model=cesiumman');
+    try {
+      await Promise.all([
+        page.waitForURL(/[?&]joint(&|=|$)/),
+        page.locator('.lil-gui .controller').filter({ has: page.locator('.name', { hasText: 'joint close-up (knees, elbows) ↗' }) }).locator('button').click(),
+      ]);
+      await page.waitForFunction(() => (window as unknown as { __demo?: { ready: Promise<void> } }).__demo !== undefined);
+      await page.evaluate(() => window.__demo.ready);
+      expect(new URL(page.url()).searchParams.get('model')).toBe('cesiumman');
+      expect(await hook(page).joints()).toEqual(['left knee', 'right knee', 'left elbow', 'right elbow']);
+      expect(errors).toEqual([]);
+    } finally {
+      await page.close();
+    }
+  }, 300000);
+
   test('CesiumMan (no bone names): two knees and two elbows found, a knee bent to 135° measured in every view', async () => {
     const { page, errors } = await openDemoPage(context, server, '?joint=right%20knee&model=cesiumman&bend=135');
     try {

@@ -46,7 +46,7 @@ export interface JointMethod {
 }
 
 /** The methods the report compares at the joints, built as `buildMethod` builds them. */
-export const JOINT_METHOD_NAMES: readonly MethodName[] = ['gcs', 'gcs-plain', 'classic', 'lbs', 'dqs'];
+export const JOINT_METHOD_NAMES: readonly MethodName[] = ['gcs', 'dqs', 'lbs', 'gcs-plain', 'classic'];
 
 export function jointMethods(settings: BuildSettings = {}, names: readonly MethodName[] = JOINT_METHOD_NAMES): JointMethod[] {
   return names.map((m) => ({ key: m, label: METHOD_LABELS[m], build: (rig: Rig) => buildMethod(rig, m, settings) }));
@@ -356,7 +356,7 @@ export interface JointResult {
 }
 
 export interface JointsOptions {
-  /** Default: jointMethods() (GCS default and plain, classic, LBS, DQS). */
+  /** Default: jointMethods() (GCS default, DQS, LBS, GCS plain, classic). */
   methods?: readonly JointMethod[];
   /** Default JOINT_ANGLES. */
   angles?: readonly number[];
