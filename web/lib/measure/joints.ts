@@ -436,8 +436,8 @@ export function jointTableRows(m: JointsMeasure, degrees = Math.max(...m.angles)
   const at = m.angles.indexOf(degrees);
   const f2 = (x: number) => (Number.isFinite(x) ? x.toFixed(2) : String(x));
   const f1 = (x: number) => (Number.isFinite(x) ? (Math.abs(x) < 0.05 ? 0 : x).toFixed(1) : String(x));
-  const rows = [['joint', 'method', `volume % ${m.angles.map((a) => `${a}°`).join(' / ')}`, `bulge p95 / max ${degrees}°`,
-    `collapse p5 / min ${degrees}°`, 'creases', 'new self-x']];
+  const rows = [['joint', 'method', `volume % ${m.angles.map((a) => `${a}°`).join('/')}`, `bulge p95/max ${degrees}°`,
+    `collapse p5/min ${degrees}°`, 'creases', 'new self-x']];
   for (const j of m.joints) {
     m.methods.forEach(({ key }, i) => {
       const r = j.methods[key];
