@@ -1,7 +1,8 @@
 /**
- * Joints measured one at a time (docs/report-json.md, "joints"): a knee or elbow (measure/hinges.ts)
- * bent alone from the bind pose about its hinge, everything else at rest, and its region — the
- * triangles with weight on the bent joint or its parent — compared posed against bind:
+ * Joints measured one at a time (docs/report-json.md, "Joints"; docs/method.md): a knee or elbow
+ * (measure/hinges.ts) bent alone from the bind pose about its hinge, everything else at rest, and
+ * its region — the triangles with a vertex weighted on the bent joint or its parent and nearest (at
+ * bind) to the limb's bones at the hinge — compared posed against bind:
  * - volume change: the sum of signed cone volumes a·(b×c)/6 about the joint centre (which the bend
  *   leaves in place; a rigid motion about it keeps every cone), % of the bind value;
  * - bulge: each region vertex's distance to the nearest posed bone segment over the same at bind
