@@ -43,6 +43,8 @@ interface Shown {
   rig: JointRig;
   /** Per view, one SkinDeformer per skinned mesh of the character; [0] is the one of rig.mesh. */
   skins: Record<ViewKind, SkinDeformer[]>;
+  /** Every view's skins in one list (the frame loop updates them). */
+  all: SkinDeformer[];
 }
 
 const params = {
@@ -180,12 +182,12 @@ function install(name: string, object: THREE.Object3D, normalise: boolean): void
   }
   for (const src of sources) src.layers.disableAll(); // drawn by the three views' meshes only
   const old = shown;
-  shown = { name, holder, rig, skins };
+  shown = { name, holder, rig, skins, all: VIEWS.flatMap((v) => skins[v.kind]) };
   scene.add(holder);
-  for (const list of Object.values(skins)) for (const s of list) scene.add(s.mesh);
+  for (const s of shown.all) scene.add(s.mesh);
   if (old) {
     scene.remove(old.holder);
-    for (const list of Object.values(old.skins)) for (const s of list) { s.mesh.removeFromParent(); s.dispose(); }
+    for (const s of old.all) { s.mesh.removeFromParent(); s.dispose(); }
     disposeObject(old.holder);
   }
   clearMessage();
@@ -258,28 +260,32 @@ function frameJoint(): void {
 
 // ----------------------------------------------------------------------------------- drawing and text
 
-function viewWidth(): number {
-  return Math.floor((window.innerWidth - (Number.parseFloat(getComputedStyle(document.documentElement).getPropertyValue('--sidebar')) || 0)) / VIEWS.length);
+let rects: { kind: ViewKind; x: number; width: number }[] = [];
+
+/** Each view's column of the canvas, left to right (px); recomputed on resize only (draw() reads it every frame). */
+export function jointViewRects(): readonly { kind: ViewKind; x: number; width: number }[] {
+  return rects;
 }
 
-/** Each view's column of the canvas, left to right (px). */
-export function jointViewRects(): { kind: ViewKind; x: number; width: number }[] {
-  const w = viewWidth();
-  return VIEWS.map((v, i) => ({ kind: v.kind, x: i * w, width: w }));
+function viewWidth(): number {
+  return rects[0]?.width ?? window.innerWidth / VIEWS.length;
 }
 
 function layout(): void {
   const width = applySidebar();
   renderer.setSize(width, window.innerHeight);
+  const w = Math.floor(width / VIEWS.length);
+  rects = VIEWS.map((v, i) => ({ kind: v.kind, x: i * w, width: w }));
   updateText();
 }
 
 function draw(): void {
   controls.update();
-  if (shown) for (const list of Object.values(shown.skins)) for (const s of list) s.update();
+  if (shown) for (const s of shown.all) s.update();
   const h = window.innerHeight;
   renderer.setScissorTest(true);
-  for (const [i, r] of jointViewRects().entries()) {
+  for (let i = 0; i < rects.length; i++) {
+    const r = rects[i];
     renderer.setViewport(r.x, 0, r.width, h);
     renderer.setScissor(r.x, 0, r.width, h);
     camera.aspect = r.width / h;
@@ -329,7 +335,7 @@ export const jointHook = {
   load: async (key: string) => { await load(key); await settled(); },
   /** The figures under each view (null: none measured). */
   readouts: () => ({ ...figures }),
-  views: jointViewRects,
+  views: () => [...rects],
   frame: () => frameCount,
   error: shownMessage,
 };
