@@ -4,6 +4,7 @@
 // `vite preview` and photographs it in headless Chromium (SwiftShader); the control column is cut off.
 //
 //   node scripts/screenshot-joints.mjs            → docs/joints-elbow.png (our human's left elbow at 135°),
+//                                                 docs/joints-elbow-centres.png (the same, GCS with centres of rotation),
 //                                                 docs/joints-knee.png (its left knee at 135°),
 //                                                 docs/joints-cesiumman.png (CesiumMan's right knee at 135°)
 //   node scripts/screenshot-joints.mjs --out DIR  → the same files in DIR
@@ -16,6 +17,7 @@ const outIndex = process.argv.indexOf('--out');
 const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
 const shots = [
   { file: 'joints-elbow.png', query: '?joint=left%20elbow&bend=135' },
+  { file: 'joints-elbow-centres.png', query: '?joint=left%20elbow&bend=135&centres=1' },
   { file: 'joints-knee.png', query: '?joint=left%20knee&bend=135' },
   { file: 'joints-cesiumman.png', query: '?joint=right%20knee&model=cesiumman&bend=135' },
 ];

@@ -16,6 +16,7 @@ interface Figures { volumeChange: number; bulgeP95: number; bulgeMax: number; co
 interface JointHook {
   joints(): string[]; joint(): string; character(): string; choose(label: string): Promise<void>; bend(degrees: number): Promise<void>;
   readouts(): Record<'gcs' | 'dqs' | 'lbs', Figures | null>; views(): { kind: string; x: number; width: number }[]; error(): string;
+  centres(on: boolean): Promise<void>;
 }
 const hook = (page: Page) => ({
   joints: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.joints()),
@@ -23,6 +24,7 @@ const hook = (page: Page) => ({
   bend: (deg: number) => page.evaluate((d) => (window.__demo as unknown as { joint: JointHook }).joint.bend(d), deg),
   readouts: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.readouts()),
   views: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.views()),
+  centres: (on: boolean) => page.evaluate((o) => (window.__demo as unknown as { joint: JointHook }).joint.centres(o), on),
 });
 
 /**
@@ -99,6 +101,15 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
       // The bend shows: every view changed from the unbent picture.
       for (const v of [gcsView, dqsView, lbsView]) expect(await viewDifference(page, bent, v, v, flat)).toBeGreaterThan(0.02);
       await expect(page.locator('.readout[data-view=lbs]').innerText()).resolves.toMatch(/volume -\d+\.\d %/);
+      // Centres of rotation in the GCS view: less bulge than the default (measured 1.03 against 1.09), the label says so.
+      await j.centres(true);
+      const withCentres = (await j.readouts()).gcs!;
+      expect(withCentres.bulgeP95).toBeLessThan(r.gcs!.bulgeP95 - 0.03);
+      await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/GCS \(centres of rotation\)/);
+      const centresShot = await page.screenshot();
+      expect(await viewDifference(page, centresShot, gcsView, gcsView, bent)).toBeGreaterThan(0.001);
+      await j.centres(false);
+      expect((await j.readouts()).gcs!.bulgeP95).toBeCloseTo(r.gcs!.bulgeP95, 6);
       expect(await page.evaluate(() => window.__demo.error())).toBe('');
       expect(errors).toEqual([]);
     } finally {

@@ -209,7 +209,7 @@ describe('every method at the joints of our human', () => {
     console.log(`joints.test: measureJoints on our human (${rig.vertexCount} vertices, ${m.joints.length} joints, ${m.methods.length} methods, 3 angles): ${(performance.now() - t0).toFixed(0)} ms`);
     rig.dispose();
     expect(m.joints.map((j) => j.hinge.label)).toEqual(['left knee (LeftLeg)', 'right knee (RightLeg)', 'left elbow (LeftForeArm)', 'right elbow (RightForeArm)']);
-    expect(m.methods.map((x) => x.key)).toEqual(['gcs', 'dqs', 'lbs', 'gcs-plain', 'classic']);
+    expect(m.methods.map((x) => x.key)).toEqual(['gcs', 'gcs-centres', 'dqs', 'lbs', 'gcs-plain', 'classic']);
     for (const j of m.joints) {
       expect(j.regionTriangles).toBeGreaterThan(500);
       const lbs = j.methods.lbs as JointFigures[], dqs = j.methods.dqs as JointFigures[];

@@ -6,6 +6,7 @@
 // any dropped character with two legs and two arms works, named bones or not.
 //
 // URL: ?joint[=left knee|right elbow|…] &model=human|fox|cesiumman|robot|URL &bend=DEG (0 … 150)
+//      &centres=1 (the GCS view with centres of rotation per node)
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
@@ -23,7 +24,7 @@ import { findJointRig, jointFigures, poseBend, type JointRig } from './joint-pos
 
 /** The three views, left to right, and the camera layer of each one's meshes. */
 const VIEWS = [
-  { kind: 'gcs', method: 'gcs', layer: 1, title: 'GCS (default)', sub: 'gcs-skin: generalized cross-sections, weights criterion' },
+  { kind: 'gcs', method: 'gcs', layer: 1, title: 'GCS', sub: 'gcs-skin: generalized cross-sections, weights criterion' },
   { kind: 'dqs', method: 'dqs', layer: 2, title: 'DQS', sub: 'dual-quaternion skinning (Blender\'s "preserve volume")' },
   { kind: 'lbs', method: 'lbs', layer: 3, title: 'LBS', sub: 'linear blend skinning (three.js, Babylon)' },
 ] as const;
@@ -51,6 +52,8 @@ const params = {
   model: 'human',
   joint: '',
   bend: Math.min(MAX_BEND, Math.max(0, Number(query.get('bend') ?? 90) || 0)),
+  /** The GCS view with centres of rotation per node (GcsOptions.centres; off: the default). */
+  centres: query.has('centres') && query.get('centres') !== '0',
 };
 let gcs: GcsSkin;
 let renderer: THREE.WebGLRenderer;
@@ -114,6 +117,7 @@ function initGui(): void {
   jointController = gui.add(params, 'joint', ['(none)']).name('joint') as unknown as typeof jointController;
   jointController.onChange(() => selectJoint(params.joint));
   gui.add(params, 'bend', 0, MAX_BEND, 1).name('bend (degrees)').onChange(() => bend(params.bend));
+  gui.add(params, 'centres').name('GCS: centres of rotation').onChange(() => setCentres(params.centres));
   gui.add({ back: () => { location.search = '' ; } }, 'back').name('← the comparison page');
 }
 
@@ -171,7 +175,7 @@ function install(name: string, object: THREE.Object3D, normalise: boolean): void
     for (const v of VIEWS) {
       skins[v.kind] = [];
       for (const src of ordered) {
-        const s = new SkinDeformer(gcs, src, { method: v.method, backend: 'cpu', material: src.material });
+        const s = new SkinDeformer(gcs, src, { method: v.method, backend: 'cpu', material: src.material, gcs: { centres: params.centres } });
         s.mesh.layers.set(v.layer);
         skins[v.kind].push(s);
       }
@@ -208,6 +212,18 @@ function selectJoint(label: string): void {
   params.joint = label;
   jointController.updateDisplay();
   frameJoint();
+  bend(params.bend);
+}
+
+/** Rebuilds the GCS view with or without centres of rotation, and measures it again. */
+function setCentres(on: boolean): void {
+  params.centres = on;
+  if (!shown) return;
+  try {
+    for (const s of shown.skins.gcs) s.rebuild('gcs', { gcs: { centres: on } });
+  } catch (e) {
+    showMessage(`GCS: ${describeError(e)}`);
+  }
   bend(params.bend);
 }
 
@@ -304,7 +320,8 @@ function updateText(): void {
   const f2 = (x: number) => (Number.isFinite(x) ? x.toFixed(2) : '—');
   jointViewRects().forEach((r, i) => {
     const v = VIEWS[i];
-    top += `<div class="label" data-view="${v.kind}" style="left:${r.x + 10}px;max-width:${r.width - 20}px"><h2>${esc(v.title)}</h2>` +
+    const title = v.kind === 'gcs' ? `GCS (${params.centres ? 'centres of rotation' : 'default'})` : v.title;
+    top += `<div class="label" data-view="${v.kind}" style="left:${r.x + 10}px;max-width:${r.width - 20}px"><h2>${esc(title)}</h2>` +
       `<div class="sub">${esc(v.sub)}</div><div class="sub">${esc(shown?.name ?? '')}${hinge ? ` · ${esc(hinge.label)} bent ${params.bend}°` : ''}</div></div>`;
     if (i > 0) top += `<div class="divider" style="left:${r.x - 1}px"></div>`;
     const f = figures[v.kind];
@@ -332,6 +349,8 @@ export const jointHook = {
   character: () => shown?.name ?? '',
   choose: async (label: string) => { selectJoint(label); await settled(); },
   bend: async (degrees: number) => { bend(Math.min(MAX_BEND, Math.max(0, degrees))); await settled(); },
+  /** The GCS view with (true) or without centres of rotation. */
+  centres: async (on: boolean) => { setCentres(on); await settled(); },
   load: async (key: string) => { await load(key); await settled(); },
   /** The figures under each view (null: none measured). */
   readouts: () => ({ ...figures }),

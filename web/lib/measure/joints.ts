@@ -49,9 +49,20 @@ export interface JointMethod {
 /** The methods the report compares at the joints, built as `buildMethod` builds them. */
 export const JOINT_METHOD_NAMES: readonly MethodName[] = ['gcs', 'dqs', 'lbs', 'gcs-plain', 'classic'];
 
-export function jointMethods(settings: BuildSettings = {}, names: readonly MethodName[] = JOINT_METHOD_NAMES): JointMethod[] {
-  return names.map((m) => ({ key: m, label: METHOD_LABELS[m], build: (rig: Rig) => buildMethod(rig, m, settings) }));
+/**
+ * The methods measured at the joints: `names` built as `buildMethod` builds them and, with
+ * `centres` (default true), GCS with centres of rotation (`centres: true`) right after the default.
+ */
+export function jointMethods(settings: BuildSettings = {}, names: readonly MethodName[] = JOINT_METHOD_NAMES, centres = true): JointMethod[] {
+  const list: JointMethod[] = names.map((m) => ({ key: m, label: METHOD_LABELS[m], build: (rig: Rig) => buildMethod(rig, m, settings) }));
+  if (centres) list.splice(names.includes('gcs') ? names.indexOf('gcs') + 1 : 0, 0, CENTRES_METHOD(settings));
+  return list;
 }
+
+/** GCS with centres of rotation per node (rig.buildGcs's `centres: true`), key 'gcs-centres'. */
+export const CENTRES_METHOD = (settings: BuildSettings = {}): JointMethod => ({
+  key: 'gcs-centres', label: 'GCS, centres of rotation', build: (rig: Rig) => rig.buildGcs({ sections: settings.sections, centres: true }),
+});
 
 /**
  * Skin matrices (J × 16) of the bind pose with `hinge.joint` and everything below it turned by
@@ -357,7 +368,7 @@ export interface JointResult {
 }
 
 export interface JointsOptions {
-  /** Default: jointMethods() (GCS default, DQS, LBS, GCS plain, classic). */
+  /** Default: jointMethods() (GCS default, GCS with centres of rotation, DQS, LBS, GCS plain, classic). */
   methods?: readonly JointMethod[];
   /** Default JOINT_ANGLES. */
   angles?: readonly number[];
