@@ -68,7 +68,7 @@ describe("a library user: `npm install gcs-skin three` in an empty folder", () =
     })}`);
     expect(Object.keys(sizes.packages).sort()).toEqual(['gcs-skin', 'three']);
     // As the README quotes them (MB of 10^6 bytes on disk, the tarball in kB of 1000): within 5 % or the quote's rounding.
-    const [library, three, tarball] = quoted(/([\d.]+) MB of gcs-skin beside three's ([\d.]+) MB, where it was [\d.]+ MB with the glTF decoders\s+\(tarball (\d+) KB/);
+    const [library, three, tarball] = quoted(/([\d.]+) MB of gcs-skin beside three's ([\d.]+) MB, where it was [\d.]+ MB with the glTF\s+decoders\s+\(tarball (\d+) KB/);
     const measured = { library: sizes.packages['gcs-skin'] / 1e6, three: sizes.packages.three / 1e6, tarball: sizeOf(packed.library) / 1000 };
     expect({ library: quotes(library, measured.library), three: quotes(three, measured.three), tarball: quotes(tarball, measured.tarball) },
       `README: ${library} MB, three ${three} MB, tarball ${tarball} KB; measured ${JSON.stringify(measured)}`).toEqual({ library: true, three: true, tarball: true });

@@ -31,9 +31,9 @@ export function quotes(quoted: string, measured: number): boolean {
   return Math.abs(q - measured) <= Math.max(0.05 * measured, 0.5 * 10 ** -decimals);
 }
 
-/** The one match of `pattern` in the README (its capture groups), or a failure naming the pattern. */
+/** The one match of `pattern` in the README, read with its line breaks as spaces (its capture groups), or a failure naming the pattern. */
 export function quoted(pattern: RegExp): string[] {
-  const all = [...readme().matchAll(new RegExp(pattern.source, 'g'))];
+  const all = [...readme().replace(/\s+/g, ' ').matchAll(new RegExp(pattern.source, 'g'))];
   if (all.length !== 1) throw new Error(`README.md quotes ${pattern} ${all.length} times (once expected)`);
   return all[0].slice(1);
 }
