@@ -1,16 +1,16 @@
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
-// method, build ms, median ms per frame and the fidelity figures of design.md §7 (FidelityProbe
+// method, build ms, median ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe
 // over every sampled frame of every clip, distances in % of the character's height), and per clip
 // the frame time. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
-import { GcsError } from '../errors.js';
-import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../index.js';
-import { rigInputFromSkinnedMesh } from '../three.js';
+import { GcsError } from '../../../web/lib/errors.js';
+import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
+import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
-} from '../measure.js';
+} from '../../../web/lib/measure.js';
 
 export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--json]
   Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
