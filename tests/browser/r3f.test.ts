@@ -14,6 +14,10 @@ import type { ViteDevServer } from 'vite';
 import { readmeBlocks } from '../helpers/readme.js';
 import { analyse, launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
+declare global {
+  interface Window { __r3f: { frames(): number; layerMasks(): number[]; unmount(): void } }
+}
+
 const reason = skipReason();
 if (reason) console.log(reason);
 const model = join(MODELS_DIR, 'CesiumMan.glb');
