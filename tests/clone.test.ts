@@ -52,7 +52,11 @@ test("the README's tarball route as written, then the command line in a fresh cl
 
   // my-app holds both packages from their tarballs, and its npx gcs-skin runs the command line.
   const app = join(dir, 'my-app');
-  for (const pkg of ['gcs-skin/dist/three.js', '@gcs-skin/cli/dist/cli/report.js']) expect(existsSync(join(app, 'node_modules', pkg)), pkg).toBe(true);
+  const built = (pkg: string, entry: string) => {
+    const manifest = JSON.parse(readFileSync(join(app, 'node_modules', pkg, 'package.json'), 'utf8'));
+    return join(app, 'node_modules', pkg, manifest.exports[entry].import);
+  };
+  for (const file of [built('gcs-skin', './three'), built('@gcs-skin/cli', './report')]) expect(existsSync(file), file).toBe(true);
   bash('npx gcs-skin human --vertices 3000 -o model.glb && npx gcs-skin report model.glb --frames 4 --time-ms 5 --json > report.json', app);
   const report = JSON.parse(readFileSync(join(app, 'report.json'), 'utf8'));
   expect(report.meshes[0].methods.gcs.fidelity.nonFinite).toBe(0);
