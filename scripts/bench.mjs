@@ -312,7 +312,24 @@ function skinOfCurrentPose(mesh) {
     same.push(performance.now() - t0);
     d.dispose();
   }
-  const rebuild = { gcsMs: median(times), gcsSameMs: median(same), classicMs: null, classicError: null };
+  // Centres of rotation (opt-in, GcsOptions.centres): a first build on a fresh rig (its per-triangle
+  // data included), then section counts the slider has not built yet (their nodes' centres
+  // integrated), then the same counts again (the pair sums kept on the rig).
+  const fresh = gcs.createRig(input);
+  let t0 = performance.now();
+  fresh.buildGcs({ sections, centres: true }).dispose();
+  const centresFirstMs = performance.now() - t0;
+  const counts = [3, 4, 5, 6, 7, 8, 9].filter((n) => n !== sections).slice(0, 6);
+  const firstVisit = [], seen = [];
+  for (const list of [firstVisit, seen])
+    for (const n of counts) {
+      t0 = performance.now();
+      fresh.buildGcs({ sections: n, centres: true }).dispose();
+      list.push(performance.now() - t0);
+    }
+  fresh.dispose();
+  const rebuild = { gcsMs: median(times), gcsSameMs: median(same), classicMs: null, classicError: null,
+    centres: { firstBuildMs: centresFirstMs, newCountMs: median(firstVisit), seenCountMs: median(seen) } };
   const classic = [];
   try {
     for (let i = 0; i < (quick ? 2 : 5); i++) {
@@ -434,6 +451,9 @@ console.log(fmtTable(rows2));
 
 console.log(`\nRebuild, median: GCS ${ms(results.rebuild.gcsMs)} ms (section counts 3–8; same count ${ms(results.rebuild.gcsSameMs)} ms), ` +
   `classic resampling ${results.rebuild.classicMs === null ? `n/a (${results.rebuild.classicError.code}: ${results.rebuild.classicError.message})` : `${ms(results.rebuild.classicMs)} ms`}`);
+const cr = results.rebuild.centres;
+console.log(`Centres of rotation (option): first build ${ms(cr.firstBuildMs)} ms (per-triangle data included), rebuild ${ms(cr.newCountMs)} ms ` +
+  `at a section count not built before, ${ms(cr.seenCountMs)} ms at one built before (medians, counts 3–9)`);
 
 if (results.sizes.length) {
   console.log('\nScaling (walk; median ms per frame):');
