@@ -11,6 +11,7 @@ import { errorInfo, median, timeFrames, timeInterleaved } from '../dist/measure.
 import { JsGcs } from './bench/js-gcs.mjs';
 import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';
 import { crowdBench } from './bench/crowd.mjs';
+import { saveFigures } from './bench/figures.mjs';
 
 const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
   const n = Number(x.replace(/k$/i, '000').replace(/m$/i, '000000'));
@@ -26,6 +27,7 @@ try {
     sizes: { parse: sizesArg, default: null },
     sections: { parse: (s) => Number(s), default: 6 },
     crowdOnly: { type: 'flag', default: false },
+    save: { type: 'flag', default: false },
   });
 } catch (e) {
   console.error(`bench: ${e.message}`);
@@ -37,7 +39,8 @@ if (args.help) {
   --quick     shorter timing, small sizes only
   --json      machine-readable results on stdout
   --markdown  tables as markdown (for docs/benchmarks.md)
-  --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)`);
+  --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)
+  --save      write the figures the README quotes to docs/figures.json (tests/readme-figures.test.ts checks them)`);
   process.exit(0);
 }
 const quick = args.quick;
@@ -437,6 +440,7 @@ target('classic resampling (17 k)', results.rebuild.classicMs, '≤ 30 ms',
   results.rebuild.classicError ? `n/a: ${results.rebuild.classicError.code}: ${results.rebuild.classicError.message}` : '');
 
 results.targets.push(...results.crowd.targets);
+if (args.save) saveFigures(results, new URL('../docs/figures.json', import.meta.url));
 
 // ---------------------------------------------------------------- output
 if (args.json) {
