@@ -9,7 +9,8 @@
  *   2. gcs_build_*()         builds a runtime deformer from a rig (GCS, classic, LBS, DQS).
  *                            A deformer keeps no pointer to the rig: the rig may be destroyed.
  *   3. gcs_deformer_deform() once per frame, from J skinning matrices; writes positions and
- *                            normals into arrays owned by the deformer (no allocation).
+ *                            normals (and tangents, when set) into arrays owned by the deformer
+ *                            (no allocation).
  *   4. gcs_deformer_destroy(), gcs_rig_destroy().
  *
  * Errors: every function that can fail returns 0 (or a null handle) and records an error code
@@ -38,6 +39,13 @@
 extern "C" {
 #endif
 
+/* The version of this header and of the core built from it (the npm package's version):
+   major · 10000 + minor · 100 + patch, so 0.1.0 is 100. gcs_version() returns the built core's. */
+#define GCS_VERSION_MAJOR 0
+#define GCS_VERSION_MINOR 1
+#define GCS_VERSION_PATCH 0
+#define GCS_VERSION (GCS_VERSION_MAJOR * 10000 + GCS_VERSION_MINOR * 100 + GCS_VERSION_PATCH)
+
 typedef enum GcsError {
   GCS_OK = 0,
   GCS_ERR_INVALID_ARGUMENT = 1,   /* a null pointer, a bad enum value, a bad handle */
@@ -60,7 +68,10 @@ typedef enum GcsError {
 #define GCS_MAX_VERTICES 16777216
 #define GCS_MAX_INFLUENCES 8  /* skin influences (joint, weight pairs) per vertex: glTF JOINTS_0/1, WEIGHTS_0/1 */
 
-/* ---------------------------------------------------------------- errors and memory */
+/* ---------------------------------------------------------------- version, errors and memory */
+
+/* GCS_VERSION of the header the core was built from: a wrapper checks it against its own. */
+uint32_t gcs_version(void);
 
 /* The code of the last call's outcome (GCS_OK after a successful call). */
 int gcs_last_error_code(void);
@@ -139,6 +150,9 @@ typedef enum GcsDeformerKind {
  *                   around its weights, below). The JS API turns it on by default for the weights
  *                   criterion; zero there is the stepped, fastest level of detail.
  *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
+ *   centres         weights criterion, nonzero: every blended section turns about its centre of
+ *                   rotation (below) instead of moving by the dual-quaternion blend's translation.
+ *                   Ignored by Y / axial.
  *
  * Weights criterion (docs/method.md §2): welded vertices (same bind-pose position) are binned by their
  * weights (influences < 0.5 % dropped, renormalised; the non-dominant ones rounded to the grid, the
@@ -160,6 +174,19 @@ typedef enum GcsDeformerKind {
  * sums of its weights, joints by index; barycentric factors; gcs_gcs_blend_third /
  * gcs_gcs_blend_third_factor): continuous in every weight, and the corners are shared by the cell's
  * vertices (corners with a zero weight are two-joint nodes). Up to three nodes per welded vertex.
+ * Centres of rotation (weights criterion, `centres` nonzero; Le & Hodgins, "Real-time Skeletal Skinning
+ * with Optimized Centers of Rotation", SIGGRAPH 2016): a blended section of weights w has the centre
+ *   p* = Σ_t sim(w, v_t) a_t c_t / Σ_t sim(w, v_t) a_t,
+ *   sim(w, v) = Σ_{j<k} w_j w_k v_j v_k exp(−(w_j v_k − w_k v_j)² / 0.1²),
+ * over the rig's triangles t (bind-pose area a_t, centroid c_t, v_t the mean of its three corners'
+ * weights as the criterion reads them), computed once at build time (the per-triangle data is kept
+ * on the rig: rebuilding the same rig does not recompute it). Per frame the section keeps the 3×3
+ * part M = R·K of its blend (R from the normalised, hemisphere-aligned blend of its joints'
+ * rotations, K the blended scale parts: the same as without centres, so normals turn the same way)
+ * and takes the translation t = Σ w_j (S_j p* − p*) − (M p* − p*): M p* + t = Σ w_j S_j p*, the
+ * centre moves by linear blend skinning (identity poses give t = 0 exactly). A rigid core is S_j as
+ * ever; a section whose integral is empty (no triangle weighs on two of its joints) keeps the
+ * dual-quaternion blend. gcs_gcs_section_centres lists the centres.
  * Y / axial criteria (the paper, docs/method.md §4): parts by dominant weight, shared sections from
  * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
  * transform S_p · D_j^α · D_k^β on the rigid parts of the S_j (scale applied first).
@@ -171,7 +198,7 @@ typedef enum GcsDeformerKind {
  * gcs_deformer_source_vertex) with the rig's triangles remapped (gcs_deformer_indices).
  */
 GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
-                           float influenceWidth, int smooth, int twistSpread);
+                           float influenceWidth, int smooth, int twistSpread, int centres);
 /* Linear blend skinning and dual-quaternion skinning; output in the rig's vertex order.
    LBS: positions by Σ w_j S_j, normals by the same matrix then unit length (as three.js), the rest
    normal turned by the first joint's rotation where that matrix has collapsed.
@@ -212,7 +239,37 @@ int gcs_deformer_set_morph_targets(GcsDeformer* deformer, const float* deltas, c
    (O(vertices × non-zero targets) then). Returns 1, or 0 with the error recorded. */
 int gcs_deformer_set_morph_influences(GcsDeformer* deformer, const float* influences, uint32_t targetCount);
 
-/* The output mesh. Arrays are owned by the deformer and stay at the same address for its life. */
+/*
+ * Tangents (normal maps), deformed by the same gcs_deformer_deform call as positions and normals.
+ *   tangents      vertexCount × 4 floats in the RIG's vertex order (glTF TANGENT: xyz a unit
+ *                 direction, w = ±1 the bitangent's handedness); finite. Null removes them.
+ *   vertexCount   must equal the deformer's vertex count (the rig's); ignored when tangents is null.
+ * From then on every gcs_deformer_deform also writes gcs_deformer_tangents(): each xyz turned as the
+ * vertex's normal is (its normal matrix and length fix; a vanished one keeps its rest direction),
+ * its w carried. Until the next deform the output holds the rest tangents. GCS, LBS and DQS (the
+ * classic model resamples the mesh: GCS_ERR_INVALID_ARGUMENT). Replaces any previous tangents.
+ * Returns 1, or 0 with the error recorded (nothing changed).
+ */
+int gcs_deformer_set_tangents(GcsDeformer* deformer, const float* tangents, uint32_t vertexCount);
+/* vertexCount × 4 floats in the output order, or null when the deformer has no tangents. Owned by
+   the deformer; at the same address until the next gcs_deformer_set_tangents. */
+float* gcs_deformer_tangents(GcsDeformer* deformer);
+
+/*
+ * Previous positions (motion vectors: a velocity buffer needs each vertex where it was the frame
+ * before). keep = 1 gives the deformer a second positions array, holding the current positions;
+ * from then on each gcs_deformer_deform writes into the array that held the frame before last and
+ * swaps the two (no copy): gcs_deformer_positions() is this frame's, gcs_deformer_previous_positions()
+ * the last frame's. While kept, gcs_deformer_positions() alternates between the two addresses: read
+ * both pointers after every deform. keep = 0 frees the second array (positions then stay where they
+ * are). A rejected deform swaps nothing. Returns 1, or 0 with the error recorded (nothing changed).
+ */
+int gcs_deformer_keep_previous_positions(GcsDeformer* deformer, int keep);
+/* vertexCount × 3 floats: the positions of the deform before the last one, or null when not kept. */
+float* gcs_deformer_previous_positions(GcsDeformer* deformer);
+
+/* The output mesh. Arrays are owned by the deformer and stay at the same address for its life
+   (positions: see gcs_deformer_keep_previous_positions). */
 uint32_t gcs_deformer_vertex_count(const GcsDeformer* deformer);
 float* gcs_deformer_positions(GcsDeformer* deformer);   /* vertexCount × 3 */
 float* gcs_deformer_normals(GcsDeformer* deformer);     /* vertexCount × 3 */
@@ -328,6 +385,14 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
  */
 #define GCS_GPU_TEXELS_PER_JOINT 4
 const float* gcs_gcs_section_influences(const GcsDeformer* deformer);
+/*
+ * gcs_gcs_section_centres: sectionCount × 4 floats, one RGBA32F texel per section: its centre of
+ *   rotation (x, y, z, 1) in the bind pose (mesh space), or (0, 0, 0, 0) where the section has none
+ *   (a rigid core, a section whose integral is empty, every section of a deformer built without
+ *   centres). A section with a centre moves by M = R·K as above and t = Σ_i w_i (S_i p* − p*) −
+ *   (M p* − p*) (gcs_build_gcs). Null where gcs_gcs_section_influences is null.
+ */
+const float* gcs_gcs_section_centres(const GcsDeformer* deformer);
 uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* deformer);
 /*
  * Joint poses only, for instanceCount poses of the same model, packed for an RGBA32F texture; O(J)

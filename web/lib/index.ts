@@ -11,17 +11,31 @@
  * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
  * 'DISPOSED'. Every failure is a GcsError with a `code`.
  */
+import { DEFORMER_KINDS, STATS } from './core-enums.js';
 import { GcsError, type GcsErrorCode } from './errors.js';
 import { instantiateCore, type CoreExports, type WasmSource } from './loader.js';
+import { VERSION, versionNumber, versionString } from './version.js';
 
 export { GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
+export { version } from './version.js';
 
 export const MIN_SECTIONS = 3;
 /** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
 export const MAX_INFLUENCES = 8;
 export const MAX_SECTIONS = 256;
+/** GcsOptions.centres when not given. */
+const DEFAULT_CENTRES = false;
 export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
+
+/**
+ * Weights criterion: the steps of the weight grid at a section count, Q = 2·(sections − 2); node
+ * weights are multiples of 1/Q (6 sections → eighths; docs/method.md §2). The core uses the same
+ * formula (gcs_model.cpp); this is the one JavaScript copy.
+ */
+export function weightGridSteps(sections: number): number {
+  return 2 * (sections - 2);
+}
 
 type ArrayLikeNumbers = ArrayLike<number>;
 
@@ -79,6 +93,14 @@ export interface GcsOptions {
   smooth?: boolean;
   /** Y/axial only: spread a joint's twist along the child part. Default false. */
   twistSpread?: boolean;
+  /**
+   * Weights criterion: each blended section turns by its joints' blended rotation about its centre
+   * of rotation (Le & Hodgins 2016: the average of the bind-pose surface whose weights resemble
+   * the section's, computed once at build time), the centre moving by linear blend skinning: DQS's
+   * volume at a bent joint without its bulge. `false`: the dual-quaternion blend. Default false.
+   * Ignored by 'y' and 'axial'.
+   */
+  centres?: boolean;
 }
 
 export interface ClassicOptions {
@@ -90,8 +112,7 @@ export interface ClassicOptions {
   bulge?: number;
 }
 
-export type DeformerKind = 'gcs' | 'classic' | 'lbs' | 'dqs';
-const KINDS: DeformerKind[] = ['gcs', 'classic', 'lbs', 'dqs'];
+export type DeformerKind = (typeof DEFORMER_KINDS)[number];
 
 export interface SectionInfo {
   first: number;
@@ -183,7 +204,10 @@ export class GcsSkin {
   raise(fallback: string): never {
     const code = this.core.gcs_last_error_code();
     const message = this.readString(this.core.gcs_last_error_message()) || fallback;
-    throw new GcsError(GcsError.codeFromNumber(code), message);
+    const name = GcsError.codeFromNumber(code);
+    if (name === 'UNKNOWN_CORE_ERROR')
+      throw new GcsError(name, `the core failed with error code ${code}, which gcs-skin ${VERSION} does not know (is gcs-skin.wasm from another version?): ${message}`);
+    throw new GcsError(name, message);
   }
 
   private readString(ptr: number): string {
@@ -278,6 +302,11 @@ export async function initGcsSkin(options: { wasm?: WasmSource } = {}): Promise<
   } catch (e) {
     throw new GcsError('WASM_LOAD', `could not load gcs-skin.wasm: ${(e as Error).message}`);
   }
+  // A binary of another version would answer the same calls differently: refuse it here.
+  const coreVersion = typeof core.gcs_version === 'function' ? core.gcs_version() : null;
+  if (coreVersion !== versionNumber(VERSION))
+    throw new GcsError('WASM_LOAD', `gcs-skin.wasm is ${coreVersion === null ? 'from before 0.1.0 (no gcs_version)' : `version ${versionString(coreVersion)}`}, ` +
+      `but this gcs-skin is ${VERSION}: load the gcs-skin.wasm of the same package`);
   return new GcsSkin(core);
 }
 
@@ -348,8 +377,9 @@ export class Rig {
       throw new GcsError(typeof width === 'number' ? 'OUT_OF_RANGE' : 'INVALID_ARGUMENT', `the influence width must be a number in (0, 1]; got ${asGiven(width)}`);
     checkFlag(options.smooth, 'smooth');
     checkFlag(options.twistSpread, 'twistSpread');
+    checkFlag(options.centres, 'centres');
     const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
-      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0);
+      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0, (options.centres ?? DEFAULT_CENTRES) ? 1 : 0);
     if (!h) this.gcs.raise('the GCS model could not be built');
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }
@@ -419,12 +449,16 @@ export class Deformer {
   private morphPtr = 0;
   private morphCount = 0;
   private morphView: Float32Array = new Float32Array(0);
+  private tangentsPtr = 0;
+  /** keepPreviousPositions: the two arrays positions alternate between, as views (made once). */
+  private swapped: { ptr: number; view: Float32Array }[] | null = null;
+  private tangentsView: Float32Array | null = null;
 
   /** @internal */
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
     const core = gcs.core;
     this.handle = handle;
-    this.kind = KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
+    this.kind = DEFORMER_KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
     this.vertexCount = core.gcs_deformer_vertex_count(handle);
     this.jointCount = jointCount;
     this.positionsPtr = core.gcs_deformer_positions(handle);
@@ -447,9 +481,36 @@ export class Deformer {
   /** Deformed positions (vertexCount × 3): a view on wasm memory, re-created after growth. */
   get positions(): Float32Array {
     this.live();
+    if (this.swapped) return this.swappedView(this.gcs.core.gcs_deformer_positions(this.handle));
     if (this.positionsView.buffer !== this.gcs.memory.buffer)
       this.positionsView = this.gcs.viewF32(this.positionsPtr, this.vertexCount * 3);
     return this.positionsView;
+  }
+
+  /**
+   * Velocity: keep the previous frame's positions (`previousPositions`). The core then writes each
+   * frame into the array that held the frame before last and swaps the two, so `positions` and
+   * `previousPositions` alternate between two views made once (no copy, no allocation per frame):
+   * read both after every `deform`. `false` frees the second array.
+   */
+  keepPreviousPositions(keep: boolean): void {
+    const h = this.live();
+    if (!this.gcs.core.gcs_deformer_keep_previous_positions(h, keep ? 1 : 0)) this.gcs.raise('the previous positions could not be kept');
+    this.positionsPtr = this.gcs.core.gcs_deformer_positions(h);
+    this.swapped = keep ? [this.positionsPtr, this.gcs.core.gcs_deformer_previous_positions(h)].map((ptr) => ({ ptr, view: this.gcs.viewF32(ptr, this.vertexCount * 3) })) : null;
+  }
+
+  /** The positions of the deform before the last one (keepPreviousPositions), or null. */
+  get previousPositions(): Float32Array | null {
+    this.live();
+    return this.swapped ? this.swappedView(this.gcs.core.gcs_deformer_previous_positions(this.handle)) : null;
+  }
+
+  /** The view of one of the two position arrays (re-created after memory growth). */
+  private swappedView(ptr: number): Float32Array {
+    const entry = this.swapped![this.swapped![0].ptr === ptr ? 0 : 1];
+    if (entry.view.buffer !== this.gcs.memory.buffer) entry.view = this.gcs.viewF32(ptr, this.vertexCount * 3);
+    return entry.view;
   }
 
   /** Deformed unit normals (vertexCount × 3): a view on wasm memory, re-created after growth. */
@@ -458,6 +519,39 @@ export class Deformer {
     if (this.normalsView.buffer !== this.gcs.memory.buffer)
       this.normalsView = this.gcs.viewF32(this.normalsPtr, this.vertexCount * 3);
     return this.normalsView;
+  }
+
+  /**
+   * Deformed tangents (vertexCount × 4: xyz turned as the normals are, w the handedness carried), a
+   * view on wasm memory re-created after growth; null until setTangents. Written by the same
+   * `deform` call as positions and normals.
+   */
+  get tangents(): Float32Array | null {
+    this.live();
+    if (!this.tangentsPtr) return null;
+    if (this.tangentsView!.buffer !== this.gcs.memory.buffer) this.tangentsView = this.gcs.viewF32(this.tangentsPtr, this.vertexCount * 4);
+    return this.tangentsView;
+  }
+
+  /**
+   * Rest tangents for normal maps: vertexCount × 4 numbers in the RIG's vertex order (glTF TANGENT,
+   * three.js's `tangent` attribute: xyz unit, w = ±1), or null to remove them. From then on every
+   * `deform` also writes `tangents`. GCS, LBS and DQS (the classic model resamples the mesh:
+   * INVALID_ARGUMENT). Build time only: it copies.
+   */
+  setTangents(tangents: ArrayLike<number> | null): void {
+    const h = this.live();
+    const V = this.vertexCount;
+    if (tangents && tangents.length !== V * 4)
+      throw new GcsError('LENGTH_MISMATCH', `tangents has ${tangents.length} numbers; ${V * 4} (4 per vertex) are expected`);
+    const ptr = tangents ? this.gcs.copyIn(tangents, 'f32') : 0;
+    try {
+      if (!this.gcs.core.gcs_deformer_set_tangents(h, ptr, tangents ? V : 0)) this.gcs.raise('the tangents were rejected');
+    } finally {
+      if (ptr) this.gcs.core.gcs_free(ptr);
+    }
+    this.tangentsPtr = this.gcs.core.gcs_deformer_tangents(h);
+    this.tangentsView = this.tangentsPtr ? this.gcs.viewF32(this.tangentsPtr, V * 4) : null;
   }
 
   /** The output mesh's triangles (a copy: they never change). */
@@ -546,11 +640,11 @@ export class Deformer {
 
   /** Sections (GCS) or contours (classic) in the model; 0 for LBS/DQS. */
   get sectionCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 0);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.sections);
   }
   /** Parts (joints that own vertices) in the model; 0 for LBS/DQS. */
   get partCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 1);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.parts);
   }
 
   /** Frees the deformer's wasm memory; its views must not be used afterwards. */
@@ -572,10 +666,10 @@ export class Deformer {
 export class GcsDeformer extends Deformer {
   /** Last frame: share of sections whose transform is not their part's rigid transform. */
   get adjustedShare(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 2);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedShare);
   }
   get adjustedSections(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 3);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedSections);
   }
   /** Section id of each output vertex (a copy). */
   sectionOfVertex(): Uint32Array {
@@ -656,6 +750,17 @@ export class GcsDeformer extends Deformer {
    */
   get sectionInfluenceSlots(): number {
     return this.gcs.core.gcs_gcs_section_influence_slots(this.live());
+  }
+  /**
+   * Weights criterion: each section's centre of rotation, 4 floats per section (x, y, z, 1) in the
+   * bind pose, or (0, 0, 0, 0) where it has none (a rigid core, built with `centres: false`, or no
+   * triangle weighing on two of its joints), a copy; null for the Y and axial criteria. A section
+   * with a centre turns by its blend's rotation about it while the centre moves by linear blend
+   * skinning (gcs_gcs_section_centres).
+   */
+  sectionCentres(): Float32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_section_centres(this.live());
+    return ptr ? this.gcs.viewF32(ptr, this.sectionCount * 4).slice() : null;
   }
   /** True when the joint-level GPU path can drive this deformer (the weights criterion). */
   get jointLevel(): boolean {

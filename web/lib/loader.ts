@@ -7,6 +7,7 @@ export type WasmSource = URL | string | ArrayBuffer | Uint8Array | WebAssembly.M
 export interface CoreExports {
   memory: WebAssembly.Memory;
   _initialize(): void;
+  gcs_version(): number;
   gcs_last_error_code(): number;
   gcs_last_error_message(): number;
   gcs_alloc(bytes: number): number;
@@ -18,7 +19,7 @@ export interface CoreExports {
   gcs_rig_vertex_count(rig: number): number;
   gcs_rig_joint_count(rig: number): number;
   gcs_rig_height(rig: number): number;
-  gcs_build_gcs(rig: number, sections: number, criterion: number, width: number, smooth: number, twist: number): number;
+  gcs_build_gcs(rig: number, sections: number, criterion: number, width: number, smooth: number, twist: number, centres: number): number;
   gcs_build_lbs(rig: number): number;
   gcs_build_dqs(rig: number): number;
   gcs_build_classic(rig: number, contours: number, rays: number, bulge: number): number;
@@ -27,6 +28,10 @@ export interface CoreExports {
   gcs_deformer_deform(d: number, skin: number, jointCount: number): number;
   gcs_deformer_set_morph_targets(d: number, deltas: number, normalDeltas: number, targets: number, vertices: number): number;
   gcs_deformer_set_morph_influences(d: number, influences: number, targets: number): number;
+  gcs_deformer_set_tangents(d: number, tangents: number, vertices: number): number;
+  gcs_deformer_tangents(d: number): number;
+  gcs_deformer_keep_previous_positions(d: number, keep: number): number;
+  gcs_deformer_previous_positions(d: number): number;
   gcs_deformer_vertex_count(d: number): number;
   gcs_deformer_positions(d: number): number;
   gcs_deformer_normals(d: number): number;
@@ -44,6 +49,7 @@ export interface CoreExports {
   gcs_gcs_compute_sections(d: number, skin: number, jointCount: number, instances: number, out: number): number;
   gcs_gcs_section_influences(d: number): number;
   gcs_gcs_section_influence_slots(d: number): number;
+  gcs_gcs_section_centres(d: number): number;
   gcs_gcs_compute_joint_poses(d: number, skin: number, jointCount: number, instances: number, out: number): number;
   gcs_classic_set_bulge(d: number, bulge: number): number;
   gcs_classic_part_count(d: number): number;
@@ -94,15 +100,16 @@ export async function instantiateCore(source?: WasmSource): Promise<CoreExports>
   return exports;
 }
 
-// Functions whose result is a pointer or a uint32 count. wasm returns i32, which JavaScript reads
-// as signed: above 2 GiB of memory a pointer would come back negative (and typed-array views on it
-// throw RangeError). `>>> 0` reads it as the unsigned value the C API means.
-const UNSIGNED_RESULTS = [
-  'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
+// Functions whose result is a pointer or a uint32 (tests/lib/boundary.test.ts checks the list
+// against the header). wasm returns i32, which JavaScript reads as signed: above 2 GiB of memory a
+// pointer would come back negative (and typed-array views on it throw RangeError). `>>> 0` reads it
+// as the unsigned value the C API means.
+export const UNSIGNED_RESULTS = [
+  'gcs_version', 'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
   'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
-  'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
+  'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_tangents', 'gcs_deformer_previous_positions', 'gcs_deformer_index_count',
   'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
-  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_section_influences', 'gcs_gcs_section_influence_slots', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
+  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_section_influences', 'gcs_gcs_section_influence_slots', 'gcs_gcs_section_centres', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
 ] as const;
 
 function unsignedResults(raw: CoreExports): CoreExports {

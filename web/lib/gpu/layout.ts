@@ -18,8 +18,12 @@ export type GpuPath = 'joints' | 'sections';
  * or 8 where some section blends more than 4 (a rig with up to 8 influences per vertex).
  */
 export type TableSlots = 4 | 8;
-/** Texels per section in the static table: per 4 slots, its joints (−1 past the last), then their weights. */
-export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2;
+/**
+ * Texels per section in the static table: per 4 slots, its joints (−1 past the last), then their
+ * weights; last, its centre of rotation (x, y, z, 1), or (0, 0, 0, 0) where it moves by the plain
+ * dual-quaternion blend (gcs_gcs_section_centres).
+ */
+export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2 + 1;
 
 /** Per-vertex attribute, plain mode: the vertex's section (a float). */
 export const SECTION_ATTRIBUTE = 'gcsSection';
@@ -30,6 +34,12 @@ export const BLEND_ATTRIBUTE = 'gcsBlend';
  * blends its weight-lattice cell's three nodes, A + f·(B − A) + g·(C − A); others (own section, 0).
  */
 export const BLEND_THIRD_ATTRIBUTE = 'gcsBlendThird';
+
+/**
+ * CPU backend on WebGPURenderer, velocity: each vertex's position the frame before (the deformer's
+ * previous positions), read by the TSL kit's velocity material.
+ */
+export const PREVIOUS_POSITION_ATTRIBUTE = 'gcsPreviousPosition';
 
 /** The CPU's test for "the scale part K is a positive uniform scale": every entry within this × s of s·I. */
 export const UNIFORM_SCALE_TOLERANCE = 1e-4;

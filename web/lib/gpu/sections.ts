@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
-import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath, type TableSlots } from './layout.js';
+import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuPath, type TableSlots } from './layout.js';
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
@@ -38,12 +38,14 @@ export class GpuSections {
   readonly transforms: PoseTexels;
   /** The per-frame texture (joint poses or section transforms). */
   readonly texture: THREE.DataTexture;
-  /** Path 'joints': the static texture of each section's joints and weights; null otherwise. */
+  /** Path 'joints': the static texture of each section's joints, weights and centre of rotation; null otherwise. */
   readonly table: THREE.DataTexture | null;
   /** Path 'joints': joints per section in `table` (4, or 8 where a section blends more); 4 otherwise. */
   readonly tableSlots: TableSlots;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
+  /** Velocity: the per-frame texels as the previous frame drew them (see previousTexture). */
+  private previous: { texture: THREE.DataTexture; drawn: Float32Array; frameId: number } | null = null;
 
   constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath) {
     if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
@@ -55,10 +57,10 @@ export class GpuSections {
     this.tableSlots = 4;
     if (this.path === 'joints') {
       this.tableSlots = deformer.sectionInfluenceSlots === 8 ? 8 : 4;
-      const influences = deformer.sectionInfluences()!;
-      const texels = influences.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+      const table = sectionTable(deformer);
+      const texels = table.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
       const data = new Float32Array(width * height * 4);
-      data.set(influences);
+      data.set(table);
       this.table = floatTexture(data, width, height);
       this.uniforms = { gcsJoints: { value: this.texture }, gcsTable: { value: this.table }, ...base };
     } else {
@@ -77,9 +79,39 @@ export class GpuSections {
     return this.transforms.skins;
   }
 
-  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16). */
+  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16), twice while velocity is drawn. */
   get bytesPerUpdate(): number {
-    return this.transforms.width * this.transforms.height * 16;
+    return this.transforms.width * this.transforms.height * 16 * (this.previous ? 2 : 1);
+  }
+
+  /**
+   * Velocity (motion vectors): a texture of the per-frame texels as they were drawn the frame
+   * before, as three.js keeps its skeletons' previous bone matrices. Made on first use (a shader
+   * that needs previous positions), then kept by advanceFrame; until a frame has passed it holds
+   * this frame's texels (no motion).
+   */
+  previousTexture(): THREE.DataTexture {
+    if (!this.previous) {
+      const t = this.transforms;
+      this.previous = { texture: floatTexture(Float32Array.from(t.texels), t.width, t.height), drawn: Float32Array.from(t.texels), frameId: -1 };
+    }
+    return this.previous.texture;
+  }
+
+  /**
+   * Once per rendered frame (three.js's frameId), before the draw: the previous texture shows what
+   * the last frame drew and the texels drawn now are kept for the next. One copy, no allocation.
+   */
+  advanceFrame(frameId: number): void {
+    const p = this.previous;
+    if (!p || p.frameId === frameId) return;
+    p.frameId = frameId;
+    const image = p.texture.image as { data: Float32Array };
+    const drawn = p.drawn;
+    p.drawn = image.data;
+    image.data = drawn;
+    p.drawn.set(this.transforms.texels);
+    p.texture.needsUpdate = true;
   }
 
   /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
@@ -93,9 +125,27 @@ export class GpuSections {
 
   dispose(): void {
     this.texture.dispose();
+    this.previous?.texture.dispose();
     this.table?.dispose();
     this.transforms.dispose();
   }
+}
+
+/**
+ * The joint-level path's static table (weights criterion; layout.ts, tableTexelsPerSection): per
+ * section its joints and weights (gcs_gcs_section_influences), then its centre of rotation
+ * (gcs_gcs_section_centres).
+ */
+export function sectionTable(deformer: GcsDeformer): Float32Array {
+  const influences = deformer.sectionInfluences(), centres = deformer.sectionCentres();
+  if (!influences || !centres) throw new GcsError('INVALID_ARGUMENT', 'the joint-level table exists for the weights criterion only');
+  const slots = deformer.sectionInfluenceSlots as TableSlots, perSection = 4 * tableTexelsPerSection(slots);
+  const table = new Float32Array(deformer.sectionCount * perSection);
+  for (let s = 0; s < deformer.sectionCount; s++) {
+    table.set(influences.subarray(2 * slots * s, 2 * slots * (s + 1)), perSection * s);
+    table.set(centres.subarray(4 * s, 4 * s + 4), perSection * s + 2 * slots);
+  }
+  return table;
 }
 
 /** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */
