@@ -15,16 +15,17 @@ import { buildClassic, buildGcs, classicSummary, scheduleCostMeasure } from './m
 import { clearMessage, DemoError, describeError, hideStatus, shownMessage, showMessage, showStatus, yieldToPage } from './page.js';
 import { dom, LAYER, params, query, queryNumber, state, type Character } from './state.js';
 import { frameCharacter } from './views.js';
+import { countInfluences } from './influences.js';
 
 /** A character shipped with the demo (public/, licences in public/LICENSES.md). */
-interface Shipped {
+export interface Shipped {
   key: string;
   label: string;
   file: string;
   /** One line: who made it, under which licence. */
   credit: string;
 }
-const SHIPPED: Shipped[] = [
+export const SHIPPED: Shipped[] = [
   { key: 'fox', label: 'Fox', file: 'Fox.glb',
     credit: 'Fox: model by PixelMannen (CC0 1.0), rigging and animation by @tomkranis (CC BY 4.0), glTF by @AsoboStudio and @scurest' },
   { key: 'cesiumman', label: 'Cesium Man', file: 'CesiumMan.glb',
@@ -189,6 +190,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     const next: Character = {
       name, key, credit, holder, sources, gcs: gcsSkins, classic: classicSkins, classicError, rigidParts: [], trunkParts: [],
       mixer, clips, action: null, skeletonHelper, sourceVertices: vertices, sourceTriangles: triangles, rigidMeshes,
+      influences: countInfluences(sources),
     };
     classicSummary(next);
     for (const s of next.gcs) { s.mesh.castShadow = true; gcsColours(s); }
@@ -221,7 +223,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
 }
 
 /** Scales a glTF's object to 1.8 units, feet on y = 0, centred on the origin. */
-function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group): void {
+export function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group): void {
   const box = new THREE.Box3().setFromObject(object);
   const size = box.getSize(new THREE.Vector3());
   const extent = Math.max(size.x, size.y, size.z);
@@ -233,7 +235,7 @@ function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group
   holder.updateMatrixWorld(true);
 }
 
-function disposeObject(root: THREE.Object3D): void {
+export function disposeObject(root: THREE.Object3D): void {
   root.traverse((o) => {
     const mesh = o as THREE.Mesh;
     if (!mesh.isMesh) return;

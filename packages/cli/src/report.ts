@@ -2,7 +2,9 @@
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
 // method, build ms, median ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe
 // over every sampled frame of every clip, distances in % of the character's height), and per clip
-// the frame time. The JSON shape is documented in docs/report-json.md.
+// the frame time, and the mesh's knees and elbows bent alone (measureJoints: volume change, bulge,
+// collapse, creases, new self-intersections per method). The JSON shape is documented in
+// docs/report-json.md.
 import type * as THREE from 'three';
 import { setConsoleFunction } from 'three';
 import { GcsError } from '../../../web/lib/errors.js';
@@ -12,7 +14,8 @@ import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
 import { wholeNumber } from './args.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
-  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, timeFrames, type Fidelity, type MethodName,
+  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, timeFrames,
+  type Fidelity, type JointsMeasure, type MethodName,
 } from '../../../web/lib/measure.js';
 
 export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--json]
@@ -20,7 +23,8 @@ export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME
   method, build ms, median ms per frame and its fidelity over every sampled frame of every clip:
   rigid error, distance from an independent DQS (p95, max), flipped and stretched triangles,
   normals off unit length, non-finite values, seam gap (distances in % of the character's height);
-  then per clip the frame times.
+  then per clip the frame times, and the knees and elbows (found from the skeleton) each bent alone
+  to 45°, 90°, 135°: volume change, bulge, collapse, creases, new self-intersections per method.
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
   --frames N      frames sampled per clip (default 60)
@@ -79,6 +83,8 @@ export interface MeshReport {
   frames: { count: number; source: 'clips' | 'bind pose' };
   methods: Record<MethodName, MethodReport>;
   clips: { name: string; duration: number; frames: number; methods: Partial<Record<MethodName, ClipMethodReport>> }[];
+  /** The knees and elbows found on this mesh, each bent alone (docs/report-json.md, "Joints"). */
+  joints: JointsMeasure;
 }
 
 export interface Report {
@@ -217,6 +223,7 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       }
       methods[method] = r;
     }
+    const joints = roundJoints(measureJoints(rig, input, { methods: jointMethods({ sections: s.sections }), names: mesh.skeleton.bones.map((b) => b.name) }));
     return {
       name: mesh.name,
       counts: {
@@ -229,10 +236,28 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       frames: { count: frames.length, source: all.length ? 'clips' : 'bind pose' },
       methods,
       clips: clips.map((clip, c) => ({ name: clip.name, duration: round(clip.duration), frames: clipFrames[c].length, methods: clipMethods[c] })),
+      joints,
     };
   } finally {
     rig.dispose();
   }
+}
+
+/** The joints' figures and geometry to 4 significant digits. */
+function roundJoints(m: JointsMeasure): JointsMeasure {
+  const vec = (v: number[]) => v.map((x) => round(x)) as [number, number, number];
+  return {
+    ...m,
+    frame: m.frame && { up: vec(m.frame.up), forward: vec(m.frame.forward), left: vec(m.frame.left) },
+    joints: m.joints.map((j) => ({
+      ...j,
+      hinge: { ...j.hinge, centre: vec(j.hinge.centre), end: vec(j.hinge.end), axis: vec(j.hinge.axis) },
+      methods: Object.fromEntries(Object.entries(j.methods).map(([k, r]) => [k, 'error' in r ? r : r.map((f) => ({
+        ...f, volumeChange: round(f.volumeChange), bulgeP95: round(f.bulgeP95), bulgeMax: round(f.bulgeMax),
+        collapseP5: round(f.collapseP5), collapseMin: round(f.collapseMin),
+      }))])),
+    })),
+  };
 }
 
 /** How many vertices have more than 4 influences (weights > 0). */
@@ -309,6 +334,11 @@ export function formatReport(r: Report): string {
       }
       out.push(table(rows2));
     }
+    const j = m.joints;
+    out.push('', `joints: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}; each bent alone from the bind pose`,
+      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone over the same at bind');
+    for (const note of j.notes) out.push(`  note: ${printable(note)}`);
+    if (j.joints.length) out.push(table(jointTableRows(j).map((row) => row.map(printable))));
   }
   return out.join('\n');
 }
