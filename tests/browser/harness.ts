@@ -63,11 +63,13 @@ export async function startDemo(mode = process.env.DEMO_SERVER === 'dev' ? 'dev'
   };
 }
 
-export async function launchChromium(): Promise<BrowserContext> {
+/** Headless Chromium; `bypassCSP` ignores the pages' Content-Security-Policy (to test what the page's own code does without it). */
+export async function launchChromium(options: { bypassCSP?: boolean } = {}): Promise<BrowserContext> {
   const { chromium } = await import('playwright-core');
   return chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
     executablePath: CHROMIUM,
     headless: true,
+    bypassCSP: options.bypassCSP ?? false,
     viewport: { width: 1280, height: 720 },
     args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],

@@ -255,10 +255,10 @@ describe('gcs-skin report on bad glTF files: one line, exit code 2', () => {
     expect(await oneLineError(dup, 'BAD_SKIN')).toContain('twice among its joints (joints 1 and 2)');
     const count = variant('counts.glb', (json) => { json.accessors[json.meshes[0].primitives[0].attributes.WEIGHTS_0].count = 100; });
     expect(await oneLineError(count, 'BAD_STRUCTURE')).toContain('WEIGHTS_0');
-    // Only the three compression extensions are read (tests/cli/compressed.test.ts); any other required one is refused.
-    const basisu = variant('basisu.glb', (json) => { json.extensionsRequired = ['KHR_draco_mesh_compression', 'KHR_texture_basisu']; });
-    expect(await oneLineError(basisu, 'UNSUPPORTED')).toContain(
-      `${basisu} requires the glTF extension KHR_texture_basisu, which this loader does not read (it reads KHR_mesh_quantization, EXT_meshopt_compression, KHR_draco_mesh_compression)`);
+    // Only the three compression extensions and KTX2 textures are read (tests/cli/compressed.test.ts); any other required one is refused.
+    const lights = variant('lights.glb', (json) => { json.extensionsRequired = ['KHR_draco_mesh_compression', 'KHR_lights_punctual']; });
+    expect(await oneLineError(lights, 'UNSUPPORTED')).toContain(
+      `${lights} requires the glTF extension KHR_lights_punctual, which this loader does not read (it reads KHR_mesh_quantization, EXT_meshopt_compression, KHR_draco_mesh_compression, KHR_texture_basisu)`);
     const v1 = join(dir, 'v1.gltf');
     writeFileSync(v1, JSON.stringify({ asset: { version: '1.0' } }));
     expect(await oneLineError(v1, 'NOT_GLTF')).toContain('is glTF 1.0, not 2.0');

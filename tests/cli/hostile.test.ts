@@ -5,8 +5,8 @@
 // bin/gcs-skin.mjs report`, a child process) and must end in one line with its code in brackets,
 // within 5 s of CPU time and a memory bound, and never echo a byte of a file it refused. Files at the limits
 // (LIMITS) are accepted and still bounded. Runs on packages/cli/dist: `npm run build:lib` first (npm test does).
-import { spawnSync } from 'node:child_process';
-import { existsSync, mkdirSync, mkdtempSync, rmSync, statSync, symlinkSync, writeFileSync } from 'node:fs';
+import { spawnSync, type SpawnSyncOptions } from 'node:child_process';
+import { chmodSync, closeSync, existsSync, ftruncateSync, mkdirSync, mkdtempSync, openSync, rmSync, statSync, symlinkSync, writeFileSync, writeSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
@@ -14,6 +14,7 @@ import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
 import { loadCharacter } from '../../packages/cli/src/gltf.js';
 import { GltfError } from '../../packages/cli/src/gltf-node.js';
 import { LIMITS } from '../../web/lib/gltf/limits.js';
+import { compressGlb } from '../helpers/compressed-gltf.js';
 import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
 
 const ROOT = join(import.meta.dirname, '../..');
@@ -41,15 +42,19 @@ interface Outcome { status: number | null; stdout: string; stderr: string; ms: n
 
 /** `gcs-skin report FILE ...args` in a child process: exit status, output, wall and CPU time, peak resident memory. */
 function report(file: string, ...args: string[]): Outcome {
+  return command(['report', file, '--frames', '1', '--time-ms', '1', ...args]);
+}
+
+/** `gcs-skin ARGS` in a child process (`input`: its standard input, else none), measured as report() says. */
+function command(argv: string[], input?: Uint8Array): Outcome {
   // The child writes its peak RSS (KB) and CPU time (µs) on fd 3 as it exits, keeping stderr for the one line.
   const runner = `import { writeSync } from 'node:fs';
 process.on('exit', () => { const u = process.resourceUsage(); writeSync(3, u.maxRSS + ' ' + (u.userCPUTime + u.systemCPUTime)); });
 process.argv.splice(1, 0, 'gcs-skin'); // the script's place in argv, which -e leaves out
 await import(${JSON.stringify(new URL(`file://${BIN}`).href)});`;
   const t0 = performance.now();
-  const r = spawnSync(process.execPath, ['--input-type=module', '-e', runner, 'report', file, '--frames', '1', '--time-ms', '1', ...args], {
-    encoding: 'utf8', timeout: WALL_SECONDS * 1000, stdio: ['ignore', 'pipe', 'pipe', 'pipe'],
-  });
+  const options: SpawnSyncOptions = { encoding: 'utf8', timeout: WALL_SECONDS * 1000, stdio: [input ? 'pipe' : 'ignore', 'pipe', 'pipe', 'pipe'], input };
+  const r = spawnSync(process.execPath, ['--input-type=module', '-e', runner, ...argv], options) as ReturnType<typeof spawnSync> & { stdout: string; stderr: string };
   const ms = performance.now() - t0;
   const [rssKb, cpuUs] = String(r.output[3] || '0 0').split(' ').map(Number);
   return { status: r.status, stdout: r.stdout, stderr: r.stderr, ms, cpuMs: cpuUs / 1000, maxRssMb: rssKb / 1024 };
@@ -57,18 +62,21 @@ await import(${JSON.stringify(new URL(`file://${BIN}`).href)});`;
 
 /** One line `gcs-skin report: ... [CODE]` on stderr, exit 2, nothing on stdout, within the time and memory bounds. */
 function expectRefused(file: string, code: string, mb = REFUSED_MB): string {
-  const r = report(file);
+  return expectRefusedBy(report(file), file, code, mb);
+}
+
+function expectRefusedBy(r: Outcome, file: string, code: string, mb = REFUSED_MB, cmd = 'report'): string {
   const where = `${file}: ${JSON.stringify(r.stderr.slice(0, 400))}`;
   expect(r.status, where).toBe(2);
   expect(r.stdout, where).toBe('');
   expect(r.stderr.endsWith('\n'), where).toBe(true);
   const line = r.stderr.slice(0, -1);
   expect(line.split('\n'), where).toHaveLength(1);
-  expect(line, where).toMatch(new RegExp(`^gcs-skin report: .* \\[${code}\\]$`));
+  expect(line, where).toMatch(new RegExp(`^gcs-skin ${cmd}: .* \\[${code}\\]$`));
   expect(line).not.toContain(SECRET);
   expect(line).not.toMatch(/[\x00-\x1f\x7f]/);
   expectBounded(r, where, mb);
-  console.log(`hostile: ${file.slice(folder.length + 1).padEnd(28)} ${code.padEnd(15)} ${r.cpuMs.toFixed(0).padStart(5)} ms CPU ${r.ms.toFixed(0).padStart(5)} ms wall ${r.maxRssMb.toFixed(0).padStart(4)} MB`);
+  console.log(`hostile: ${file.slice(file.startsWith(folder) ? folder.length + 1 : 0).padEnd(28)} ${code.padEnd(15)} ${String(line.length).padStart(4)} chars ${r.cpuMs.toFixed(0).padStart(5)} ms CPU ${r.ms.toFixed(0).padStart(5)} ms wall ${r.maxRssMb.toFixed(0).padStart(4)} MB`);
   return line;
 }
 
@@ -125,7 +133,7 @@ describe('no file read outside the glTF\'s folder', () => {
     ['file-url.gltf', 'file:///etc/passwd'],
     ['http-url.gltf', 'http://127.0.0.1:9/x.bin'],
   ])('%s (uri %s): OUTSIDE_FOLDER', (name, uri) => {
-    expect(expectRefused(bufferAt(name, uri), 'OUTSIDE_FOLDER')).toContain("a buffer is read only from a file in the glTF's own folder");
+    expect(expectRefused(bufferAt(name, uri), 'OUTSIDE_FOLDER')).toContain("buffers are read from the glTF's folder only");
   });
 
   it('links inside the folder that lead out of it (to the secret, to /dev/zero) are refused after following them', () => {
@@ -351,5 +359,170 @@ describe('terminal escapes in names are printed as escapes', () => {
     expect(missing.stderr.trimEnd().split('\n')).toHaveLength(1);
     expect(missing.stderr).toMatch(/\[NO_CLIP\]\n$/);
     expect(missing.stderr.slice(0, -1)).not.toMatch(/[\x00-\x1f\x7f]/);
+  });
+});
+
+// Second round (issue 28): the model file itself, compressed data that lies, keys that reach a
+// prototype, names a megabyte long, write errors of `human -o`, and numbers read too kindly.
+describe('the model file itself: a regular file only, its size checked before reading, no more read than needed', () => {
+  it('a FIFO, /dev/zero, a directory and a pipe through /dev/stdin as the model: refused by type, at once', () => {
+    const made = spawnSync('mkfifo', [join(folder, 'model-pipe.glb')]);
+    if (made.status === 0) expect(expectRefused(join(folder, 'model-pipe.glb'), 'UNREADABLE')).toMatch(/a FIFO \(named pipe\), not a regular file \(give '-' to read standard input\)/);
+    expect(expectRefused('/dev/zero', 'UNREADABLE')).toMatch(/a character device, not a regular file/);
+    expect(expectRefused(folder, 'UNREADABLE')).toMatch(/a directory, not a regular file/);
+    const piped = command(['report', '/dev/stdin', '--frames', '1'], new TextEncoder().encode(JSON.stringify({ asset: { version: '2.0' } })));
+    expect(expectRefusedBy(piped, '/dev/stdin', 'UNREADABLE')).toMatch(/cannot read \/dev\/stdin: /);
+  });
+
+  it('a 1.9 GB sparse file: its first bytes are read (NOT_GLTF), or its size refuses it (TOO_LARGE), never the whole', () => {
+    const sparse = (name: string, head?: Uint8Array) => {
+      const file = join(folder, name);
+      const fd = openSync(file, 'w');
+      ftruncateSync(fd, 1.9e9);
+      if (head) writeSync(fd, head, 0, head.length, 0);
+      closeSync(fd);
+      return file;
+    };
+    expectRefused(sparse('zeros.glb'), 'NOT_GLTF');
+    const header = new Uint8Array(12);
+    new DataView(header.buffer).setUint32(0, 0x46546c67, true);
+    new DataView(header.buffer).setUint32(4, 2, true);
+    new DataView(header.buffer).setUint32(8, 1.9e9, true);
+    expect(expectRefused(sparse('huge.glb', header), 'TOO_LARGE')).toMatch(/1,900,000,000 bytes, past the 536,870,912/);
+    rmSync(join(folder, 'zeros.glb'));
+    rmSync(join(folder, 'huge.glb'));
+  });
+
+  it('- reads standard input as bytes: a .glb reports; a .gltf with a buffer in a file of its own is refused (no folder)', () => {
+    const ok = command(['report', '-', '--frames', '1', '--time-ms', '1', '--json'], packGlb(human.json, human.bin));
+    expect(ok.status, ok.stderr).toBe(0);
+    expect(JSON.parse(ok.stdout).file).toBe('-');
+    const json = structuredClone(human.json);
+    json.buffers = [{ byteLength: human.bin.length, uri: 'human.bin' }];
+    const refused = command(['report', '-', '--frames', '1'], new TextEncoder().encode(JSON.stringify(json)));
+    expect(expectRefusedBy(refused, '-', 'UNREADABLE')).toMatch(/standard input: buffer 0 is in the file 'human\.bin', which cannot be read from bytes alone/);
+  });
+
+  it('a link to the model inside its folder still reads (legal but unusual)', () => {
+    writeFileSync(join(folder, 'real.glb'), packGlb(human.json, human.bin));
+    symlinkSync(join(folder, 'real.glb'), join(folder, 'link.glb'));
+    const r = report(join(folder, 'link.glb'));
+    expect(r.status, r.stderr).toBe(0);
+    expect(r.stderr).toBe('');
+  });
+});
+
+describe('compressed data that lies: refused before decoding, or by what the decoder returns', () => {
+  let compressed: Record<string, { json: Json; bin: Uint8Array }>;
+  beforeAll(async () => {
+    compressed = {};
+    const glb = packGlb(human.json, human.bin);
+    for (const how of ['draco', 'draco-sequential', 'meshopt'] as const) compressed[how] = splitGlb(await compressGlb(glb, how));
+  });
+  const declare = (vertices: number, indices?: number) => (json: Json) => {
+    const p = json.meshes[0].primitives[0];
+    for (const a of Object.values(p.attributes) as number[]) json.accessors[a].count = vertices;
+    if (indices !== undefined) json.accessors[p.indices].count = indices;
+  };
+  const variant = (name: string, source: { json: Json; bin: Uint8Array }, edit: (json: Json, bin: DataView) => void) => {
+    const json = structuredClone(source.json);
+    const bin = source.bin.slice();
+    edit(json, new DataView(bin.buffer));
+    const file = join(folder, name);
+    writeFileSync(file, packGlb(json, bin));
+    return file;
+  };
+
+  it('Draco whose header declares more than its accessors (3 vertices declared): BAD_DATA before the decoder runs', () => {
+    expect(expectRefused(variant('draco-liar.glb', compressed.draco, declare(3, 3)), 'BAD_DATA')).toMatch(/declares [\d,]+ triangles where its indices declare 1/);
+    expect(expectRefused(variant('draco-seq-liar.glb', compressed['draco-sequential'], declare(100)), 'BAD_DATA')).toMatch(/declares [\d,]+ vertices where its accessors declare 100/);
+  });
+
+  it('Draco edgebreaker that decodes to more vertices than declared: BAD_DATA from the decoded count', () => {
+    expect(expectRefused(variant('draco-seam-liar.glb', compressed.draco, declare(100)), 'BAD_DATA')).toMatch(/decodes to [\d,]+ vertices where its accessors declare 100/);
+  });
+
+  it('a corrupt meshopt stream: BAD_DATA in our words, not "Invalid typed array length"', () => {
+    const line = expectRefused(variant('meshopt-corrupt.glb', compressed.meshopt, (json, bin) => {
+      for (const v of json.bufferViews) {
+        const m = v.extensions?.EXT_meshopt_compression;
+        if (m && m.buffer === 0) for (let k = m.byteOffset + 1; k < m.byteOffset + m.byteLength - 1; k++) bin.setUint8(k, 0xff);
+      }
+    }), 'BAD_DATA');
+    expect(line).toMatch(/its meshopt data does not decode/);
+  });
+});
+
+describe('keys and names from the file: never a prototype, never a megabyte line', () => {
+  it.each([
+    ['attr-constructor.glb', (json: Json) => { json.meshes[0].primitives[0].attributes.constructor = json.meshes[0].primitives[0].attributes.POSITION; }, 'constructor'],
+    ['extras-proto.glb', (json: Json) => { json.nodes[0].extras = JSON.parse('{"__proto__": {"isSkinnedMesh": true}}'); }, '__proto__'],
+    ['ext-tostring.glb', (json: Json) => { json.meshes[0].extensions = { toString: {} }; }, 'toString'],
+  ])('%s: BAD_STRUCTURE naming the key', (name, edit, key) => {
+    const line = expectRefused(humanVariant(name, edit), 'BAD_STRUCTURE');
+    expect(line).toContain(`uses the key '${key}'`);
+    expect(line.length).toBeLessThanOrEqual(200);
+  });
+
+  it('a 1 MB node name and a 1 MB uri: the line stays short (48 characters of a name, then …)', () => {
+    const big = 'N'.repeat(2 ** 20);
+    const line = expectRefused(humanVariant('long-name.glb', (json) => {
+      json.nodes[0].name = big;
+      json.nodes[0].children = [...(json.nodes[0].children ?? []), 0]; // its own child: the message names it
+    }), 'NODE_CYCLE');
+    expect(line).toContain(`'${'N'.repeat(47)}…'`);
+    expect(line.length).toBeLessThanOrEqual(200);
+    expect(expectRefused(bufferAt('long-uri.gltf', `${'u'.repeat(2 ** 20)}%zz`), 'BAD_URI').length).toBeLessThanOrEqual(200);
+  });
+
+  it('JOINTS_0 of FLOAT: the accessor is blamed, not a joint', () => {
+    const line = expectRefused(humanVariant('joints-float.glb', (json) => {
+      json.accessors[json.meshes[0].primitives[0].attributes.JOINTS_0].componentType = 5126;
+    }), 'BAD_STRUCTURE');
+    expect(line).toMatch(/accessor \d+ \(JOINTS_0 of mesh 0 'Human' primitive 0\) is VEC4 FLOAT, not VEC4 UNSIGNED_BYTE\/SHORT/);
+    expect(line.length).toBeLessThanOrEqual(200);
+    expect(line).not.toMatch(/joint \d{3,}/);
+  });
+});
+
+describe('numbers read strictly', () => {
+  it.each(['0x3', '1e9', 'NaN', ' 7', '+5', '3.0'])('--frames %j: refused, naming the flag', (value) => {
+    const r = report(join(folder, 'none.glb'), '--frames', value);
+    expect(r.status).toBe(2);
+    expect(r.stderr.split('\n')[0]).toMatch(/^gcs-skin report: --frames takes a whole number from 1 to 10000 in decimal digits; got '.*'$/);
+  });
+  it('human --vertices 0x3000: refused, naming the flag', () => {
+    const r = command(['human', '--vertices', '0x3000', '-o', join(folder, 'h.glb')]);
+    expect(r.status).toBe(2);
+    expect(r.stderr).toMatch(/^gcs-skin human: --vertices takes a whole number from \d+ to \d+ in decimal digits; got '0x3000'/);
+  });
+});
+
+describe('gcs-skin human -o: write errors are one line with a code', () => {
+  it.each([
+    ['a directory', () => folder, /it is not a regular file|it is a directory/],
+    ['/dev/full', () => '/dev/full', /not a regular file/],
+    ['a missing folder', () => join(folder, 'no-such-folder', 'out.glb'), /its folder does not exist/],
+    ['a name with escape bytes in a missing folder', () => join(folder, 'no\x1b[2Jsuch', 'out.glb'), /no\\x1b\[2Jsuch/],
+  ])('%s: exit 2, [UNWRITABLE]', (_, out, reason) => {
+    const r = command(['human', '--vertices', '2000', '-o', out()]);
+    expectRefusedBy(r, out(), 'UNWRITABLE', LOADED_MB, 'human');
+    expect(r.stderr).toMatch(reason);
+  });
+
+  it('a read-only file: exit 2, [UNWRITABLE] (skipped as root, who may write it)', (ctx) => {
+    if (process.getuid?.() === 0) return ctx.skip();
+    const file = join(folder, 'read-only.glb');
+    writeFileSync(file, 'x');
+    chmodSync(file, 0o444);
+    expectRefusedBy(command(['human', '--vertices', '2000', '-o', file]), file, 'UNWRITABLE', LOADED_MB, 'human');
+  });
+
+  it('the "wrote" line prints the name escaped', () => {
+    const out = join(folder, 'bell\x07.glb');
+    const r = command(['human', '--vertices', '2000', '-o', out]);
+    expect(r.status, r.stderr).toBe(0);
+    expect(r.stdout).toContain('bell\\x07.glb');
+    expect(r.stdout).not.toMatch(/[\x00-\x09\x0b-\x1f]/);
   });
 });

@@ -268,7 +268,7 @@ describe('gcs-skin report', () => {
     const bad = await runCli([humanFile, '--frames', '0']);
     expect(bad.code).toBe(2);
     expect(bad.stdout).toBe('');
-    expect(bad.stderr).toMatch(/--frames must be a whole number/);
+    expect(bad.stderr).toMatch(/--frames takes a whole number/);
   });
 
   it('exits 2 with one line on stderr for an unskinned glTF', async () => {

@@ -1,20 +1,26 @@
 // Reads a dropped or linked glTF in the page the way `gcs-skin report` reads one in node: the
-// bytes go through the shared validation (web/lib/gltf/buffers.ts, validate.ts) before
-// three's GLTFLoader sees them, so a broken or hostile file is one sentence with a code
-// (GltfError). GLTFLoader then parses the validated JSON with each buffer's checked bytes (blob
-// URLs), and vertices whose weights are all 0 get their zeros back (three would bind them to the
-// first joint), so the core reports them as the CLI does. No read is unbounded: a file or a URL's
-// body is cut at MAX_FILE_BYTES, an external buffer at its declared byteLength.
+// bytes go through the shared validation (web/lib/gltf/buffers.ts, validate.ts; Draco
+// headers against the accessors: web/lib/gltf/draco-check.ts) before three's GLTFLoader sees
+// them, so a broken or hostile file is one sentence with a code (GltfError). Every buffer and
+// image is read here, from the dropped files, this site or a data: URI only (gltf-sources.ts),
+// each image's declared size checked (image-size.ts), then handed to GLTFLoader as a blob URL of
+// its checked bytes; compressed data is decoded by the decoders the file needs
+// (gltf-decoders.ts), and what they decode must be what the accessors declare. Vertices whose
+// weights are all 0 get their zeros back (three would bind them to the first joint), so the core
+// reports them as the CLI does.
 import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { decodeBufferPath, readValidatedGltf, type ExternalReader, type ValidatedGltf } from '../lib/gltf/buffers.js';
+import { readValidatedGltf, type ValidatedGltf } from '../lib/gltf/buffers.js';
 import { restoreZeroWeights, zeroWeightVertices } from '../lib/gltf/accessors.js';
 import { GltfError, n } from '../lib/gltf/error.js';
+import type { GltfJson } from '../lib/gltf/json.js';
+import { shownName } from '../lib/gltf/shown-name.js';
+import { addDecoders, decoderFailure } from './gltf-decoders.js';
+import { droppedReader, fetchAtMost, guardedManager, MAX_FILE_BYTES, siteReader, siteUrl, takeRefused, tooLarge, type ResourceReader } from './gltf-sources.js';
+import { imageSize, imageTooLarge } from './image-size.js';
+import { state } from './state.js';
 
 export { GltfError } from '../lib/gltf/error.js';
-
-/** The largest file the page reads. */
-const MAX_FILE_BYTES = 512 * 2 ** 20;
 
 /** The last part of a path or URL, %-decoded where it decodes. */
 export function basename(path: string): string {
@@ -26,99 +32,137 @@ export function basename(path: string): string {
   }
 }
 
+/** Characters of a file's own name the page shows (its label and menu have room for more than a message). */
+export const FILE_NAME_LENGTH = 80;
+
+/** How the page names a ?model= value: its file name, or the start of a data: URI; capped and escaped. */
+export function modelName(value: string): string {
+  return /^data:/i.test(value) ? shownName(value, 40) : shownName(basename(value), FILE_NAME_LENGTH);
+}
+
+/** How the page names a dropped file. */
+export const fileName = (file: File): string => shownName(file.name, FILE_NAME_LENGTH);
+
 /** A dropped .glb or .gltf with the files dropped beside it (its external buffers and images, found by name). */
 export async function loadDroppedGltf(main: File, companions: readonly File[]): Promise<GLTF> {
-  if (main.size > MAX_FILE_BYTES) throw tooLarge(main.name, main.size);
-  const byName = new Map(companions.map((f) => [f.name, f]));
-  const external: ExternalReader = async (uri, i, maxBytes) => {
-    const file = byName.get(basename(decodeBufferPath(uri, main.name, i)));
-    if (!file)
-      throw new GltfError('UNREADABLE', main.name, `/buffers/${i}/uri`,
-        `${main.name} keeps its data in external files (${uri}), which a dropped .gltf cannot reach: ` +
-        'drop the .gltf together with those files (select them all), or use a .glb or a .gltf with embedded buffers');
-    return new Uint8Array(await file.slice(0, maxBytes).arrayBuffer());
-  };
-  const gltf = await readValidatedGltf(new Uint8Array(await main.arrayBuffer()), main.name, external);
-  const images = new Map<string, string>();
-  return parseValidated(gltf, main.name, '', (url) => {
-    const file = byName.get(basename(url));
-    if (!file) return url;
-    if (!images.has(url)) images.set(url, URL.createObjectURL(file));
-    return images.get(url)!;
-  }, () => images.forEach((u) => URL.revokeObjectURL(u)));
+  const name = fileName(main);
+  if (main.size > MAX_FILE_BYTES) throw tooLarge(name, main.size);
+  return loadBytes(new Uint8Array(await main.arrayBuffer()), name, droppedReader(companions, name));
 }
 
-/** A .glb or .gltf at a URL (relative to the page), its external buffers and images beside it. */
-export async function loadGltfUrl(url: string, name = url): Promise<GLTF> {
-  const base = new URL(url, location.href);
-  const external: ExternalReader = (uri, i, maxBytes) => fetchAtMost(new URL(decodeBufferPath(uri, name, i), base).href, maxBytes, name, i);
-  const bytes = await fetchAtMost(base.href, MAX_FILE_BYTES, name, -1);
+/** A .glb or .gltf on this site (a path relative to the page) or in a data: URI; `name` names it in messages. */
+export async function loadGltfUrl(value: string, name = modelName(value)): Promise<GLTF> {
+  const url = siteUrl(value);
+  const bytes = await fetchAtMost(url, MAX_FILE_BYTES, name, `Could not load ${name}`);
   if (bytes.byteLength >= MAX_FILE_BYTES) throw tooLarge(name, bytes.byteLength);
-  const gltf = await readValidatedGltf(bytes, name, external);
-  return parseValidated(gltf, name, new URL('.', base).href, (u) => u, () => {});
+  return loadBytes(bytes, name, siteReader(url.protocol === 'data:' ? null : url, name));
 }
 
-function tooLarge(name: string, bytes: number): GltfError {
-  return new GltfError('TOO_LARGE', name, '', `${name} has ${n(bytes)} bytes or more, past the ${n(MAX_FILE_BYTES)} this page reads`);
-}
-
-/** The body of `url`, at most `maxBytes` of it (the rest is never downloaded); buffer `index` (-1: the file itself) in messages. */
-async function fetchAtMost(url: string, maxBytes: number, name: string, index: number): Promise<Uint8Array> {
-  const what = index < 0 ? `Could not load ${name}` : `${name}: buffer ${index}'s file ${url} cannot be read`;
-  let response: Response;
+async function loadBytes(bytes: Uint8Array, name: string, read: ResourceReader): Promise<GLTF> {
+  const gltf = await readValidatedGltf(bytes, name, (uri, i, maxBytes) => read(uri, 'buffer', i, maxBytes));
+  const blobs: string[] = [];
   try {
-    response = await fetch(url);
-  } catch (e) {
-    throw new GltfError('UNREADABLE', name, '', `${what} (${(e as Error).message})`);
+    await checkImages(gltf, name, read, blobs);
+    return await parseValidated(gltf, name, blobs);
+  } finally {
+    setTimeout(() => blobs.forEach((u) => URL.revokeObjectURL(u)), 10000); // textures may still be decoding
   }
-  if (!response.ok || !response.body) throw new GltfError('UNREADABLE', name, '', `${what} (HTTP ${response.status}${response.statusText ? ` ${response.statusText}` : ''})`);
-  const out = new Uint8Array(Math.min(maxBytes, Number(response.headers.get('content-length')) || 2 ** 20));
-  let data = out, length = 0;
-  const reader = response.body.getReader();
-  while (length < maxBytes) {
-    const { done, value } = await reader.read();
-    if (done) break;
-    const take = Math.min(value.byteLength, maxBytes - length);
-    if (length + take > data.length) {
-      const grown = new Uint8Array(Math.min(maxBytes, Math.max(2 * data.length, length + take)));
-      grown.set(data.subarray(0, length));
-      data = grown;
+}
+
+/**
+ * Reads every image (its uri's file, data: URI or buffer view), refuses one that declares too many
+ * pixels before anything decodes it, and points each uri at a blob URL of the bytes read.
+ */
+async function checkImages({ json, buffers }: ValidatedGltf, name: string, read: ResourceReader, blobs: string[]): Promise<void> {
+  const images: GltfJson[] = Array.isArray(json.images) ? json.images : [];
+  let budget = MAX_FILE_BYTES;
+  for (const [i, image] of images.entries()) {
+    let bytes: Uint8Array | undefined;
+    if (typeof image?.uri === 'string') {
+      bytes = await read(image.uri, 'image', i, budget + 1);
+      if (bytes.byteLength > budget) throw tooLarge(name, MAX_FILE_BYTES, `${name}'s images`);
+      budget -= bytes.byteLength;
+      image.uri = URL.createObjectURL(new Blob([bytes as Uint8Array<ArrayBuffer>], typeof image.mimeType === 'string' ? { type: image.mimeType } : {}));
+      blobs.push(image.uri);
+    } else if (Number.isInteger(image?.bufferView)) {
+      const view = json.bufferViews?.[image.bufferView];
+      const data = view && buffers[view.buffer];
+      if (data) bytes = data.subarray(view.byteOffset ?? 0, (view.byteOffset ?? 0) + view.byteLength);
     }
-    data.set(value.subarray(0, take), length);
-    length += take;
+    const size = bytes && imageSize(bytes);
+    const why = size && imageTooLarge(size);
+    if (why) throw new GltfError('TOO_LARGE', name, `/images/${i}`, `${name}: image ${i} ${why}`);
   }
-  await reader.cancel().catch(() => {});
-  return data.subarray(0, length);
 }
 
 /**
  * GLTFLoader on validated JSON: each buffer's uri replaced by a blob URL of its checked bytes
- * (GLB chunk, data: URI and external files alike), so the loader fetches nothing the checks did
- * not see. `imageUrl` maps the images' remaining URLs.
+ * (GLB chunk, data: URI and external files alike), images already so, so the loader reads nothing
+ * the checks did not see; what it still asks for goes through the guarded manager.
  */
-async function parseValidated(gltf: ValidatedGltf, name: string, path: string, imageUrl: (url: string) => string, done: () => void): Promise<GLTF> {
+async function parseValidated(gltf: ValidatedGltf, name: string, blobs: string[]): Promise<GLTF> {
   const { json, buffers, data } = gltf;
   const zeroWeights = zeroWeightVertices(json, data);
-  const blobs: string[] = [];
   buffers.forEach((bytes, i) => {
     if (!bytes) return;
     json.buffers[i].uri = URL.createObjectURL(new Blob([bytes as Uint8Array<ArrayBuffer>]));
     blobs.push(json.buffers[i].uri);
   });
-  const manager = new THREE.LoadingManager();
-  manager.setURLModifier((url) => (blobs.includes(url) ? url : imageUrl(url)));
+  const used: string[] = Array.isArray(json.extensionsUsed) ? json.extensionsUsed.filter((e: unknown) => typeof e === 'string') : [];
+  const loader = new GLTFLoader(guardedManager);
+  await addDecoders(loader, used, state.renderer, guardedManager);
+  takeRefused();
   let result: GLTF;
   try {
-    result = await new GLTFLoader(manager).parseAsync(JSON.stringify(json), path);
+    result = await withinTime(loader.parseAsync(JSON.stringify(json), ''), PARSE_SECONDS, () => new GltfError('LOAD_FAILED', name, '',
+      `${name}: three's GLTFLoader and its decoders did not finish within ${PARSE_SECONDS} s`));
   } catch (e) {
-    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${(e as Error)?.message ?? e}`);
-  } finally {
-    blobs.forEach((u) => URL.revokeObjectURL(u));
-    setTimeout(done, 10000); // images may still be decoding
+    if (e instanceof GltfError) throw e;
+    const failed = decoderFailure(used);
+    if (failed) throw new GltfError('BAD_DATA', name, '', `${name}: ${failed}`);
+    const message = (e as Error)?.message ?? String(e);
+    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${shownName(message, 120)}`);
   }
+  const refused = takeRefused();
+  if (refused.length)
+    throw new GltfError('OUTSIDE_FOLDER', name, '', `${name} asked the page for '${shownName(refused[0])}', on another site: this page reads only its own files`);
+  checkDecodedCounts(json, result, name);
   const skinned: THREE.SkinnedMesh[] = [];
   result.scene?.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) skinned.push(o as THREE.SkinnedMesh); });
   restoreZeroWeights(skinned, result.parser.associations, zeroWeights);
   result.scene ??= new THREE.Group();
   return result;
+}
+
+/** A decoder whose worker dies (a crash, a refused script) never settles its promise: the page gives up after this. */
+const PARSE_SECONDS = 60;
+
+function withinTime<T>(work: Promise<T>, seconds: number, late: () => Error): Promise<T> {
+  let timer = 0;
+  return Promise.race([work, new Promise<never>((_, reject) => { timer = window.setTimeout(() => reject(late()), seconds * 1000); })])
+    .finally(() => clearTimeout(timer));
+}
+
+/**
+ * After Draco's decoder: every Draco primitive has the vertices and indices its accessors declare
+ * (BAD_DATA otherwise). The other decoders cannot change a count: meshopt fills buffer views of
+ * their declared length, quantized attributes are read as they are.
+ */
+function checkDecodedCounts(json: GltfJson, result: GLTF, name: string): void {
+  result.parser.associations.forEach((ref, object) => {
+    const mesh = object as THREE.Mesh;
+    if (!mesh.isMesh || ref.meshes === undefined || ref.primitives === undefined) return;
+    const p = json.meshes[ref.meshes].primitives[ref.primitives];
+    if (!p.extensions?.KHR_draco_mesh_compression) return;
+    const prim = `mesh ${ref.meshes} primitive ${ref.primitives}`;
+    const declared = json.accessors[p.attributes.POSITION]?.count;
+    const position = mesh.geometry.getAttribute('position');
+    if (declared !== undefined && position?.count !== declared)
+      throw new GltfError('BAD_DATA', name, `/meshes/${ref.meshes}/primitives/${ref.primitives}`,
+        `${name}: ${prim} decodes to ${n(position?.count ?? 0)} vertices where its accessors declare ${n(declared)}`);
+    const indices = p.indices === undefined ? undefined : json.accessors[p.indices].count;
+    if (indices !== undefined && mesh.geometry.index?.count !== indices)
+      throw new GltfError('BAD_DATA', name, `/meshes/${ref.meshes}/primitives/${ref.primitives}`,
+        `${name}: ${prim} decodes to ${n(mesh.geometry.index?.count ?? 0)} indices where its accessors declare ${n(indices)}`);
+  });
 }

@@ -9,7 +9,8 @@ import { playClip } from './animate.js';
 import { applyMaterials, gcsColours } from './colours.js';
 import { setClipOptions, syncModelMenu, updateCredit, type MenuEntry } from './controls.js';
 import { humanDataInWorker } from './human-data.js';
-import { basename, GltfError, loadDroppedGltf, loadGltfUrl } from './load-gltf.js';
+import { fileName, GltfError, loadDroppedGltf, loadGltfUrl, modelName } from './load-gltf.js';
+import { shownName } from '../lib/gltf/shown-name.js';
 import { buildClassic, buildGcs, classicSummary, scheduleCostMeasure } from './models.js';
 import { clearMessage, DemoError, describeError, hideStatus, shownMessage, showMessage, showStatus, yieldToPage } from './page.js';
 import { dom, LAYER, params, query, queryNumber, state, type Character } from './state.js';
@@ -113,21 +114,22 @@ async function loadHuman(): Promise<void> {
 async function loadFiles(files: File[]): Promise<void> {
   const main = files.find((f) => /\.glb$/i.test(f.name)) ?? files.find((f) => /\.gltf$/i.test(f.name));
   if (!main) {
-    const names = files.map((f) => f.name).join(', ') || 'That';
+    const names = shownName(files.map((f) => f.name).join(', ')) || 'That';
     throw new GltfError('NOT_GLTF', names, '', `${names} is not a glTF file: drop a skinned .glb or .gltf`);
   }
-  showStatus(`building… reading ${main.name}`);
+  const name = fileName(main);
+  showStatus(`building… reading ${name}`);
   await yieldToPage();
   // Validated as the CLI validates (a GltfError: one sentence and a code), then parsed.
   const gltf = await loadDroppedGltf(main, files.filter((f) => f !== main));
-  await install(main.name, gltf.scene, gltf.animations, { normalise: true, key: 'file', credit: null });
+  await install(name, gltf.scene, gltf.animations, { normalise: true, key: 'file', credit: null });
 }
 
 /** A URL, or a character shipped in public/ (served beside the page). */
 async function loadUrl(url: string, shipped?: Shipped): Promise<void> {
-  const name = shipped?.label ?? basename(url);
+  const name = shipped?.label ?? modelName(url);
   showStatus(`building… loading ${name}`);
-  const gltf = await loadGltfUrl(url, shipped ? name : url);
+  const gltf = await loadGltfUrl(url, name);
   await install(name, gltf.scene, gltf.animations, { normalise: true, key: shipped?.key ?? 'file', credit: shipped?.credit ?? null });
 }
 

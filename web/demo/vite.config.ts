@@ -1,6 +1,7 @@
 // Vite config of the demo page: `npm start` (dev server) and `npm run build:demo` (static build).
 import { fileURLToPath } from 'node:url';
 import { defineConfig } from 'vite';
+import { decoderFiles } from './decoder-files.js';
 
 const here = fileURLToPath(new URL('.', import.meta.url));
 const repo = fileURLToPath(new URL('../..', import.meta.url));
@@ -13,6 +14,8 @@ export default defineConfig({
   // CesiumMan.glb, RobotExpressive.glb) and their LICENSES.md, copied as they are to the build's root.
   publicDir: fileURLToPath(new URL('../../public', import.meta.url)),
   server: { fs: { allow: [repo] } },
+  // Draco's and Basis Universal's decoders, served from the page's own origin (decoder-files.ts).
+  plugins: [decoderFiles()],
   // The human character is generated in a module worker (it imports three).
   worker: { format: 'es' },
   build: {

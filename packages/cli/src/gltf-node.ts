@@ -10,15 +10,18 @@
 // than 8: the 8 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
 // gets. Used by `gcs-skin report`, `@gcs-skin/cli/gltf` (loadCharacter), the bench scripts and tests.
-import { constants as fs } from 'node:fs';
-import { open, readFile, realpath } from 'node:fs/promises';
+import { realpath } from 'node:fs/promises';
 import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { restoreZeroWeights } from '../../../web/lib/gltf/accessors.js';
 import { decodeBufferPath, readValidatedGltf } from '../../../web/lib/gltf/buffers.js';
+import { sniffGltf } from '../../../web/lib/gltf/container.js';
 import { GltfError, n } from '../../../web/lib/gltf/error.js';
 import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
+import { LIMITS } from '../../../web/lib/gltf/limits.js';
+import { shownName } from '../../../web/lib/gltf/shown-name.js';
+import { FileRefused, readRegularFile, readStandardInput, systemReason } from './read-file.js';
 import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
 
 export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
@@ -42,12 +45,14 @@ export interface GltfFile {
 const GLB_BUFFER = '@glb.bin'; // gltf-transform's key for the GLB's BIN chunk
 
 function reason(e: unknown): string {
-  const err = e as NodeJS.ErrnoException;
-  if (err?.code === 'ENOENT') return 'no such file';
-  if (err?.code === 'EISDIR') return 'it is a directory';
-  if (err?.code === 'EACCES') return 'permission denied';
-  return String(err?.message ?? e).replace(/\s*\n\s*/g, ' ');
+  return shownName(systemReason(e), 160);
 }
+
+/** A byte budget shared by a file and its external buffers (LIMITS.fileBytes in all). */
+interface Budget { left: number }
+
+const tooMuch = (file: string, what: string, bytes: number) => new GltfError('TOO_LARGE', file, '',
+  `${what} has ${n(bytes)} bytes, past the ${n(LIMITS.fileBytes)} a glTF file and its buffers may hold together`);
 
 /**
  * The bytes of buffer `i`'s external file: only a regular file inside the glTF's folder `baseDir`
@@ -55,17 +60,17 @@ function reason(e: unknown): string {
  * shorter file is reported TRUNCATED by the validator). URLs, absolute paths, '..' out of the
  * folder, links leading out of it, devices and pipes are refused before anything is opened.
  */
-async function readBufferFile(baseDir: string, uri: string, maxBytes: number, file: string, i: number): Promise<Uint8Array> {
+async function readBufferFile(baseDir: string, uri: string, maxBytes: number, file: string, i: number, budget: Budget): Promise<Uint8Array> {
   const where = `/buffers/${i}/uri`;
   const outside = (why: string) =>
-    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${uri}' ${why}: a buffer is read only from a file in the glTF's own folder`);
+    new GltfError('OUTSIDE_FOLDER', file, where, `${file}: buffer ${i}'s uri '${shownName(uri)}' ${why}; buffers are read from the glTF's folder only`);
   const path = decodeBufferPath(uri, file, i);
   if (/^[a-z][a-z0-9+.-]+:/i.test(path)) throw outside('is a URL, not a relative path');
   if (isAbsolute(path) || /^[\\/]/.test(path)) throw outside('is an absolute path');
   const folder = resolve(baseDir);
   const within = (root: string, p: string) => { const r = relative(root, p); return r !== '..' && !r.startsWith(`..${sep}`) && !isAbsolute(r); };
   if (!within(folder, resolve(folder, path))) throw outside("leads out of the glTF's folder");
-  const unreadable = (e: unknown) => new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${uri}' cannot be read (${reason(e)})`);
+  const unreadable = (e: unknown) => new GltfError('UNREADABLE', file, where, `${file}: buffer ${i}'s file '${shownName(uri)}' cannot be read (${reason(e)})`);
   let real: string;
   try {
     real = await realpath(resolve(folder, path));
@@ -73,39 +78,46 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
     throw unreadable(e);
   }
   if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
-  // Non-blocking: opening a FIFO must not wait for a writer; what is open is then checked, not a name.
-  const handle = await open(real, fs.O_RDONLY | fs.O_NONBLOCK | fs.O_NOFOLLOW).catch((e) => { throw unreadable(e); });
-  if (!(await handle.stat()).isFile()) {
-    await handle.close();
-    throw outside('is not a regular file');
-  }
   try {
-    const size = (await handle.stat()).size;
-    const wanted = Math.min(maxBytes, size);
-    const bytes = new Uint8Array(wanted);
-    for (let at = 0; at < wanted;) {
-      const { bytesRead } = await handle.read(bytes, at, wanted - at, at);
-      if (!bytesRead) return bytes.subarray(0, at); // the file shrank meanwhile: TRUNCATED
-      at += bytesRead;
-    }
+    // No link followed at the last step: the path checked above is the one opened.
+    const bytes = await readRegularFile(real, { maxBytes: budget.left, truncateAt: maxBytes, noFollow: true });
+    budget.left -= bytes.byteLength;
     return bytes;
-  } finally {
-    await handle.close();
+  } catch (e) {
+    if (!(e instanceof FileRefused)) throw e;
+    if (e.kind === 'type') throw outside(`is not a regular file (${e.message.replace(/, not a regular file$/, '')})`);
+    if (e.kind === 'size') throw tooMuch(file, `${file}: buffer ${i}'s file '${shownName(uri)}'`, Math.min(maxBytes, e.size));
+    throw unreadable(e.message);
   }
 }
 
 /**
- * Reads a .glb or .gltf file and its external buffers and validates them (gltf-validate.ts).
- * Throws a GltfError (code and one sentence naming the file) for anything wrong.
+ * Reads a .glb or .gltf file (a regular file, read as read-file.ts guards it) and its external
+ * buffers, and validates them (web/lib/gltf/validate.ts). `-` reads standard input, as bytes with
+ * no folder. Throws a GltfError (code and one sentence naming the file) for anything wrong.
  */
 export async function readGltfFile(file: string): Promise<GltfFile> {
+  if (file === '-') {
+    const name = 'standard input';
+    try {
+      return await readGltfBytes(await readStandardInput(LIMITS.fileBytes), name, null);
+    } catch (e) {
+      if (e instanceof FileRefused) throw tooMuch(name, name, e.size);
+      throw e;
+    }
+  }
   let bytes: Uint8Array;
   try {
-    bytes = await readFile(file);
+    bytes = await readRegularFile(file, { maxBytes: LIMITS.fileBytes, sniff: (head, size) => void sniffGltf(head, size, file) });
   } catch (e) {
-    throw new GltfError('UNREADABLE', file, '', `cannot read ${file}: ${reason(e)}`);
+    if (!(e instanceof FileRefused)) throw e;
+    if (e.kind === 'size') throw tooMuch(file, file, e.size);
+    const stdin = e.kind === 'type' && /FIFO|character device/.test(e.message) ? " (give '-' to read standard input)" : '';
+    throw new GltfError('UNREADABLE', file, '', `cannot read ${file}: ${e.message}${stdin}`);
   }
-  return readGltfBytes(bytes, file, dirname(file));
+  // A file named through /dev or /proc (/dev/stdin redirected from a file, /dev/fd/3) has no folder of its own.
+  const folder = /^\/(dev|proc)\//.test(resolve(file)) ? null : dirname(file);
+  return readGltfBytes(bytes, file, folder, { left: LIMITS.fileBytes - bytes.byteLength });
 }
 
 /**
@@ -113,8 +125,8 @@ export async function readGltfFile(file: string): Promise<GltfFile> {
  * buffers are read from `baseDir` (null: bytes with no folder, so a buffer in a file of its own is
  * an UNREADABLE error). Throws a GltfError for anything wrong.
  */
-export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: string | null): Promise<GltfFile> {
-  const external = baseDir === null ? null : (uri: string, i: number, maxBytes: number) => readBufferFile(baseDir, uri, maxBytes, name, i);
+export async function readGltfBytes(bytes: Uint8Array, name: string, baseDir: string | null, budget: Budget = { left: LIMITS.fileBytes }): Promise<GltfFile> {
+  const external = baseDir === null ? null : (uri: string, i: number, maxBytes: number) => readBufferFile(baseDir, uri, maxBytes, name, i, budget);
   const { json, buffers, glbBin, data } = await readValidatedGltf(bytes, name, external);
   // gltf-transform reads each buffer's bytes under a key of its own (decoded once, here: data: URIs
   // included; two buffers may name one file with different byteLengths).
@@ -146,7 +158,7 @@ const DRACO_MODULE = 'draco3dgltf';
 /** A NodeIO that reads the compression extensions `used` by a file, with their decoders registered. */
 async function decodingIO(used: readonly string[]) {
   const [{ NodeIO }, ext] = await Promise.all([import('@gltf-transform/core'), import('@gltf-transform/extensions')]);
-  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression]);
+  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression, ext.KHRTextureBasisu]);
   const dependencies: Record<string, unknown> = {};
   if (used.includes('EXT_meshopt_compression')) {
     meshoptDecoder ??= import('meshoptimizer').then(async ({ MeshoptDecoder }) => {
@@ -270,21 +282,62 @@ function reduceInfluences(doc: Doc, prim: import('@gltf-transform/core').Primiti
     `gcs-skin takes ${KEPT}: kept the ${KEPT} largest of each vertex and renormalised them (${n(cut)} of ${n(count)} vertices lost an influence, the largest lost weight ${maxDropped.toPrecision(3)})`;
 }
 
+/** The compressed data a decoder reads, as messages name it. */
+const COMPRESSED_DATA: [string, string][] = [['KHR_draco_mesh_compression', 'Draco'], ['EXT_meshopt_compression', 'meshopt']];
+
+/** Per Draco primitive ("mesh/primitive"), the vertices and indices its accessors declare. */
+function dracoCounts(json: GltfJson): Map<string, { vertices: number; indices?: number }> {
+  const out = new Map<string, { vertices: number; indices?: number }>();
+  (json.meshes ?? []).forEach((m: GltfJson, mi: number) => m.primitives.forEach((p: GltfJson, pi: number) => {
+    if (!p.extensions?.KHR_draco_mesh_compression) return;
+    out.set(`${mi}/${pi}`, { vertices: json.accessors[p.attributes.POSITION ?? Object.values(p.attributes)[0]].count, indices: p.indices === undefined ? undefined : json.accessors[p.indices].count });
+  }));
+  return out;
+}
+
+/**
+ * After Draco's decoder: each Draco primitive decoded to the vertices and indices its accessors
+ * declare (BAD_DATA otherwise; the header was checked against them before decoding, but an
+ * edgebreaker stream's vertex count is known only once decoded). meshopt and quantization cannot
+ * change a count.
+ */
+function checkDecodedCounts(doc: Doc, declared: Map<string, { vertices: number; indices?: number }>, file: string): void {
+  doc.getRoot().listMeshes().forEach((mesh, mi) => mesh.listPrimitives().forEach((prim, pi) => {
+    const want = declared.get(`${mi}/${pi}`);
+    if (!want) return;
+    const vertices = (prim.getAttribute('POSITION') ?? prim.listAttributes()[0])?.getCount() ?? 0;
+    const indices = prim.getIndices()?.getCount();
+    const what = vertices !== want.vertices ? `${n(vertices)} vertices where its accessors declare ${n(want.vertices)}`
+      : want.indices !== undefined && indices !== want.indices ? `${n(indices ?? 0)} indices where its accessors declare ${n(want.indices)}` : null;
+    if (what) throw new GltfError('BAD_DATA', file, `/meshes/${mi}/primitives/${pi}`, `${file}: the Draco data of mesh ${mi} primitive ${pi} decodes to ${what}`);
+  }));
+}
+
 /**
  * Reads a .glb or .gltf file (a path, or its bytes: `name` then names it in messages) in node into
  * three.js objects: compressed geometry decoded, textures dropped. Throws a GltfError for a bad file.
  */
-export async function loadGltfFile(file: string | Uint8Array, name = typeof file === 'string' ? file : 'the glTF bytes'): Promise<LoadedModel> {
+export async function loadGltfFile(file: string | Uint8Array, name = typeof file !== 'string' ? 'the glTF bytes' : file === '-' ? 'standard input' : file): Promise<LoadedModel> {
   const { json, resources } = typeof file === 'string' ? await readGltfFile(file) : await readGltfBytes(file, name, null);
   file = name;
   const warnings: string[] = [];
   const logger = { debug() {}, info() {}, warn: (t: string) => void warnings.push(t), error: (t: string) => void warnings.push(t), verbosity: 2 };
   let bytes: Uint8Array;
   const zeroWeights = new Map<string, number[]>();
+  const used: string[] = Array.isArray(json.extensionsUsed) ? json.extensionsUsed : [];
+  const declared = dracoCounts(json);
+  const io = (await decodingIO(used)).setLogger(logger as never);
+  let doc: Doc;
   try {
-    const used: string[] = Array.isArray(json.extensionsUsed) ? json.extensionsUsed : [];
-    const io = (await decodingIO(used)).setLogger(logger as never);
-    const doc = await io.readJSON({ json, resources } as Parameters<typeof io.readJSON>[0]);
+    doc = await io.readJSON({ json, resources } as Parameters<typeof io.readJSON>[0]);
+  } catch (e) {
+    // The decoders' own exceptions ("Invalid typed array length", a Draco status) become ours.
+    const compressed = COMPRESSED_DATA.filter(([ext]) => used.includes(ext)).map(([, what]) => what);
+    if (compressed.length) throw new GltfError('BAD_DATA', file, '', `${file}: its ${compressed.join(' or ')} data does not decode`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+  }
+  checkDecodedCounts(doc, declared, file);
+  try {
     for (const texture of doc.getRoot().listTextures()) texture.dispose();
     plainGeometry(doc, warnings);
     // three's GLTFLoader binds a vertex whose skin weights are all 0 to the first joint ("do

@@ -1,5 +1,8 @@
 // `gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb`
-import { writeFileSync } from 'node:fs';
+import { closeSync, constants, fstatSync, ftruncateSync, openSync, writeSync } from 'node:fs';
+import { printable } from '../../../web/lib/gltf/shown-name.js';
+import { wholeNumber } from './args.js';
+import { systemReason } from './read-file.js';
 import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from '../../../web/lib/human/index.js';
 
 export const usage = `usage: gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb
@@ -20,9 +23,7 @@ function parse(argv: string[]) {
       return v;
     };
     if (a === '--vertices' || a === '-n') {
-      const v = value();
-      if (!/^\d+$/.test(v)) throw new UsageError(`--vertices must be an integer (got '${v}')`);
-      opts.vertices = Number(v);
+      opts.vertices = wholeNumber(a, value(), MIN_VERTICES, MAX_VERTICES);
     } else if (a === '--pose') {
       const v = value();
       if (v !== 'stand' && v !== 'tpose') throw new UsageError(`--pose must be stand or tpose (got '${v}')`);
@@ -45,9 +46,13 @@ export async function run(argv: string[]): Promise<number> {
     const t0 = performance.now();
     const human = createHuman({ vertices: opts.vertices, pose: opts.pose, seams: opts.seams });
     const glb = await humanToGlb(human);
-    writeFileSync(opts.out!, glb);
+    const failed = writeRegularFile(opts.out!, glb);
+    if (failed) {
+      process.stderr.write(`gcs-skin human: cannot write '${printable(opts.out!)}': ${failed} [UNWRITABLE]\n`);
+      return 2;
+    }
     const d = human.data;
-    process.stdout.write(`wrote ${opts.out}: ${d.positions.length / 3} vertices, ${d.indices.length / 3} triangles, ` +
+    process.stdout.write(`wrote ${printable(opts.out!)}: ${d.positions.length / 3} vertices, ${d.indices.length / 3} triangles, ` +
       `${d.jointNames.length} joints, clips ${human.clips.map((c) => c.name).join('/')}, ${(glb.length / 1024).toFixed(0)} KiB ` +
       `(${(performance.now() - t0).toFixed(0)} ms)\n`);
     return 0;
@@ -57,5 +62,25 @@ export async function run(argv: string[]): Promise<number> {
       return 2;
     }
     throw e;
+  }
+}
+
+/**
+ * Writes `bytes` to the regular file `path` (created or replaced): opened non-blocking (a FIFO
+ * with no reader fails at once instead of hanging), refused unless it is a regular file (a
+ * directory, /dev/full, a device), then written whole. Returns why it failed, or null.
+ */
+function writeRegularFile(path: string, bytes: Uint8Array): string | null {
+  let fd = -1;
+  try {
+    fd = openSync(path, constants.O_WRONLY | constants.O_CREAT | constants.O_NONBLOCK, 0o644);
+    if (!fstatSync(fd).isFile()) return 'it is not a regular file';
+    ftruncateSync(fd, 0);
+    for (let at = 0; at < bytes.length;) at += writeSync(fd, bytes, at, bytes.length - at);
+    return null;
+  } catch (e) {
+    return (e as NodeJS.ErrnoException).code === 'ENOENT' ? 'its folder does not exist' : systemReason(e);
+  } finally {
+    if (fd >= 0) closeSync(fd);
   }
 }

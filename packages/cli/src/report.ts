@@ -6,9 +6,12 @@
 // collapse, creases, new self-intersections per method). The JSON shape is documented in
 // docs/report-json.md.
 import type * as THREE from 'three';
+import { setConsoleFunction } from 'three';
 import { GcsError } from '../../../web/lib/errors.js';
 import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
+import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
+import { wholeNumber } from './args.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, timeFrames,
@@ -107,21 +110,6 @@ export class ReportError extends Error {
     this.name = 'ReportError';
     this.code = code;
   }
-}
-
-/**
- * Text safe for a terminal: control characters (C0, DEL, C1) and bidirectional overrides, which a
- * file's names may carry to set the window title, clear the screen or reorder text, written as
- * escapes (\x1b, \n, \u202e) instead of being sent raw.
- */
-export function printable(s: string): string {
-  return s.replace(/[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]/g, (c) => {
-    const code = c.charCodeAt(0);
-    if (c === '\n') return '\\n';
-    if (c === '\r') return '\\r';
-    if (c === '\t') return '\\t';
-    return code < 0x100 ? `\\x${code.toString(16).padStart(2, '0')}` : `\\u${code.toString(16).padStart(4, '0')}`;
-  });
 }
 
 /** One printable line: a message's line breaks (engine messages have some) become spaces, other controls escapes. */
@@ -313,7 +301,7 @@ export function formatReport(r: Report): string {
   for (const w of r.warnings) out.push(`loader warning: ${printable(w)}`);
   for (const m of r.meshes) {
     const c = m.counts;
-    out.push('', `mesh '${printable(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
+    out.push('', `mesh '${shownName(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
     out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
@@ -337,7 +325,7 @@ export function formatReport(r: Report): string {
     out.push(table(rows));
     if (!m.clips.length) out.push('(no animation clips: per-clip timing needs a clip)');
     for (const clip of m.clips) {
-      out.push('', `clip '${printable(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
+      out.push('', `clip '${shownName(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
       const rows2 = [['method', 'median ms', 'p95 ms', 'adjusted']];
       for (const name of METHODS) {
         const x = clip.methods[name];
@@ -365,19 +353,14 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
       if (v === undefined) throw new ReportError(`${a} needs a value`);
       return v;
     };
-    const integer = (min: number, max: number) => {
-      const s = value();
-      const n = Number(s);
-      if (!Number.isInteger(n) || n < min || n > max) throw new ReportError(`${a} must be a whole number from ${min} to ${max}; got '${s}'`);
-      return n;
-    };
+    const integer = (min: number, max: number) => wholeNumber(a, value(), min, max);
     if (a === '--json') json = true;
     else if (a === '-h' || a === '--help') help = true;
     else if (a === '--clip') options.clip = value();
     else if (a === '--sections') options.sections = integer(3, 256);
     else if (a === '--frames') options.frames = integer(1, 10000);
     else if (a === '--time-ms') options.timeMs = integer(1, 60000);
-    else if (a.startsWith('-')) throw new ReportError(`unknown option '${a}'`);
+    else if (a.startsWith('-') && a !== '-') throw new ReportError(`unknown option '${a}'`); // '-': standard input
     else if (file === undefined) file = a;
     else throw new ReportError(`only one model file, got '${file}' and '${a}'`);
   }
@@ -404,6 +387,9 @@ export async function run(argv: string[]): Promise<number> {
     process.stderr.write(`gcs-skin report: missing model file\n${usage}\n`);
     return 2;
   }
+  // three's own notes (PropertyBinding: a track whose node is absent) are not the command's to
+  // print: a successful run writes its report and nothing else; three's errors still reach stderr.
+  setConsoleFunction((level, message, ...params) => { if (level === 'error') console.error(message, ...params); });
   let r: Report;
   try {
     r = await report(args.file, args.options);
@@ -417,7 +403,7 @@ export async function run(argv: string[]): Promise<number> {
   console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r));
   const bad = nonFiniteMethods(r);
   if (bad.length) {
-    process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${printable(b.mesh)}' (${b.count})`).join(', ')}\n`);
+    process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${shownName(b.mesh)}' (${b.count})`).join(', ')}\n`);
     return 1;
   }
   return 0;

@@ -4,6 +4,8 @@
 // external files through a reader the caller gives, asked for at most the declared byteLength.
 // Then the whole file goes through validateGltfJson. Browser-safe: no node module.
 import { parseGltfContainer } from './container.js';
+import { checkDracoCounts } from './draco-check.js';
+import { shownName } from './shown-name.js';
 import { GltfError, n } from './error.js';
 import type { BufferData, GltfJson } from './json.js';
 import { validateGltfJson } from './validate.js';
@@ -60,7 +62,7 @@ export function decodeBufferPath(uri: string, file: string, i: number): string {
   try {
     path = decodeURIComponent(uri);
   } catch {
-    throw new GltfError('BAD_URI', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri '${uri}' has a bad %-escape`);
+    throw new GltfError('BAD_URI', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri '${shownName(uri)}' has a bad %-escape`);
   }
   if (path.includes('\0')) throw new GltfError('BAD_URI', file, `/buffers/${i}/uri`, `${file}: buffer ${i}'s uri has a NUL character`);
   return path;
@@ -100,10 +102,11 @@ export async function readValidatedGltf(bytes: Uint8Array, file: string, externa
     if (inline) { keep(inline, 'its data: URI'); continue; }
     if (!external)
       throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
-        `${file}: buffer ${i} is in the file '${uri}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
+        `${file}: buffer ${i} is in the file '${shownName(uri)}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
     const maxBytes = Number.isInteger(b.byteLength) && b.byteLength >= 0 ? b.byteLength : 0; // a bad byteLength is reported next
-    keep(await external(uri, i, maxBytes), `its file '${uri}'`);
+    keep(await external(uri, i, maxBytes), `its file '${shownName(uri)}'`);
   }
   validateGltfJson(json, file, data);
+  checkDracoCounts(json, data, file);
   return { json, buffers, glbBin, data };
 }

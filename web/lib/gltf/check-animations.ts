@@ -4,6 +4,7 @@ import { n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
 import { COMPONENT, isObject, TYPE_COMPONENTS, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { shownValue } from './shown-name.js';
 
 const INTERPOLATIONS = ['LINEAR', 'STEP', 'CUBICSPLINE'];
 const PATH_TYPES: Record<string, string> = { translation: 'VEC3', rotation: 'VEC4', scale: 'VEC3', weights: 'SCALAR' };
@@ -59,7 +60,7 @@ export function checkAnimations(ctx: ValidationContext): void {
       ref(s.input, accessors, 'accessor', `${sw}/input`, `the input of sampler ${i} of ${anim}`, true);
       ref(s.output, accessors, 'accessor', `${sw}/output`, `the output of sampler ${i} of ${anim}`, true);
       if (s.interpolation !== undefined && !INTERPOLATIONS.includes(s.interpolation))
-        fail('BAD_STRUCTURE', `${sw}/interpolation`, `sampler ${i} of ${anim} has interpolation ${JSON.stringify(s.interpolation)}, not ${INTERPOLATIONS.join(', ')}`);
+        fail('BAD_STRUCTURE', `${sw}/interpolation`, `sampler ${i} of ${anim} has interpolation ${shownValue(s.interpolation)}, not ${INTERPOLATIONS.join(', ')}`);
       const input = accessors[s.input];
       if (input.type !== 'SCALAR' || input.componentType !== 5126)
         fail('BAD_STRUCTURE', `${sw}/input`, `the key times of sampler ${i} of ${anim} (accessor ${s.input}) are ${input.type} of ${COMPONENT[input.componentType].name}, not SCALAR of FLOAT`);
@@ -72,7 +73,7 @@ export function checkAnimations(ctx: ValidationContext): void {
       ref(c.target.node, nodes, 'node', `${where}/channels/${i}/target/node`, `channel ${i} of ${anim}`);
       if (!TARGET_PATHS.includes(c.target.path))
         fail('BAD_STRUCTURE', `${where}/channels/${i}/target/path`,
-          `channel ${i} of ${anim} animates ${JSON.stringify(c.target.path) ?? 'nothing'}, not ${TARGET_PATHS.join(', ')}`);
+          `channel ${i} of ${anim} animates ${shownValue(c.target.path) ?? 'nothing'}, not ${TARGET_PATHS.join(', ')}`);
       // The values must be what the path takes, one per key (three per key for CUBICSPLINE: in-tangent,
       // value, out-tangent; weights: one per morph target): three's interpolants read them by stride, and
       // a rotation fed 3-vectors makes its mixer loop forever.

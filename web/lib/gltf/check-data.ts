@@ -4,6 +4,7 @@ import { sparseReader } from './accessors.js';
 import { GltfError, n, plural } from './error.js';
 import { LIMITS } from './limits.js';
 import { COMPONENT, elementBytes, isIndex, isObject, TYPE_COMPONENTS, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { shownValue } from './shown-name.js';
 
 /** Buffers: declared byteLength against the data. */
 export function checkBuffers(ctx: ValidationContext): void {
@@ -11,7 +12,7 @@ export function checkBuffers(ctx: ValidationContext): void {
   const { file, buffers, bufferDefs } = ctx;
   bufferDefs.forEach((b, i) => {
     const where = `/buffers/${i}`;
-    if (!isIndex(b.byteLength)) fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer ${i}'s byteLength is ${JSON.stringify(b.byteLength)}, not a whole number`);
+    if (!isIndex(b.byteLength)) fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer ${i}'s byteLength is ${shownValue(b.byteLength)}, not a whole number`);
     const data = buffers[i];
     if (data && b.byteLength > data.byteLength)
       throw new GltfError('TRUNCATED', file, where,
@@ -28,11 +29,11 @@ export function checkBufferViews(ctx: ValidationContext): void {
     const where = `/bufferViews/${i}`;
     ref(v.buffer, bufferDefs, 'buffer', `${where}/buffer`, `buffer view ${i}`, true);
     const offset = v.byteOffset ?? 0;
-    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `buffer view ${i}'s byteOffset is ${JSON.stringify(offset)}, not a whole number`);
+    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `buffer view ${i}'s byteOffset is ${shownValue(offset)}, not a whole number`);
     if (!isIndex(v.byteLength) || v.byteLength < 1)
-      fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer view ${i}'s byteLength is ${JSON.stringify(v.byteLength)}, not a whole number ≥ 1`);
+      fail('BAD_STRUCTURE', `${where}/byteLength`, `buffer view ${i}'s byteLength is ${shownValue(v.byteLength)}, not a whole number ≥ 1`);
     if (v.byteStride !== undefined && (!Number.isInteger(v.byteStride) || v.byteStride < 4 || v.byteStride > 252))
-      fail('BAD_STRUCTURE', `${where}/byteStride`, `buffer view ${i}'s byteStride is ${JSON.stringify(v.byteStride)}, not a whole number from 4 to 252`);
+      fail('BAD_STRUCTURE', `${where}/byteStride`, `buffer view ${i}'s byteStride is ${shownValue(v.byteStride)}, not a whole number from 4 to 252`);
     const meshopt = v.extensions?.EXT_meshopt_compression;
     if (meshopt !== undefined) {
       // The compressed bytes: inside their buffer; decoded, count × byteStride bytes, inside this view.
@@ -41,7 +42,7 @@ export function checkBufferViews(ctx: ValidationContext): void {
       ref(meshopt.buffer, bufferDefs, 'buffer', `${mw}/buffer`, `the compressed data of buffer view ${i}`, true);
       const mo = meshopt.byteOffset ?? 0;
       for (const [key, value] of [['byteOffset', mo], ['byteLength', meshopt.byteLength], ['byteStride', meshopt.byteStride], ['count', meshopt.count]] as const)
-        if (!isIndex(value)) fail('BAD_STRUCTURE', `${mw}/${key}`, `the compressed data of buffer view ${i} has ${key} ${JSON.stringify(value)}, not a whole number`);
+        if (!isIndex(value)) fail('BAD_STRUCTURE', `${mw}/${key}`, `the compressed data of buffer view ${i} has ${key} ${shownValue(value)}, not a whole number`);
       const data = buffers[meshopt.buffer];
       const have = data ? Math.min(data.byteLength, bufferDefs[meshopt.buffer].byteLength) : bufferDefs[meshopt.buffer].byteLength;
       if (mo + meshopt.byteLength > have)
@@ -76,11 +77,11 @@ export function checkAccessors(ctx: ValidationContext): void {
     const where = `/accessors/${i}`;
     const name = accessorName(i);
     const component = COMPONENT[a.componentType];
-    if (!component) fail('BAD_STRUCTURE', `${where}/componentType`, `${name} has componentType ${JSON.stringify(a.componentType)}, not a glTF component type`);
-    if (!(a.type in TYPE_COMPONENTS)) fail('BAD_STRUCTURE', `${where}/type`, `${name} has type ${JSON.stringify(a.type)}, not SCALAR, VEC2-4 or MAT2-4`);
-    if (!isIndex(a.count) || a.count < 1) fail('BAD_STRUCTURE', `${where}/count`, `${name} has count ${JSON.stringify(a.count)}, not a whole number ≥ 1`);
+    if (!component) fail('BAD_STRUCTURE', `${where}/componentType`, `${name} has componentType ${shownValue(a.componentType)}, not a glTF component type`);
+    if (!(a.type in TYPE_COMPONENTS)) fail('BAD_STRUCTURE', `${where}/type`, `${name} has type ${shownValue(a.type)}, not SCALAR, VEC2-4 or MAT2-4`);
+    if (!isIndex(a.count) || a.count < 1) fail('BAD_STRUCTURE', `${where}/count`, `${name} has count ${shownValue(a.count)}, not a whole number ≥ 1`);
     const offset = a.byteOffset ?? 0;
-    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `${name} has byteOffset ${JSON.stringify(offset)}, not a whole number`);
+    if (!isIndex(offset)) fail('BAD_STRUCTURE', `${where}/byteOffset`, `${name} has byteOffset ${shownValue(offset)}, not a whole number`);
     const bytes = elementBytes(a.type, component.size);
     if (a.bufferView !== undefined) {
       ref(a.bufferView, bufferViews, 'buffer view', `${where}/bufferView`, name);
@@ -96,15 +97,15 @@ export function checkAccessors(ctx: ValidationContext): void {
       const sw = `${where}/sparse`;
       if (!isObject(s) || !isObject(s.indices) || !isObject(s.values)) fail('BAD_STRUCTURE', sw, `the sparse part of ${name} lacks indices or values`);
       if (!isIndex(s.count) || s.count < 1 || s.count > a.count)
-        fail('BAD_STRUCTURE', `${sw}/count`, `the sparse count of ${name} is ${JSON.stringify(s.count)}, not from 1 to its count ${n(a.count)}`);
+        fail('BAD_STRUCTURE', `${sw}/count`, `the sparse count of ${name} is ${shownValue(s.count)}, not from 1 to its count ${n(a.count)}`);
       const ic = COMPONENT[s.indices.componentType];
       if (![5121, 5123, 5125].includes(s.indices.componentType))
-        fail('BAD_STRUCTURE', `${sw}/indices/componentType`, `the sparse indices of ${name} have componentType ${JSON.stringify(s.indices.componentType)}, not an unsigned integer type`);
+        fail('BAD_STRUCTURE', `${sw}/indices/componentType`, `the sparse indices of ${name} have componentType ${shownValue(s.indices.componentType)}, not an unsigned integer type`);
       for (const [part, size] of [['indices', ic.size], ['values', bytes]] as const) {
         const p = s[part];
         ref(p.bufferView, bufferViews, 'buffer view', `${sw}/${part}/bufferView`, `the sparse ${part} of ${name}`, true);
         const po = p.byteOffset ?? 0;
-        if (!isIndex(po)) fail('BAD_STRUCTURE', `${sw}/${part}/byteOffset`, `the sparse ${part} of ${name} have byteOffset ${JSON.stringify(po)}, not a whole number`);
+        if (!isIndex(po)) fail('BAD_STRUCTURE', `${sw}/${part}/byteOffset`, `the sparse ${part} of ${name} have byteOffset ${shownValue(po)}, not a whole number`);
         fits(`${sw}/${part}`, `the sparse ${part} of ${name}`, p.bufferView, po, s.count, size, size);
       }
     }
@@ -129,8 +130,8 @@ export function checkDeclaredBytes(ctx: ValidationContext): void {
   const allowed = LIMITS.expandedFloor + LIMITS.expansion * present;
   if (expanded > allowed)
     fail('TOO_LARGE', largest >= 0 ? `/accessors/${largest}` : '/bufferViews',
-      `its accessors declare ${n(expanded)} bytes of data${largest >= 0 ? ` (the largest, ${accessorName(largest)}, ${plural(accessors[largest].count, 'element')})` : ''}` +
-      ` but the file has ${n(present)} bytes of buffer data: more than ${n(LIMITS.expandedFloor)} + ${LIMITS.expansion} × its data, refused before loading`);
+      `its accessors declare ${n(expanded)} bytes${largest >= 0 ? ` (largest: accessor ${largest}, ${plural(accessors[largest].count, 'element')})` : ''}` +
+      ` from ${n(present)} bytes of data, past ${LIMITS.expandedFloor / 2 ** 20} MiB + ${LIMITS.expansion} × the data`);
 }
 
 /** Sparse indices read from the data. */

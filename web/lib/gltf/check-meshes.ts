@@ -3,7 +3,8 @@
 import { n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
-import { isIndex, isObject, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { COMPONENT, isIndex, isObject, type Fail, type Ref, type ValidationContext } from './validation-context.js';
+import { shownName, shownValue } from './shown-name.js';
 
 /** Meshes: primitives, attributes of one count, Draco references, morph targets. */
 export function checkMeshes(ctx: ValidationContext): void {
@@ -21,8 +22,9 @@ export function checkMeshes(ctx: ValidationContext): void {
       if (!isObject(p) || !isObject(p.attributes)) fail('BAD_STRUCTURE', where, `${prim} has no attributes`);
       let first: [string, number] | undefined;
       for (const [k, a] of Object.entries(p.attributes)) {
-        ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${k}`, true);
+        ref(a, accessors, 'accessor', `${where}/attributes/${k}`, `${prim}'s ${shownName(k)}`, true);
         const count = accessors[a as number].count;
+        checkInfluenceType(ctx, k, a as number, `${where}/attributes/${k}`);
         if (!first) {
           first = [k, count];
           if (count > LIMITS.vertices)
@@ -30,7 +32,7 @@ export function checkMeshes(ctx: ValidationContext): void {
         }
         else if (count !== first[1])
           fail('BAD_STRUCTURE', `${where}/attributes/${k}`,
-            `${prim}'s ${k} (accessor ${a}) has ${plural(count, 'element')} but its ${first[0]} has ${n(first[1])}: every attribute has one per vertex`);
+            `${prim}'s ${shownName(k)} (accessor ${a}) has ${plural(count, 'element')} but its ${shownName(first[0])} has ${n(first[1])}: every attribute has one per vertex`);
       }
       ref(p.indices, accessors, 'accessor', `${where}/indices`, `${prim}'s indices`);
       const draco = p.extensions?.KHR_draco_mesh_compression;
@@ -39,9 +41,9 @@ export function checkMeshes(ctx: ValidationContext): void {
         if (!isObject(draco) || !isObject(draco.attributes)) fail('BAD_STRUCTURE', dw, `the KHR_draco_mesh_compression of ${prim} has no attributes`);
         ref(draco.bufferView, bufferViews, 'buffer view', `${dw}/bufferView`, `the Draco data of ${prim}`, true);
         for (const [k, id] of Object.entries(draco.attributes)) {
-          if (!isIndex(id)) fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `the Draco attribute id of ${prim}'s ${k} is ${JSON.stringify(id)}, not a whole number`);
+          if (!isIndex(id)) fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `the Draco attribute id of ${prim}'s ${shownName(k)} is ${shownValue(id)}, not a whole number`);
           if (p.attributes[k] === undefined)
-            fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${k} but no ${k} attribute`);
+            fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${shownName(k)} but no ${shownName(k)} attribute`);
         }
       }
       ref(p.material, materials, 'material', `${where}/material`, prim);
@@ -49,11 +51,27 @@ export function checkMeshes(ctx: ValidationContext): void {
         if (!Array.isArray(p.targets)) fail('BAD_STRUCTURE', `${where}/targets`, `${prim}'s morph targets are not an array`);
         p.targets.forEach((t: GltfJson, ti: number) => {
           if (!isObject(t)) fail('BAD_STRUCTURE', `${where}/targets/${ti}`, `${prim}'s morph target ${ti} is not an object`);
-          for (const [k, a] of Object.entries(t)) ref(a, accessors, 'accessor', `${where}/targets/${ti}/${k}`, `${prim}'s morph target ${ti} ${k}`, true);
+          for (const [k, a] of Object.entries(t)) ref(a, accessors, 'accessor', `${where}/targets/${ti}/${k}`, `${prim}'s morph target ${ti} ${shownName(k)}`, true);
         });
       }
     });
   });
+}
+
+/**
+ * JOINTS_n and WEIGHTS_n of glTF's types (JOINTS: VEC4 of UNSIGNED_BYTE or UNSIGNED_SHORT;
+ * WEIGHTS: VEC4 of FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT): read as anything else,
+ * their values would be blamed on a joint ("joint 30608") instead of on the accessor.
+ */
+function checkInfluenceType(ctx: ValidationContext, semantic: string, index: number, where: string): void {
+  const joints = /^JOINTS_\d+$/.test(semantic);
+  if (!joints && !/^WEIGHTS_\d+$/.test(semantic)) return;
+  const a = ctx.accessors[index];
+  const integer = a.componentType === 5121 || a.componentType === 5123;
+  const ok = a.type === 'VEC4' && (joints ? integer : a.componentType === 5126 || (integer && a.normalized === true));
+  if (!ok)
+    ctx.fail('BAD_STRUCTURE', where, `${ctx.accessorName(index)} is ${a.type} ${COMPONENT[a.componentType].name}${integer && !joints && !a.normalized ? ' not normalized' : ''}, ` +
+      (joints ? 'not VEC4 UNSIGNED_BYTE/SHORT' : 'not VEC4 FLOAT or normalized UNSIGNED_BYTE/SHORT'));
 }
 
 /** Textures, images, materials. */

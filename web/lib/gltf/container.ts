@@ -3,6 +3,8 @@
 import { GltfError, n, plural } from './error.js';
 import type { GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
+import { reservedKey } from './reserved-keys.js';
+import { shownName } from './shown-name.js';
 
 /** A split glTF file: the JSON, and the GLB's BIN chunk if any. */
 export interface GltfContainer {
@@ -62,24 +64,34 @@ function parseJsonText(bytes: Uint8Array, file: string, where: string, what: str
   const depth = nestingDepth(json, LIMITS.jsonDepth);
   if (depth > LIMITS.jsonDepth)
     throw new GltfError('TOO_LARGE', file, where, `${what} nests objects or arrays more than ${LIMITS.jsonDepth} deep, past any glTF (loaders would overflow their stack)`);
+  const reserved = reservedKey(json);
+  if (reserved)
+    throw new GltfError('BAD_STRUCTURE', file, `${where}${reserved.path}`,
+      `${what} uses the key '${shownName(reserved.key)}' (at ${shownName(reserved.path, 32)}), reserved in JavaScript objects`);
   return json as GltfJson;
 }
 
+const notGltf = (head: Uint8Array, file: string) => new GltfError('NOT_GLTF', file, 'byte 0',
+  `${file} is not a glTF file: it starts with ${showBytes(head)}, neither the binary glTF magic 'glTF' nor a JSON object`);
+
 /**
- * Splits the bytes of a .glb or .gltf into its JSON and BIN chunk, checking the GLB container.
- * Binary or JSON is decided by the content (magic 'glTF', or a JSON object), not the file name.
+ * What the first bytes of a file of `size` bytes say, before the rest is read: true for binary
+ * glTF (its 12-byte header checked against `size`), false for what may be JSON glTF (a '{' first,
+ * or only blanks so far). Throws the GltfError of a file that is neither, or whose GLB header
+ * disagrees with its size, so a reader never reads more than `head` of such a file.
  */
-export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContainer {
-  const size = bytes.byteLength;
-  const magic = size >= 4 ? new DataView(bytes.buffer, bytes.byteOffset, 4).getUint32(0, true) : -1;
+export function sniffGltf(head: Uint8Array, size: number, file: string): boolean {
+  const magic = head.byteLength >= 4 ? new DataView(head.buffer, head.byteOffset, 4).getUint32(0, true) : -1;
   if (magic !== GLB_MAGIC) {
-    if (looksLikeJson(bytes)) return { json: parseJsonText(bytes, file, '', file), glb: false };
     if (size === 0) throw new GltfError('NOT_GLTF', file, '', `${file} is empty: not a glTF file`);
-    throw new GltfError('NOT_GLTF', file, 'byte 0',
-      `${file} is not a glTF file: it starts with ${showBytes(bytes)}, neither the binary glTF magic 'glTF' nor a JSON object`);
+    let i = head[0] === 0xef && head[1] === 0xbb && head[2] === 0xbf ? 3 : 0; // UTF-8 BOM
+    while (i < head.length && (head[i] === 0x20 || head[i] === 0x09 || head[i] === 0x0a || head[i] === 0x0d)) i++;
+    if (i < head.length && head[i] !== 0x7b) throw notGltf(head, file);
+    return false;
   }
   if (size < 12) throw new GltfError('TRUNCATED', file, 'byte 0', `${file} is truncated: it has ${plural(size, 'byte')}, fewer than the 12-byte binary glTF header`);
-  const view = new DataView(bytes.buffer, bytes.byteOffset, size);
+  if (head.byteLength < 12) return true; // the caller reads more
+  const view = new DataView(head.buffer, head.byteOffset, 12);
   const version = view.getUint32(4, true);
   if (version !== 2)
     throw new GltfError('BAD_CONTAINER', file, 'byte 4', `${file} is binary glTF version ${version}, not 2: only glTF 2.0 is read`);
@@ -88,6 +100,21 @@ export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContain
   if (total < size)
     throw new GltfError('BAD_CONTAINER', file, 'byte 8',
       `${file} has ${plural(size - total, 'byte')} more than its header says: the header says ${n(total)} bytes but the file has ${n(size)}`);
+  return true;
+}
+
+/**
+ * Splits the bytes of a .glb or .gltf into its JSON and BIN chunk, checking the GLB container.
+ * Binary or JSON is decided by the content (magic 'glTF', or a JSON object), not the file name.
+ */
+export function parseGltfContainer(bytes: Uint8Array, file: string): GltfContainer {
+  const size = bytes.byteLength;
+  if (!sniffGltf(bytes, size, file)) {
+    if (looksLikeJson(bytes)) return { json: parseJsonText(bytes, file, '', file), glb: false };
+    throw notGltf(bytes, file);
+  }
+  const view = new DataView(bytes.buffer, bytes.byteOffset, size);
+  const total = view.getUint32(8, true);
   let json: GltfJson | undefined;
   let bin: Uint8Array | undefined;
   let offset = 12;

@@ -1,13 +1,18 @@
 // What a glTF file may declare and require, checked before any loader allocates.
 
-/** The required extensions the loader reads (the node reader, packages/cli/src/gltf-node.ts, decodes them); any other is UNSUPPORTED. */
-export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression'];
+/** The required extensions the loaders read (geometry decoded by the node reader, packages/cli/src/gltf-node.ts, and the demo; KTX2 textures by the demo, dropped in node); any other is UNSUPPORTED. */
+export const READ_EXTENSIONS: readonly string[] = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_draco_mesh_compression', 'KHR_texture_basisu'];
 
 /**
  * What a file may declare, checked on the JSON before a loader allocates or loops over anything:
  * work and memory then grow with the bytes a file has, not with the counts its header claims.
  */
 export const LIMITS = {
+  /**
+   * Bytes of a file and its external buffers together, checked on their sizes before they are
+   * read (the loaders then hold several copies: past ~512 MiB a load would pass 1.5 GB).
+   */
+  fileBytes: 512 * 2 ** 20,
   /** Vertices of one primitive: the core's GCS_MAX_VERTICES (wasm/include/gcs_skin.h). */
   vertices: 16_777_216,
   /** Nodes: three makes an Object3D of each (skinned characters have hundreds). */

@@ -4,6 +4,7 @@
 import { GltfError, n, plural, type GltfErrorCode } from './error.js';
 import type { BufferData, GltfJson } from './json.js';
 import { LIMITS } from './limits.js';
+import { shownName, shownValue } from './shown-name.js';
 
 /** Throws the GltfError `code` at `where` with the sentence `${file}: ${what}`. */
 export type Fail = (code: GltfErrorCode, where: string, what: string) => never;
@@ -62,14 +63,14 @@ export class ValidationContext {
 
   readonly ref: Ref = (value, array, kind, where, owner, required = false) => {
     if (value === undefined && !required) return;
-    if (!isIndex(value)) this.fail('BAD_STRUCTURE', where, `${owner} refers to ${kind} ${JSON.stringify(value) ?? 'undefined'}, not an index`);
+    if (!isIndex(value)) this.fail('BAD_STRUCTURE', where, `${owner} refers to ${kind} ${shownValue(value) ?? 'undefined'}, not an index`);
     if (value >= array.length)
       this.fail('BAD_REFERENCE', where, `${owner} refers to ${kind} ${value}, but the file has ${array.length ? `only ${plural(array.length, kind)}` : `no ${kind}`}`);
   };
 
   /** "mesh 3 'Body'", or "mesh 3" when it has no name. */
   readonly named = (kind: string, i: number, def: GltfJson | undefined): string =>
-    typeof def?.name === 'string' && def.name ? `${kind} ${i} '${def.name}'` : `${kind} ${i}`;
+    typeof def?.name === 'string' && def.name ? `${kind} ${i} '${shownName(def.name)}'` : `${kind} ${i}`;
 
   /** "accessor 4 (POSITION of mesh 0 primitive 0)". */
   readonly accessorName = (i: number): string => `accessor ${i}${this.use[i] ? ` (${this.use[i]})` : ''}`;
@@ -95,7 +96,7 @@ export class ValidationContext {
       m.primitives.forEach((p: GltfJson, pi: number) => {
         if (!isObject(p)) return;
         const where = `${named('mesh', mi, m)} primitive ${pi}`;
-        if (isObject(p.attributes)) for (const [k, a] of Object.entries(p.attributes)) noteUse(a, `${k} of ${where}`);
+        if (isObject(p.attributes)) for (const [k, a] of Object.entries(p.attributes)) noteUse(a, `${shownName(k)} of ${where}`);
         noteUse(p.indices, `indices of ${where}`);
       });
     });
