@@ -32,3 +32,20 @@ describe('timeFrames', () => {
     expect(t.samples).toBe(frames.length - 4);
   });
 });
+
+describe('timeInterleaved with repeat (a coarse clock)', () => {
+  test('each sample times `repeat` calls of its step on the same frames, and reports ms per call', () => {
+    const calls: string[] = [];
+    const timings = timeInterleaved(5, [(f) => calls.push(`a${f}`), (f) => calls.push(`b${f}`)], { minSamples: 2, minMs: 0, maxMs: 1e9, warmup: 0, repeat: [3, 1] });
+    // Round 1: a on frames 0-2, b on frame 0; round 2 starts 3 frames on (the longest repeat).
+    expect(calls.slice(0, 8)).toEqual(['a0', 'a1', 'a2', 'b0', 'a3', 'a4', 'a0', 'b3']);
+    expect(timings[0].samples).toBe(timings[1].samples);
+  });
+
+  test('a sample of n calls of a 1 ms step is about 1 ms per call, not n ms', () => {
+    const busy = () => { const end = performance.now() + 1; while (performance.now() < end); };
+    const [t] = timeInterleaved(1, [busy], { minSamples: 3, minMs: 0, warmup: 0, repeat: 4 });
+    expect(t.medianMs).toBeGreaterThanOrEqual(0.99);
+    expect(t.medianMs).toBeLessThan(4);
+  });
+});
