@@ -48,6 +48,11 @@ export class SteadyFigure {
     return this.stored;
   }
 
+  /** True once the deadline has passed (a figure still missing then lacks frames). */
+  get overdue(): boolean {
+    return this.now() - this.since >= this.deadlineMs;
+  }
+
   /** Whether the figure shown had stopped changing (its halves agreed), or was shown at the deadline. */
   agreed(): boolean {
     return this.halvesAgree;
