@@ -38,23 +38,35 @@ describe('FrameCost on the default human', () => {
     walk = sampleClip(human.mesh, human.clips.find((c) => c.name === 'walk')!, 60);
   });
 
-  /** A FrameCost fed the walk's frames as the live poses; frames run until its figures stand. */
-  function measure(skins: { gcs: SkinDeformer[]; classic: SkinDeformer[] }, smooth = true) {
-    let f = 0;
-    const cost = new FrameCost((_source, out) => out.set(walk[f++ % walk.length]));
+  /**
+   * A FrameCost fed the walk's frames as the live poses; frames run until its figures stand. The
+   * page's clock: `frameMs` per frame (60 fps unless said), the time the timing itself takes added.
+   */
+  function measure(skins: { gcs: SkinDeformer[]; classic: SkinDeformer[] }, smooth = true, frameMs = 1000 / 60) {
+    let f = 0, clock = 0, last = performance.now();
+    const cost = new FrameCost((_source, out) => out.set(walk[f++ % walk.length]), () => clock + (performance.now() - last));
     cost.restart({ ...skins, options: { smooth } });
     let frames = 0;
-    while (!cost.settled && frames < 200) { cost.afterFrame(); frames++; }
-    return { figures: cost.figures(), frames };
+    while (!cost.settled && frames < 200) {
+      clock += frameMs;
+      last = performance.now();
+      cost.afterFrame();
+      clock += performance.now() - last;
+      frames++;
+    }
+    return { figures: cost.figures(), frames, ms: clock };
   }
 
   test('figures stand 12 frames after a build (4 poses recorded, the twin built with the 4th, 8 slices); a restart starts over', () => {
     const live = new SkinDeformer(gcs, human.mesh, { method: 'gcs' });
     const classic = new SkinDeformer(gcs, human.mesh, { method: 'classic' });
     try {
-      const { figures, frames } = measure({ gcs: [live], classic: [classic] });
-      // 12 unless an inverted measurement was taken again (at most twice more, 8 slices each).
-      expect([12, 20, 28]).toContain(frames);
+      const { figures, frames, ms } = measure({ gcs: [live], classic: [classic] });
+      // 12 unless an inverted measurement was taken again (at most twice more, 8 slices each), or
+      // the host is so loaded that the page clock passed 0.8 s (then the rest runs at once).
+      console.log(`figures stood ${frames} frames (${ms.toFixed(0)} ms of page time) after the build`);
+      expect(frames).toBeLessThanOrEqual(28);
+      expect(ms).toBeLessThan(3000);
       for (const v of [figures.gcs, figures.stepped, figures.classic]) {
         expect(v).toBeGreaterThan(0);
         expect(v).toBeLessThan(50);
@@ -70,11 +82,23 @@ describe('FrameCost on the default human', () => {
     }
   });
 
+  test('a slow page (1 frame a second): the figures stand after the first frame, not 12 s later', () => {
+    const live = new SkinDeformer(gcs, human.mesh, { method: 'gcs' });
+    try {
+      const { figures, frames } = measure({ gcs: [live], classic: [] }, true, 1000);
+      expect(frames).toBe(1);
+      expect(figures.gcs).toBeGreaterThan(0);
+      expect(figures.stepped).toBeGreaterThan(0);
+    } finally {
+      live.dispose();
+    }
+  });
+
   test('plain mode: the stepped figure is the model on screen (no twin is built)', () => {
     const live = new SkinDeformer(gcs, human.mesh, { method: 'gcs', gcs: { smooth: false } });
     try {
       const { figures, frames } = measure({ gcs: [live], classic: [] }, false);
-      expect(frames).toBe(12);
+      expect(frames).toBeLessThanOrEqual(12);
       expect(figures.stepped).toBe(figures.gcs);
       expect(Number.isNaN(figures.classic)).toBe(true);
     } finally {

@@ -8,11 +8,18 @@ import type { GcsDeformer, GcsOptions } from '../lib/index.js';
 import { median, timeInterleaved } from '../lib/measure.js';
 import { writeSkinMatrices, type SkinDeformer } from '../lib/three.js';
 
-/** Live poses recorded after a build (frames of the clip as it plays). */
+/** Live poses recorded after a build (frames of the clip as it plays), at most. */
 const RECORDED_FRAMES = 4;
 /** Slices of timing, one after each frame, and how long each may run. */
 const SLICES = 8;
 const SLICE_MS = 10;
+/**
+ * On a slow page (a few frames a second) the figures must still stand within 3 s of the build:
+ * recording stops after this long with the poses it has, and past LATE_MS the remaining slices all
+ * run after one frame (a frame that slow hides 80 ms more).
+ */
+const RECORD_MS = 300;
+const LATE_MS = 800;
 /** A timed sample lasts at least this: a browser's clock moves in 0.1 ms steps (timeInterleaved's repeat). */
 const SAMPLE_MS = 1;
 
@@ -73,8 +80,12 @@ export class FrameCost {
   private listener: (figures: FrameCostFigures) => void = () => {};
   /** Frames since the last restart (for tests: how soon the figures stand). */
   framesSinceBuild = 0;
+  private builtAt = 0;
 
-  constructor(private readonly writePose: (source: SkinDeformer['source'], out: Float32Array) => void = (s, out) => writeSkinMatrices(s, out)) {}
+  constructor(
+    private readonly writePose: (source: SkinDeformer['source'], out: Float32Array) => void = (s, out) => writeSkinMatrices(s, out),
+    private readonly now: () => number = () => performance.now(),
+  ) {}
 
   /** Calls `listener` whenever the figures change. */
   onChange(listener: (figures: FrameCostFigures) => void): void {
@@ -99,6 +110,7 @@ export class FrameCost {
     this.slices = [];
     this.guard.reset();
     this.framesSinceBuild = 0;
+    this.builtAt = this.now();
     this.phase = 'recording';
     this.publish(NONE);
   }
@@ -121,10 +133,12 @@ export class FrameCost {
         this.writePose(src, out);
         return out;
       }));
-      if (this.poses.length >= RECORDED_FRAMES) this.prepare();
-      return;
+      if (this.poses.length < RECORDED_FRAMES && this.now() - this.builtAt < RECORD_MS) return;
+      this.prepare();
+      if (this.now() - this.builtAt < LATE_MS) return;
     }
-    this.slice();
+    do this.slice();
+    while (this.phase === 'measuring' && this.now() - this.builtAt >= LATE_MS);
   }
 
   /** The steps to time in turn (each deforms every mesh of one model) and their repeat counts. */
@@ -147,8 +161,8 @@ export class FrameCost {
     // Calibration (also the warm-up: the stepped twin's code path has not run yet): ms per call.
     this.repeat = this.steps.map((s) => {
       const t0 = performance.now();
-      for (let f = 0; f < RECORDED_FRAMES; f++) s(f);
-      const perCall = (performance.now() - t0) / RECORDED_FRAMES;
+      for (let f = 0; f < this.poses.length; f++) s(f);
+      const perCall = (performance.now() - t0) / this.poses.length;
       return Math.max(1, Math.min(200, Math.ceil(SAMPLE_MS / Math.max(perCall, 0.002))));
     });
     this.slices = this.steps.map(() => []);
@@ -156,7 +170,7 @@ export class FrameCost {
   }
 
   private slice(): void {
-    const t = timeInterleaved(RECORDED_FRAMES, this.steps, { minSamples: 1, minMs: 0, maxMs: SLICE_MS, warmup: 0, repeat: this.repeat });
+    const t = timeInterleaved(this.poses.length, this.steps, { minSamples: 1, minMs: 0, maxMs: SLICE_MS, warmup: 0, repeat: this.repeat });
     t.forEach((x, k) => this.slices[k].push(x.medianMs));
     if (this.slices[0].length < SLICES) return;
     const m = this.models!;
