@@ -9,11 +9,19 @@
  *   stretched triangles, normals off unit length, non-finite values and the seam gap. Distances are
  *   in % of the character's height.
  *
+ * - Joints: `measureJoints` finds the knees and elbows (`findHinges`) and bends each alone
+ *   (`JointProbe`): volume change, bulge and collapse, creases, new self-intersections.
+ *
  * Plain TypeScript over typed arrays; no three.js.
  */
 import type { ClassicDeformer, ClassicReason, Deformer, Rig, RigInput } from './index.js';
 import { GcsError } from './errors.js';
 import { TriangleGrid } from './surface-distance.js';
+
+// Knees and elbows bent one at a time (design of the figures: measure/joints.ts).
+export * from './measure/hinges.js';
+export * from './measure/joints.js';
+export { intersectingPairs } from './measure/self-intersection.js';
 
 // ------------------------------------------------------------------------------------ statistics
 
@@ -605,11 +613,12 @@ export const CREASE_DEGREES = 20;
 /**
  * The interior edges of a triangle mesh: edges shared by exactly two triangles once vertices at
  * one rest position are welded (so UV seams are not borders). `a`/`b` are the two triangles.
- * Edges of three or more triangles (non-manifold) and border edges are left out.
+ * Edges of three or more triangles (non-manifold) and border edges are left out. `weld`: the
+ * weldByPosition of `rest`, when the caller has it.
  */
-export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>): { a: Uint32Array; b: Uint32Array } {
+export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>,
+  weld: ArrayLike<number> = weldByPosition(rest)): { a: Uint32Array; b: Uint32Array } {
   const n = Math.floor(rest.length / 3);
-  const weld = weldByPosition(rest);
   // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
   const first = new Map<number, number>();
   const second = new Map<number, number>();
