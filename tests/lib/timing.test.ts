@@ -1,7 +1,7 @@
 // The timing helpers of gcs-skin/measure: what they call and how often (no wall-clock assertions:
 // those flake on shared hosts; the benchmark prints the figures).
 import { describe, expect, test } from 'vitest';
-import { timeFrames, timeInterleaved } from '../../web/lib/measure.js';
+import { percentile, timeFrames, timeInterleaved } from '../../web/lib/measure.js';
 
 describe('timeInterleaved', () => {
   test('calls every step once per round, in turn, cycling over the frames', () => {
@@ -47,5 +47,22 @@ describe('timeInterleaved with repeat (a coarse clock)', () => {
     const [t] = timeInterleaved(1, [busy], { minSamples: 3, minMs: 0, warmup: 0, repeat: 4 });
     expect(t.medianMs).toBeGreaterThanOrEqual(0.99);
     expect(t.medianMs).toBeLessThan(4);
+  });
+});
+
+describe('percentile (by selection)', () => {
+  test('the nearest rank of the sorted values, NaN sorting last, as a sort gives it', () => {
+    let seed = 7;
+    const random = () => ((seed = (seed * 1103515245 + 12345) >>> 0) / 4294967296);
+    for (const n of [1, 2, 3, 10, 101, 5000]) {
+      const values = Array.from({ length: n }, () => (random() < 0.05 ? NaN : Math.round(random() * 50) / 10));
+      const sorted = Float64Array.from(values).sort();
+      for (const p of [0, 1, 25, 50, 95, 99, 100]) {
+        const rank = Math.min(n - 1, Math.max(0, Math.ceil((p / 100) * n) - 1));
+        expect(percentile(values, p), `n ${n}, p ${p}`).toBe(sorted[rank]);
+      }
+    }
+    expect(percentile([], 50)).toBeNaN();
+    expect(percentile(new Float32Array([3, 1, 2]), 50)).toBe(2);
   });
 });
