@@ -1,12 +1,12 @@
 // npm run bench [-- --sizes 10000,100000,1000000] [--quick] [--json] [--sections N]
 // Speed of every deformer on the default human (the paper's Table 1: 17,023 vertices, walk and
 // run) and at larger sizes, against the same GCS in plain JavaScript, a wasm memcpy of the bytes a
-// frame touches, and three.js's SkinnedMesh.applyBoneTransform. design.md §7; docs/benchmarks.md.
+// frame touches, and three.js's SkinnedMesh.applyBoneTransform. docs/method.md §9; docs/benchmarks.md.
 import * as THREE from 'three';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh, SkinDeformer } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { rootOf, sampleClip } from '../dist/cli/gltf-node.js';
+import { rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { errorInfo, median, timeFrames, timeInterleaved } from '../dist/measure.js';
 import { JsGcs } from './bench/js-gcs.mjs';
 import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';

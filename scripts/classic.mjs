@@ -15,7 +15,7 @@ import { fileURLToPath } from 'node:url';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { characterHeight, loadGltfFile, sampleClip } from '../dist/cli/gltf-node.js';
+import { characterHeight, loadGltfFile, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { classicAtBudget, classicFigures, classicOffSurface, identitySkin, meshBorder } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';

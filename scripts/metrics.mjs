@@ -1,5 +1,5 @@
 // npm run metrics [-- --json] [--markdown] [--no-models] [--vertices N] [--sections N] [--frames N]
-// Fidelity per method (design.md §7) on the default human and on every character in
+// Fidelity per method (docs/method.md §9) on the default human and on every character in
 // ../shared/models (skipped with a reason when absent):
 // - FidelityProbe (web/lib/measure.ts) over every sampled frame of every clip, on every skinned
 //   mesh of the character, in % of the character's height (gltf-node characterHeight): rigid
@@ -15,9 +15,9 @@ import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
 import { initGcsSkin } from '../dist/index.js';
-import { rigInputFromSkinnedMesh } from '../dist/three.js';
+import { rigInputFromSkinnedMesh, writeSkinMatrices } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
-import { characterHeight, loadGltfFile, rootOf, sampleClip, skinMatricesOf } from '../dist/cli/gltf-node.js';
+import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, restOfOutput } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import {
@@ -130,7 +130,7 @@ function shapeOf(mesh, height) {
   const J = bones.length;
   const rest0 = bones.map((b) => b.quaternion.clone());
   const resetPose = () => { bones.forEach((b, j) => b.quaternion.copy(rest0[j])); root.updateMatrixWorld(true); };
-  const skinOf = () => { root.updateMatrixWorld(true); return skinMatricesOf(mesh, new Float32Array(J * 16)); };
+  const skinOf = () => { root.updateMatrixWorld(true); const s = new Float32Array(J * 16); writeSkinMatrices(mesh, s); return s; };
   const dominant = dominantJoints(input);
   const centres = bindCentres(input);
   const meshWorldInv = new THREE.Matrix4().copy(mesh.matrixWorld).invert();

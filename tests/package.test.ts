@@ -70,6 +70,7 @@ describe("a library user: `npm install gcs-skin three` in an empty folder", () =
     // The library's files only: no command-line modules (they are @gcs-skin/cli's).
     expect(existsSync(join(a, 'node_modules/gcs-skin/dist/cli'))).toBe(false);
     expect(existsSync(join(a, 'node_modules/gcs-skin/dist/human/cli.js'))).toBe(false);
+    expect(existsSync(join(a, 'node_modules/gcs-skin/dist/gltf'))).toBe(false); // the glTF validator: the demo's and the CLI's
     expect(existsSync(join(a, 'node_modules/gcs-skin/dist/gcs-skin.wasm'))).toBe(true);
     const manifest = JSON.parse(readFileSync(join(a, 'node_modules/gcs-skin/package.json'), 'utf8'));
     expect(manifest.sideEffects).toBe(false);
@@ -133,7 +134,7 @@ describe("a library user: `npm install gcs-skin three` in an empty folder", () =
     const result = JSON.parse(execFileSync(process.execPath, ['webgpu.mjs'], { cwd: a, env: userEnv(), encoding: 'utf8' }).trim().split('\n').pop()!);
     expect(result.names).toEqual(expect.arrayContaining(['GcsCharacter', 'GcsCrowd', 'SkinDeformer', 'bakeClip', 'writeSkinMatrices']));
     expect(result.subclasses).toBe(true);
-    for (const file of ['webgpu.d.ts', 'three.d.ts', 'crowd.d.ts'])
+    for (const file of ['webgpu.d.ts', 'three.d.ts', 'crowd.d.ts', 'three/options.d.ts', 'three/skin-deformer.d.ts', 'three/character.d.ts'])
       expect(readFileSync(join(a, 'node_modules/gcs-skin/dist', file), 'utf8')).not.toMatch(/@internal|gpuKit\?:|warned\?:/);
   });
 
@@ -183,8 +184,20 @@ describe('the command line: `npm install -D @gcs-skin/cli` beside it', () => {
       expect(report.meshes[0].methods.gcs.fidelity.dqsP95).toBeLessThan(1);
     }
     // @gcs-skin/cli/gltf's types show nothing of three.
-    expect(readFileSync(join(a, 'node_modules/@gcs-skin/cli/dist/cli/gltf.d.ts'), 'utf8')).not.toMatch(/three/i);
+    expect(readFileSync(join(a, 'node_modules/@gcs-skin/cli/dist/gltf.d.ts'), 'utf8')).not.toMatch(/three/i);
   }, 120000);
+
+  test("the command line's build holds no three.js adapter and no GPU code", () => {
+    const cliDist = join(a, 'node_modules/@gcs-skin/cli/dist');
+    const files = readdirSync(cliDist, { recursive: true, encoding: 'utf8' }).map((f) => f.split('\\').join('/'));
+    expect(files).toContain('report.js');
+    expect(files).toContain('lib/three/rig-input.js'); // what it does read of three: rigs, morphs, skin matrices
+    const adapter = /^lib\/(gpu\/|gpu\.|three\.|webgpu\.|crowd\.|surface-attributes\.)|^lib\/three\/(?!(rig-input|morph-data|skin-matrices)\.)/;
+    expect(files.filter((f) => adapter.test(f))).toEqual([]);
+    // Shader code, in any module: GLSL patches, TSL nodes, render hooks.
+    const shaderish = /gl_Position|onBeforeCompile|positionNode|three\/tsl|three\/webgpu/;
+    expect(files.filter((f) => f.endsWith('.js') && shaderish.test(readFileSync(join(cliDist, f), 'utf8')))).toEqual([]);
+  });
 
   test('@gcs-skin/cli/gltf poses a character and initGcsSkin deforms it', () => {
     // The ten-line example of docs/node.md.

@@ -59,7 +59,9 @@ async function measureBuild(dist, withSpread) {
   const { initGcsSkin } = await import(join(dist, 'index.js'));
   const { rigInputFromSkinnedMesh } = await import(join(dist, 'three.js'));
   const { createHuman } = await import(join(dist, 'human/index.js'));
-  const { loadGltfFile, sampleClip } = await import(join(dist, 'cli/gltf-node.js'));
+  // The node glTF reader: packages/cli/dist beside dist/ (a build before the CLI's move: dist/cli).
+  const reader = existsSync(join(dist, 'cli/gltf-node.js')) ? join(dist, 'cli/gltf-node.js') : join(dist, '../packages/cli/dist/gltf-node.js');
+  const { loadGltfFile, sampleClip } = await import(reader);
   const { timeFrames, median } = await import(join(dist, 'measure.js'));
   const gcs = await initGcsSkin();
   const characters = [];

@@ -1,4 +1,4 @@
-// The GCS per-frame algorithm (design.md §3) in plain JavaScript, for the bench's "same algorithm
+// The GCS per-frame algorithm (docs/method.md §4) in plain JavaScript, for the bench's "same algorithm
 // in JS" ratio. It takes the section table from the wasm model (sections(): runs of output
 // vertices, part, distal child, alpha, beta) and the rest mesh in output order, and per frame
 // computes the relative part motions D_j = S_parent⁻¹ · S_j, each section's

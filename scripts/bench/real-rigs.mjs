@@ -13,7 +13,7 @@ import { existsSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { rigInputFromSkinnedMesh } from '../../dist/three.js';
-import { loadGltfFile, sampleClip } from '../../dist/cli/gltf-node.js';
+import { loadGltfFile, sampleClip } from '../../packages/cli/dist/gltf-node.js';
 import { timeInterleaved } from '../../dist/measure.js';
 
 const MODELS = resolve(dirname(fileURLToPath(import.meta.url)), '../../../shared/models');

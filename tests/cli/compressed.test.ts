@@ -15,8 +15,8 @@ import { MeshoptDecoder, MeshoptEncoder } from 'meshoptimizer';
 // draco3dgltf (CommonJS, no types): createEncoderModule / createDecoderModule
 import draco3d from 'draco3dgltf';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
-import { run, type Report } from '../../web/lib/cli/report.js';
-import { loadCharacter } from '../../web/lib/cli/gltf.js';
+import { run, type Report } from '../../packages/cli/src/report.js';
+import { loadCharacter } from '../../packages/cli/src/gltf.js';
 import { MODELS_DIR } from '../helpers/models.js';
 
 let dir: string;

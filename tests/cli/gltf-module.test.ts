@@ -1,4 +1,4 @@
-// `gcs-skin/gltf` (web/lib/cli/gltf.ts): loadCharacter gives per skinned mesh a RigInput, the
+// `gcs-skin/gltf` (packages/cli/src/gltf.ts): loadCharacter gives per skinned mesh a RigInput, the
 // character's height and clips sampled into skin matrices — the same matrices as the report's
 // sampling through three's AnimationMixer, wrapped outside the clip, independent of the clip
 // sampled before; the rest pose; morph targets and their animated influences; bytes and URLs as
@@ -10,8 +10,8 @@ import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { Document, NodeIO } from '@gltf-transform/core';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
-import { GltfError, loadCharacter, type Character } from '../../web/lib/cli/gltf.js';
-import { loadGltfFile, sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { GltfError, loadCharacter, type Character } from '../../packages/cli/src/gltf.js';
+import { loadGltfFile, sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { initGcsSkin } from '../../web/lib/index.js';
 
 let dir: string;

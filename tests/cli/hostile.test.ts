@@ -4,21 +4,21 @@
 // to smuggle values and terminal escapes. Each goes through the real command (`node
 // bin/gcs-skin.mjs report`, a child process) and must end in one line with its code in brackets,
 // within 5 s of CPU time and a memory bound, and never echo a byte of a file it refused. Files at the limits
-// (LIMITS) are accepted and still bounded. Runs on dist/: `npm run build:lib` first (npm test does).
+// (LIMITS) are accepted and still bounded. Runs on packages/cli/dist: `npm run build:lib` first (npm test does).
 import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, rmSync, statSync, symlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
-import { loadCharacter } from '../../web/lib/cli/gltf.js';
-import { GltfError } from '../../web/lib/cli/gltf-node.js';
-import { LIMITS } from '../../web/lib/cli/gltf-validate.js';
+import { loadCharacter } from '../../packages/cli/src/gltf.js';
+import { GltfError } from '../../packages/cli/src/gltf-node.js';
+import { LIMITS } from '../../web/lib/gltf/limits.js';
 import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
 
 const ROOT = join(import.meta.dirname, '../..');
 const BIN = join(ROOT, 'bin/gcs-skin.mjs');
-const BUILT = join(ROOT, 'dist/cli/gltf-validate.js');
+const BUILT = join(ROOT, 'packages/cli/dist/lib/gltf/validate.js');
 
 /**
  * Time bound per file: CPU seconds of the whole child (node's own start included), so that a
@@ -104,8 +104,8 @@ function humanVariant(name: string, edit: (json: Json, bin: DataView) => void): 
 }
 
 beforeAll(async () => {
-  if (!existsSync(BUILT) || statSync(BUILT).mtimeMs < statSync(join(ROOT, 'web/lib/cli/gltf-validate.ts')).mtimeMs)
-    throw new Error('dist/ is missing or older than web/lib: run `npm run build:lib` first');
+  if (!existsSync(BUILT) || statSync(BUILT).mtimeMs < statSync(join(ROOT, 'web/lib/gltf/validate.ts')).mtimeMs)
+    throw new Error('packages/cli/dist is missing or older than web/lib: run `npm run build:lib` first');
   dir = mkdtempSync(join(tmpdir(), 'gcs-hostile-'));
   folder = join(dir, 'model');
   mkdirSync(folder);

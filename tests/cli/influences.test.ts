@@ -16,11 +16,11 @@ import { afterAll, beforeAll, describe, expect, test, vi } from 'vitest';
 import * as THREE from 'three';
 import { NodeIO } from '@gltf-transform/core';
 import { initGcsSkin, type GcsSkin, type RigInput } from '../../web/lib/index.js';
-import { GcsCharacter, type SkinDeformer } from '../../web/lib/three.js';
+import { GcsCharacter, writeSkinMatrices, type SkinDeformer } from '../../web/lib/three.js';
 import { GcsCharacter as WebGpuCharacter } from '../../web/lib/webgpu.js';
-import { loadCharacter } from '../../web/lib/cli/gltf.js';
-import { parseGlb, skinMatricesOf } from '../../web/lib/cli/gltf-node.js';
-import { formatReport, run, type Report } from '../../web/lib/cli/report.js';
+import { loadCharacter } from '../../packages/cli/src/gltf.js';
+import { parseGlb } from '../../packages/cli/src/gltf-node.js';
+import { formatReport, run, type Report } from '../../packages/cli/src/report.js';
 import { MODELS_DIR } from '../helpers/models.js';
 import { distances, referenceDqs, referenceLbs } from '../helpers/influences.js';
 import { eightInfluenceGlb } from '../helpers/influences-glb.js';
@@ -126,7 +126,7 @@ describe.skipIf(!!missing)('8 influences per vertex from a file (CesiumMan, weig
     for (const t of [0.3, 0.9, 1.6]) {
       mixer.setTime(t);
       character.update();
-      skinMatricesOf(source!, S);
+      writeSkinMatrices(source!, S);
       const want = method === 'lbs' ? referenceLbs(fileRig, S) : referenceDqs(fileRig, S);
       max = Math.max(max, distances(skin.deformer.positions, want, skin.rig.height, skin.deformer.sourceVertex ?? undefined).max);
     }

@@ -10,7 +10,7 @@ import { Document, NodeIO } from '@gltf-transform/core';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
 import {
   REPORT_COLUMNS, defaultFramesPerClip, formatReport, nonFiniteMethods, report, run, wantsProgress, type Report,
-} from '../../web/lib/cli/report.js';
+} from '../../packages/cli/src/report.js';
 import { METHODS, median } from '../../web/lib/measure.js';
 import { sharedModels } from '../helpers/models.js';
 
@@ -86,7 +86,7 @@ function checkShape(r: Report, framesPerClip: number) {
       }
     }
     const gcs = m.methods.gcs.fidelity!, dqs = m.methods.dqs.fidelity!, lbs = m.methods.lbs.fidelity!;
-    // design.md §7: the default GCS keeps rigid vertices rigid (≤ 1e-4 of height = 0.01 %) and
+    // docs/method.md §9: the default GCS keeps rigid vertices rigid (≤ 1e-4 of height = 0.01 %) and
     // opens no seam; the core's DQS is the independent reference DQS up to float rounding.
     if (gcs.rigidVertices > 0) expect(gcs.rigidError).toBeLessThanOrEqual(0.01);
     for (const name of GCS_FAMILY) expect(m.methods[name].fidelity!.seamGap).toBeLessThanOrEqual(1e-3);
@@ -123,7 +123,7 @@ describe('gcs-skin report', () => {
     // One mesh at world scale 1: the character's height is the mesh's own extent.
     expect(m.worldScale).toBe(1);
     expect(m.height).toBeCloseTo(m.counts.height, 5);
-    // design.md §7 targets for the default GCS on the default human.
+    // docs/method.md §9 targets for the default GCS on the default human.
     const gcs = m.methods.gcs.fidelity!;
     expect(gcs.dqsP95).toBeLessThanOrEqual(1);
     expect(gcs.dqsMax).toBeLessThanOrEqual(4);

@@ -7,7 +7,7 @@ import { initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { timeInterleaved } from '../../web/lib/measure.js';
 import { SkinDeformer } from '../../web/lib/three.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { FrameCost, InversionGuard } from '../../web/demo/cost.js';
 
 describe('InversionGuard', () => {

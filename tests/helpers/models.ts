@@ -1,10 +1,10 @@
 // Loads the shared test characters (../shared/models, never copied into the repo) in node.
-// The loading itself lives in the library (web/lib/cli/gltf-node.ts, used by `gcs-skin report`).
+// The loading itself lives in the library (packages/cli/src/gltf-node.ts, used by `gcs-skin report`).
 import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-export { loadGltfFile as loadGlb, skinMatricesAt, type LoadedModel } from '../../web/lib/cli/gltf-node.js';
+export { loadGltfFile as loadGlb, skinMatricesAt, type LoadedModel } from '../../packages/cli/src/gltf-node.js';
 
 export const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../../shared/models');
 

@@ -9,8 +9,8 @@ export const ROOT = resolve(__dirname, '../..');
 export const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
 
 /** What the tarballs are packed from: the files both packages' `files`, `prepack` and build read. */
-const SOURCES = ['package.json', 'package-lock.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md',
-  'web/lib', 'wasm/include', 'scripts/build-lib.mjs', 'packages/cli/package.json', 'packages/cli/bin', 'packages/cli/README.md'];
+const SOURCES = ['package.json', 'package-lock.json', 'tsconfig.json', 'README.md', 'LICENSE', 'bin', 'docs/node.md', 'docs/report-json.md', 'docs/method.md',
+  'web/lib', 'wasm/include', 'scripts/build-lib.mjs', 'packages/cli/package.json', 'packages/cli/tsconfig.json', 'packages/cli/src', 'packages/cli/bin', 'packages/cli/README.md'];
 
 export interface Tarballs {
   /** gcs-skin */
@@ -44,7 +44,7 @@ export function packTarballs(dir: string, version?: string): Tarballs {
   // The library's prepack builds both packages; the CLI's (the same script) need not run again.
   const library = pack(src);
   const cli = pack(join(src, 'packages/cli'), '--ignore-scripts');
-  if (!existsSync(join(src, 'packages/cli/dist/cli/report.js'))) throw new Error('prepack did not build packages/cli/dist');
+  if (!existsSync(join(src, 'packages/cli/dist/report.js'))) throw new Error('prepack did not build packages/cli/dist');
   rmSync(src, { recursive: true, force: true });
   return { library, cli, version: version ?? JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')).version };
 }

@@ -8,9 +8,9 @@ import { basename } from 'node:path';
 import { initGcsSkin, type GcsSkin, type ClassicDeformer } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { classicOffSurface, coincidentPairs, meshBorder, seamGap } from '../../web/lib/measure.js';
-import { characterHeight } from '../../web/lib/cli/gltf-node.js';
+import { characterHeight } from '../../packages/cli/src/gltf-node.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
 import type * as THREE from 'three';
 

@@ -1,4 +1,4 @@
-// The classic cross-section model (design.md §4): analytic tubes (radius, joint contour on the
+// The classic cross-section model (docs/method.md §6): analytic tubes (radius, joint contour on the
 // bisector plane, rings moving as their skin, bulge formula, winding, errors, fallbacks), the default human (which parts
 // resample, points per limb, detail loss, rebuild time) and the shared real characters.
 import { beforeAll, describe, expect, test } from 'vitest';

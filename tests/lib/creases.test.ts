@@ -1,4 +1,4 @@
-// Steps between sections, measured by creases (design.md §7; issue "No steps by default"): the
+// Steps between sections, measured by creases (docs/method.md §9; issue "No steps by default"): the
 // metric itself on a hinge, then the default GCS against LBS and DQS on our human (every clip) and
 // on every shared character — creases and flipped triangles no more than 1.1× the more of LBS's and
 // DQS's, within 0.15 % of the height (p95) of DQS, rigid parts exact — and the stepped plain mode
@@ -8,7 +8,7 @@ import { basename } from 'node:path';
 import { initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { characterHeight, sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { characterHeight, sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { FidelityProbe, countCreases, dihedralCosines, interiorEdges, type Fidelity } from '../../web/lib/measure.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
 import type * as THREE from 'three';

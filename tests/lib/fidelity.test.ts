@@ -1,5 +1,5 @@
 // The default GCS (weights criterion) on real characters and on rigs with scaled matrices
-// (design.md §2a, §7; issue "GCS that is right on real characters"): rigid error, distance from an
+// (docs/method.md §2, §9; issue "GCS that is right on real characters"): rigid error, distance from an
 // independent scale-aware DQS, flipped triangles, unit normals, finite output. Every figure is
 // printed, so a run shows the margins.
 import { beforeAll, describe, expect, test } from 'vitest';
@@ -8,7 +8,7 @@ import { basename } from 'node:path';
 import { initGcsSkin, type Deformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { characterHeight, sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { characterHeight, sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { FidelityProbe, type Fidelity } from '../../web/lib/measure.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
@@ -22,7 +22,7 @@ beforeAll(async () => {
   gcs = await initGcsSkin();
 });
 
-// Targets of the issue, in % of the character's height (design.md §7).
+// Targets of the issue, in % of the character's height (docs/method.md §9).
 const RIGID_MAX = 0.01;    // 1e-4 of height
 const DQS_P95_MAX = 1;
 const DQS_MAX_MAX = 4;

@@ -1,4 +1,4 @@
-// The GCS method on analytic rigs (design.md §2–3): the ω schedule, exact rest pose, seams,
+// The GCS method on analytic rigs (docs/method.md §2–4): the ω schedule, exact rest pose, seams,
 // criteria, smooth mode and twist spread.
 import { beforeAll, describe, expect, test } from 'vitest';
 import * as THREE from 'three';
@@ -251,7 +251,7 @@ describe('reference deformers against hand-computed values', () => {
   });
 });
 
-// The weights criterion (design.md §2a), the default: analytic cases that fail if it were wrong.
+// The weights criterion (docs/method.md §2), the default: analytic cases that fail if it were wrong.
 describe('GCS weights criterion (default)', () => {
   const bend = (tube: ReturnType<typeof makeTube>, deg: number) => rotationAbout(tube.joint, Z, (deg * Math.PI) / 180);
   /** Largest distance between two deformers' outputs, matched through their source vertices. */

@@ -14,7 +14,7 @@ import { join } from 'node:path';
 import { GcsError, GPU_TEXELS_PER_JOINT, initGcsSkin, JointPoses, type GcsDeformer, type GcsSkin, type Rig } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { identitySkin } from '../../web/lib/measure.js';
 import { loadGlb, MODELS_DIR } from '../helpers/models.js';
 import { maxDistance, scaledSkin as scaled } from '../helpers/skins.js';

@@ -7,7 +7,7 @@ import { beforeAll, describe, expect, test } from 'vitest';
 import { GcsError, initGcsSkin, SectionTransforms, GPU_TEXELS_PER_SECTION, type GcsDeformer, type GcsOptions, type GcsSkin, type Rig } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
-import { sampleClip } from '../../web/lib/cli/gltf-node.js';
+import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { identitySkin } from '../../web/lib/measure.js';
 import { maxDistance, scaledSkin as scaled } from '../helpers/skins.js';
 

@@ -11,7 +11,7 @@ import { existsSync } from 'node:fs';
 import { join } from 'node:path';
 import { beforeAll, describe, expect, test } from 'vitest';
 import { GcsError, initGcsSkin, MAX_INFLUENCES, type GcsSkin, type RigInput } from '../../web/lib/index.js';
-import { loadCharacter } from '../../web/lib/cli/gltf.js';
+import { loadCharacter } from '../../packages/cli/src/gltf.js';
 import { MODELS_DIR } from '../helpers/models.js';
 import { distances, firstFour, overFour, referenceDqs, referenceLbs, spreadInfluences } from '../helpers/influences.js';
 

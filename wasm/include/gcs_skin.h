@@ -115,7 +115,7 @@ typedef struct GcsDeformer GcsDeformer;
 typedef enum GcsCriterion {
   GCS_CRITERION_Y = 0,       /* the paper's: bin by the bind-pose Y coordinate */
   GCS_CRITERION_AXIAL = 1,   /* the paper's rule, binned by the projection on the bone axis (T-poses) */
-  GCS_CRITERION_WEIGHTS = 2  /* the default: bin by skin weights; sections are rigid blends (design.md §2a) */
+  GCS_CRITERION_WEIGHTS = 2  /* the default: bin by skin weights; sections are rigid blends (docs/method.md §2) */
 } GcsCriterion;
 
 typedef enum GcsDeformerKind {
@@ -140,7 +140,7 @@ typedef enum GcsDeformerKind {
  *                   criterion; zero there is the stepped, fastest level of detail.
  *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
  *
- * Weights criterion (design.md §2a): welded vertices (same bind-pose position) are binned by their
+ * Weights criterion (docs/method.md §2): welded vertices (same bind-pose position) are binned by their
  * weights (influences < 0.5 % dropped, renormalised; the non-dominant ones rounded to the grid, the
  * dominant one taking the rest). A bin with one joint is its rigid core: transform exactly S_j, so
  * geometry bound 100 % to a bone moves exactly with it. The bin where two joints share the weight
@@ -160,7 +160,7 @@ typedef enum GcsDeformerKind {
  * sums of its weights, joints by index; barycentric factors; gcs_gcs_blend_third /
  * gcs_gcs_blend_third_factor): continuous in every weight, and the corners are shared by the cell's
  * vertices (corners with a zero weight are two-joint nodes). Up to three nodes per welded vertex.
- * Y / axial criteria (the paper, design.md §2b–3): parts by dominant weight, shared sections from
+ * Y / axial criteria (the paper, docs/method.md §4): parts by dominant weight, shared sections from
  * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
  * transform S_p · D_j^α · D_k^β on the rigid parts of the S_j (scale applied first).
  *
@@ -258,7 +258,7 @@ const float* gcs_gcs_section_matrices(const GcsDeformer* deformer);
 /* ---------------------------------------------------------------- GCS on the GPU */
 
 /*
- * The GPU path (design.md §6): the mesh stays in GPU memory in the bind pose, section by section
+ * The GPU path (docs/method.md §8): the mesh stays in GPU memory in the bind pose, section by section
  * as gcs_deformer_source_vertex orders it; per vertex the static data is its section
  * (gcs_gcs_section_of_vertex) and, in smooth mode, the other section it blends with and the factor
  * towards it (below); per frame only the section transforms change, computed here, and a vertex
@@ -360,7 +360,7 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
 #define GCS_CLASSIC_MAX_BULGE 4.0f
 
 /*
- * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; design.md §4).
+ * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; docs/method.md §6).
  *
  * Parts are the GCS parts (vertices by dominant weight, welded by position; parent part = nearest
  * ancestor joint owning vertices). A part is resampled when it is cylinder-like:

@@ -1212,7 +1212,7 @@ void probeSkin(const Rig& rig, const glm::vec3& axis, float angle, std::vector<g
   for (uint32_t j = 0; j < J; ++j) pose(j);
 }
 
-// Which resampled parts stand off the skin they replace (design.md §7's classic off-surface
+// Which resampled parts stand off the skin they replace (docs/method.md §9's classic off-surface
 // target: p99 ≤ 1 %, max ≤ 2.5 % of the height). Per ring vertex: its distance from the point of
 // the input surface its ray hit, both posed — the ring by the model (bulge included), the surface
 // by dual-quaternion skinning — at probe poses (every joint bent 35° forward,

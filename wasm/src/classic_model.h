@@ -1,5 +1,5 @@
 // The classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; the paper's section 2;
-// design.md §4): cylinder-like parts are resampled into contours × star rays and deformed contour by
+// docs/method.md §6): cylinder-like parts are resampled into contours × star rays and deformed contour by
 // contour; the other parts keep their original triangles, carried by dual-quaternion skinning of
 // their own weights (so they follow the skin the tubes meet instead of standing off it).
 #pragma once

@@ -299,7 +299,7 @@ uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight
   return kept;
 }
 
-// The weights criterion (design.md §2a): sections are bins of the welded vertices' skin weights on
+// The weights criterion (docs/method.md §2): sections are bins of the welded vertices' skin weights on
 // a grid of step 1/Q, Q = 2 · (sections − 2) (so the even split between two joints is a bin: their
 // shared section). Each section's blend is its members' mean weights on the joints of its key; a
 // key with one joint is that joint's rigid core (transform exactly S_j). The stepped level of
@@ -395,7 +395,7 @@ LatticeCell latticeCell(const float (&weight)[kMaxInfluences], uint32_t Q) {
 // core: (d, u quantised, level l) with s = l/Q; a node moves by the DQS blend at its exact weights
 // (level 0 is the rigid core itself, S_d). A vertex belongs to the node at the level just below its
 // s and blends with the node just above by its fraction: the result is continuous in s, and in u up
-// to 1/(8Q) of weight (1/64 at the default 6 sections), so no step between bins (design.md §2a;
+// to 1/(8Q) of weight (1/64 at the default 6 sections), so no step between bins (docs/method.md §2;
 // creases measured in §7). The even split of two joints is one key from either side, so their rays
 // share that node.
 //   A vertex of exactly three joints instead blends the three nodes of its cell on the lattice of

@@ -1,5 +1,5 @@
 // The generalized cross-section (GCS) model: build once per mesh and setting, deform per frame.
-// design.md §2–3; the paper's sections 3.1–3.2.
+// docs/method.md §2–4; the paper's sections 3.1–3.2.
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 // Reads a dropped or linked glTF in the page the way `gcs-skin report` reads one in node: the
-// bytes go through the shared validation (web/lib/cli/gltf-buffers.ts, gltf-validate.ts) before
+// bytes go through the shared validation (web/lib/gltf/buffers.ts, validate.ts) before
 // three's GLTFLoader sees them, so a broken or hostile file is one sentence with a code
 // (GltfError). GLTFLoader then parses the validated JSON with each buffer's checked bytes (blob
 // URLs), and vertices whose weights are all 0 get their zeros back (three would bind them to the
@@ -7,11 +7,11 @@
 // body is cut at MAX_FILE_BYTES, an external buffer at its declared byteLength.
 import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { decodeBufferPath, readValidatedGltf, type ExternalReader, type ValidatedGltf } from '../lib/cli/gltf-buffers.js';
-import { restoreZeroWeights, zeroWeightVertices } from '../lib/cli/gltf-accessors.js';
-import { GltfError, n } from '../lib/cli/gltf-validate.js';
+import { decodeBufferPath, readValidatedGltf, type ExternalReader, type ValidatedGltf } from '../lib/gltf/buffers.js';
+import { restoreZeroWeights, zeroWeightVertices } from '../lib/gltf/accessors.js';
+import { GltfError, n } from '../lib/gltf/error.js';
 
-export { GltfError } from '../lib/cli/gltf-validate.js';
+export { GltfError } from '../lib/gltf/error.js';
 
 /** The largest file the page reads. */
 const MAX_FILE_BYTES = 512 * 2 ** 20;

@@ -24,9 +24,10 @@ import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './g
 import type { GpuPath } from './gpu/layout.js';
 import { GpuSections } from './gpu/sections.js';
 import { glslKit } from './gpu/webgl-materials.js';
-import { rigInputFromSkinnedMesh, writeSkinMatrices } from './three.js';
+import { rigInputFromSkinnedMesh } from './three/rig-input.js';
+import { writeSkinMatrices } from './three/skin-matrices.js';
 
-export { writeSkinMatrices } from './three.js';
+export { writeSkinMatrices } from './three/skin-matrices.js';
 
 /** A clip sampled once into skin matrices: `frames` poses of J × 16 floats, `fps` apart. */
 export interface BakedClip {

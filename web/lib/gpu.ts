@@ -1,5 +1,5 @@
 /**
- * gcs-skin/gpu: generalized cross-sections on the GPU (design.md §6, docs/gpu.md).
+ * gcs-skin/gpu: generalized cross-sections on the GPU (docs/gpu.md, docs/method.md §8).
  *
  * The mesh stays in GPU memory in the bind pose, section by section; per vertex its section id
  * (smooth mode: also the other section and the factor towards it) is a static attribute. Two paths:

@@ -72,8 +72,8 @@ export interface GcsOptions {
   influenceWidth?: number;
   /**
    * Each vertex blends the transforms of the two sections around it (no steps between sections).
-   * Default true under 'weights' (sections are then nodes on the rays from each rigid core, design.md
-   * §2a: as smooth as DQS, measured by creases), false under the paper's 'y' and 'axial' (the paper's
+   * Default true under 'weights' (sections are then nodes on the rays from each rigid core, docs/method.md
+   * §2: as smooth as DQS, measured by creases), false under the paper's 'y' and 'axial' (the paper's
    * method as published). `false` under 'weights' is the fastest, stepped level of detail.
    */
   smooth?: boolean;
@@ -334,7 +334,7 @@ export class Rig {
     return this.handle;
   }
 
-  /** Builds a generalized cross-section model (design.md §2). */
+  /** Builds a generalized cross-section model (docs/method.md §2–4). */
   buildGcs(options: GcsOptions = {}): GcsDeformer {
     checkOptions(options, 'buildGcs');
     const sections = options.sections ?? 6;
@@ -354,7 +354,7 @@ export class Rig {
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }
 
-  /** Builds the classic cross-section model (design.md §4). */
+  /** Builds the classic cross-section model (docs/method.md §6). */
   buildClassic(options: ClassicOptions = {}): ClassicDeformer {
     checkOptions(options, 'buildClassic');
     const contours = options.contours ?? 25;

@@ -1,5 +1,5 @@
 /**
- * gcs-skin/measure: the one place where the project measures its deformers (design.md §7). Used by
+ * gcs-skin/measure: the one place where the project measures its deformers (docs/method.md §9). Used by
  * `gcs-skin report`, `npm run metrics`, `npm run bench` and the tests.
  *
  * - Timing: `timeFrames` (median / p95 ms of a per-frame step).
@@ -394,7 +394,7 @@ function quatFromRotation(r: Float64Array): number[] {
 }
 
 /**
- * Scale-aware dual-quaternion skinning of a rig's bind-pose positions (design.md §5): per vertex,
+ * Scale-aware dual-quaternion skinning of a rig's bind-pose positions (docs/method.md §7): per vertex,
  * the normalised blend of its joints' dual quaternions (in the first influence's hemisphere) moves
  * K·x, K the blend of the joints' scale parts. Writes vertexCount × 3 positions into `out`.
  */
@@ -440,7 +440,7 @@ export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Floa
 
 // ------------------------------------------------------------------------------------ fidelity
 
-/** Fidelity of one method over a set of frames (design.md §7). Distances in % of `height`. */
+/** Fidelity of one method over a set of frames (docs/method.md §9). Distances in % of `height`. */
 export interface Fidelity {
   frames: number;
   /** Largest distance of a vertex bound ≥ 0.999 to one joint from S_j·x; null: no such vertex or no source map. */
@@ -455,7 +455,7 @@ export interface Fidelity {
   /**
    * Creases: interior edges (shared by exactly two triangles, vertices welded by rest position)
    * whose dihedral angle changes by more than 20° from the rest pose, summed over frames. Steps
-   * between sections show here long before they flip a triangle (design.md §7).
+   * between sections show here long before they flip a triangle (docs/method.md §9).
    */
   creases: number;
   /** Triangles with an edge longer than twice its rest length, summed over frames. */
@@ -637,7 +637,7 @@ export class FidelityProbe {
 
 // ------------------------------------------------------------------------------------ creases
 
-/** The crease threshold of design.md §7: a dihedral angle change of more than 20°. */
+/** The crease threshold of docs/method.md §9: a dihedral angle change of more than 20°. */
 export const CREASE_DEGREES = 20;
 
 /**
@@ -841,7 +841,7 @@ export interface OffSurfacePart {
   worstVertex: number;
 }
 
-/** The classic model against the skin it replaces (design.md §7, "classic off-surface"). */
+/** The classic model against the skin it replaces (docs/method.md §9, "classic off-surface"). */
 export interface ClassicOffSurface {
   frames: number;
   /** Over every output vertex and frame, % of height. */

@@ -1,11 +1,11 @@
 #!/usr/bin/env node
-// gcs-skin command line (the package @gcs-skin/cli): a table of subcommands, each a module (copied
-// into ../dist by `npm run build:lib`, with the part of the core it imports) exporting
+// gcs-skin command line (the package @gcs-skin/cli): a table of subcommands, each a module of
+// ../src (built into ../dist by `npm run build:lib`, with the part of the core it imports) exporting
 // `run(argv) → Promise<exit code>` and `usage`. The library's own bin (gcs-skin/bin/gcs-skin.mjs)
 // runs this file.
 const SUBCOMMANDS = {
-  human: { module: '../dist/human/cli.js', about: 'write the default human character (mesh, skin, clips) as .glb' },
-  report: { module: '../dist/cli/report.js', about: 'build every deformer on a glTF skinned model and report counts, timings, fidelity' },
+  human: { module: '../dist/human.js', about: 'write the default human character (mesh, skin, clips) as .glb' },
+  report: { module: '../dist/report.js', about: 'build every deformer on a glTF skinned model and report counts, timings, fidelity' },
 };
 
 function usage() {

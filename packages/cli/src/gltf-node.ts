@@ -1,5 +1,5 @@
 // Loads a glTF skinned character in node (no DOM, no image decoder). The file is first checked by
-// gltf-validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
+// web/lib/gltf/validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
 // animations): a bad file is a GltfError with a code and one sentence, before any loader sees it.
 // External buffers are read only from regular files inside the glTF's folder, up to their
 // declared byteLength (readBufferFile). Then @gltf-transform/core
@@ -9,17 +9,19 @@
 // back into plain float attributes (JOINTS_1/WEIGHTS_1 kept: up to 8 influences per vertex; more
 // than 8: the 8 largest, renormalised)
 // and writes an uncompressed GLB that three's GLTFLoader parses into the same objects a browser
-// gets. Used by `gcs-skin report`, `gcs-skin/gltf` (loadCharacter), the bench scripts and tests.
+// gets. Used by `gcs-skin report`, `@gcs-skin/cli/gltf` (loadCharacter), the bench scripts and tests.
 import { constants as fs } from 'node:fs';
 import { open, readFile, realpath } from 'node:fs/promises';
 import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { decodeBufferPath, readValidatedGltf } from './gltf-buffers.js';
-import { restoreZeroWeights } from './gltf-accessors.js';
-import { GltfError, n, type BufferData, type GltfJson } from './gltf-validate.js';
+import { restoreZeroWeights } from '../../../web/lib/gltf/accessors.js';
+import { decodeBufferPath, readValidatedGltf } from '../../../web/lib/gltf/buffers.js';
+import { GltfError, n } from '../../../web/lib/gltf/error.js';
+import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
+import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
 
-export { GltfError, type GltfErrorCode } from './gltf-validate.js';
+export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
 
 export interface LoadedModel {
   scene: THREE.Object3D;
@@ -342,26 +344,12 @@ export async function parseGlb(
   return { scene, skinnedMeshes, clips: gltf.animations, warnings };
 }
 
-/**
- * Skin matrices of `mesh` in its own mesh space (bindMatrixInverse · boneWorld · boneInverse ·
- * bindMatrix), as the deformers expect, from the bones' current world matrices.
- */
-export function skinMatricesOf(mesh: THREE.SkinnedMesh, out: Float32Array, tmp = new THREE.Matrix4()): Float32Array {
-  const bones = mesh.skeleton.bones;
-  const inverses = mesh.skeleton.boneInverses;
-  for (let j = 0; j < bones.length; j++) {
-    tmp.multiplyMatrices(bones[j].matrixWorld, inverses[j]);
-    tmp.premultiply(mesh.bindMatrixInverse).multiply(mesh.bindMatrix);
-    out.set(tmp.elements, 16 * j);
-  }
-  return out;
-}
-
 /** Poses `root` at time t with `mixer` (its clip actions already playing) and returns `mesh`'s skin matrices. */
 export function skinMatricesAt(mixer: THREE.AnimationMixer, root: THREE.Object3D, mesh: THREE.SkinnedMesh, t: number, out: Float32Array): Float32Array {
   mixer.setTime(t);
   root.updateMatrixWorld(true);
-  return skinMatricesOf(mesh, out);
+  writeSkinMatrices(mesh, out);
+  return out;
 }
 
 /** The topmost ancestor of an object. */
@@ -403,7 +391,7 @@ export interface CharacterHeight {
 }
 
 /**
- * The character's height (design.md §7): the largest extent of the world bounding box of all
+ * The character's height (docs/method.md §9): the largest extent of the world bounding box of all
  * `meshes` in their bind pose, then that length in each mesh's own units through the mesh's world
  * scale (the deformers work in mesh space and their output is drawn through the mesh's world
  * matrix, so a distance d in a deformer's output is d × scale in the world).
@@ -435,7 +423,8 @@ export function characterHeight(meshes: readonly THREE.SkinnedMesh[]): Character
 /** C of characterHeight: the common skin matrix of the weighted joints, or their mean scale. */
 function bindPoseMatrix(mesh: THREE.SkinnedMesh): THREE.Matrix4 {
   const J = mesh.skeleton.bones.length;
-  const skin = skinMatricesOf(mesh, new Float32Array(16 * J));
+  const skin = new Float32Array(16 * J);
+  writeSkinMatrices(mesh, skin);
   const used = new Set<number>();
   for (const [j, w] of [['skinIndex', 'skinWeight'], ['joints_1', 'weights_1']]) {
     const joints = mesh.geometry.getAttribute(j), weights = mesh.geometry.getAttribute(w);

@@ -1,10 +1,10 @@
 // Reads accessor values straight from a glTF's buffers, for the checks that need values and not
-// only sizes (gltf-validate.ts: key times, sparse indices; the demo: all-zero skin weights). No
+// only sizes (validate.ts: key times, sparse indices; the demo: all-zero skin weights). No
 // decoding: an accessor in a meshopt-compressed or Draco buffer view, or in a buffer whose bytes
 // are not at hand, is not readable here (null), and those checks then leave it to the loaders.
 // Browser-safe: no node module, so the demo validates with the same code as the CLI.
 import type * as THREE from 'three';
-import type { BufferData, GltfJson } from './gltf-validate.js';
+import type { BufferData, GltfJson } from './json.js';
 
 /** Component i of element e. */
 export type ComponentReader = (element: number, component: number) => number;

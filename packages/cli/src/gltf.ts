@@ -1,4 +1,4 @@
-// `gcs-skin/gltf`: a glTF/GLB character in node, as rigs and skin matrices, with no three.js in
+// `@gcs-skin/cli/gltf`: a glTF/GLB character in node, as rigs and skin matrices, with no three.js in
 // sight. `loadCharacter(file)` reads the file (validated, compressed geometry decoded: see
 // gltf-node.ts), and gives per skinned mesh the RigInput for `gcs.createRig`, the character's
 // height in that mesh's units, and its clips, each sampled at any time into the J×16 skin matrices
@@ -6,13 +6,15 @@
 // three appears in the types. Documented in docs/node.md.
 import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
-import type { RigInput } from '../index.js';
-import { rigInputFromSkinnedMesh } from '../three.js';
-import { characterHeight, loadGltfFile, rootOf, skinMatricesOf } from './gltf-node.js';
-import { GltfError } from './gltf-validate.js';
+import { GltfError } from '../../../web/lib/gltf/error.js';
+import type { RigInput } from '../../../web/lib/index.js';
+import { morphData } from '../../../web/lib/three/morph-data.js';
+import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
+import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
+import { characterHeight, loadGltfFile, rootOf } from './gltf-node.js';
 
-export { GltfError, type GltfErrorCode } from './gltf-validate.js';
-export type { RigInput } from '../index.js';
+export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
+export type { RigInput } from '../../../web/lib/index.js';
 
 /** One animation clip of the file, as seen by one skinned mesh. */
 export interface CharacterClip {
@@ -152,9 +154,11 @@ function characterMesh(mesh: THREE.SkinnedMesh, height: number, poser: Poser): C
   const skin = (out?: Float32Array) => {
     const o = out ?? new Float32Array(16 * J);
     if (o.length < 16 * J) throw new RangeError(`sample(): out has ${o.length} floats, ${16 * J} are needed (16 per joint)`);
-    return skinMatricesOf(mesh, o, tmp);
+    writeSkinMatrices(mesh, o, 0, tmp);
+    return o;
   };
-  const morphs = morphTargetsOf(mesh.geometry);
+  const morph = morphData(mesh.geometry);
+  const morphs = morph && { positions: morph.positions, normals: morph.normals };
   const T = morphs?.positions.length ?? 0;
   const influences = (out?: Float32Array) => {
     const o = out ?? new Float32Array(T);
@@ -191,27 +195,5 @@ function characterMesh(mesh: THREE.SkinnedMesh, height: number, poser: Poser): C
     },
     clips,
     clip: (name: string) => clips.find((c) => c.name === name),
-  };
-}
-
-/** Morph targets of a geometry as relative deltas (glTF's are relative; three keeps them so). */
-function morphTargetsOf(geometry: THREE.BufferGeometry): CharacterMesh['morphTargets'] {
-  const targets = geometry.morphAttributes.position;
-  if (!targets?.length) return null;
-  const relative = geometry.morphTargetsRelative;
-  type Attr = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
-  const deltas = (list: Attr[], base: Attr | undefined) => list.map((attr) => {
-    const out = new Float32Array(3 * attr.count);
-    for (let i = 0; i < attr.count; i++) {
-      out[3 * i] = attr.getX(i) - (relative || !base ? 0 : base.getX(i));
-      out[3 * i + 1] = attr.getY(i) - (relative || !base ? 0 : base.getY(i));
-      out[3 * i + 2] = attr.getZ(i) - (relative || !base ? 0 : base.getZ(i));
-    }
-    return out;
-  });
-  const normals = geometry.morphAttributes.normal;
-  return {
-    positions: deltas(targets, geometry.getAttribute('position')),
-    normals: normals?.length === targets.length ? deltas(normals, geometry.getAttribute('normal')) : null,
   };
 }

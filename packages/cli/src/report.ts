@@ -1,18 +1,18 @@
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--wide] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
-// method, build ms, ms per frame and the fidelity figures of design.md §7 (FidelityProbe over the
+// method, build ms, ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe over the
 // sampled frames of every clip, distances in % of the character's height). Frame times come from
 // one interleaved timing per clip (every method in turn: timeInterleaved, as `npm run bench`), and
 // a method's one figure is the median of its clips'. Progress on stderr when it is a terminal.
 // The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
-import { GcsError } from '../errors.js';
-import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../index.js';
-import { rigInputFromSkinnedMesh } from '../three.js';
+import { GcsError } from '../../../web/lib/errors.js';
+import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
+import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, median, timeInterleaved, type Fidelity, type MethodName,
-} from '../measure.js';
+} from '../../../web/lib/measure.js';
 
 /** Fidelity frames in all (default --frames: this many spread over the clips, at least MIN_FRAMES_PER_CLIP each, at most 60). */
 export const FRAME_BUDGET = 64;

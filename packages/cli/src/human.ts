@@ -1,6 +1,6 @@
 // `gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb`
 import { writeFileSync } from 'node:fs';
-import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from './index.js';
+import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from '../../../web/lib/human/index.js';
 
 export const usage = `usage: gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb
   --vertices N   vertex count, ${MIN_VERTICES}..${MAX_VERTICES} (default ${DEFAULT_VERTICES})

@@ -1,9 +1,12 @@
-// The bytes of a glTF's buffers, gathered and validated the same way in node (gltf-node.ts: files
+// The bytes of a glTF's buffers, gathered and validated the same way in node (packages/cli/src/gltf-node.ts: files
 // beside the .gltf) and in the browser (the demo: dropped files, URLs): the GLB's BIN chunk,
 // data: URIs decoded here (a malformed one is a BAD_URI GltfError, not the engine's URIError), and
 // external files through a reader the caller gives, asked for at most the declared byteLength.
 // Then the whole file goes through validateGltfJson. Browser-safe: no node module.
-import { GltfError, n, parseGltfContainer, validateGltfJson, type BufferData, type GltfJson } from './gltf-validate.js';
+import { parseGltfContainer } from './container.js';
+import { GltfError, n } from './error.js';
+import type { BufferData, GltfJson } from './json.js';
+import { validateGltfJson } from './validate.js';
 
 /**
  * Reads buffer `index`'s external file `uri`: at most `maxBytes` of it (its declared byteLength),

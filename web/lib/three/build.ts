@@ -1,0 +1,189 @@
+// The build transaction of a SkinDeformer: prepareBuild makes the next deformer and the geometry
+// around it without showing them; SkinDeformer.commit shows one, discardBuild frees one never shown
+// (GcsCharacter.rebuild prepares every skin before it commits any: all or nothing).
+import * as THREE from 'three';
+import { GcsError } from '../errors.js';
+import { ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type Rig } from '../index.js';
+import { transferSurfaceAttributes } from '../surface-attributes.js';
+import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from '../gpu/bind.js';
+import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from '../gpu/kit.js';
+import type { GpuPath } from '../gpu/layout.js';
+import { GpuSections } from '../gpu/sections.js';
+import { morphData } from './morph-data.js';
+import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
+
+/** A deformer and the geometry around it, built but not yet shown (rebuilds are all-or-nothing). */
+export interface PendingBuild {
+  method: DeformerKind;
+  gcs: GcsOptions;
+  classic: ClassicOptions;
+  deformer: Deformer;
+  /** Deforms the tangents (as its normals), or null. */
+  tangentDeformer: Deformer | null;
+  geometry: THREE.BufferGeometry;
+  /** Per morph target, the largest delta length; null without morphs. */
+  maxDelta: Float32Array | null;
+  /** The GPU backend's state, or null (CPU). */
+  gpu: GpuBuild | null;
+  /** Why 'gpu' was asked for and 'cpu' runs, or ''. */
+  note: string;
+  /** The backend asked for. */
+  backend: Backend;
+  /** The GPU path asked for. */
+  gpuPath: GpuPath | 'auto';
+}
+
+/** The GPU backend of one build: section texture, patched materials, the geometry raycasts test. */
+export interface GpuBuild {
+  sections: GpuSections;
+  materials: GpuMaterials;
+  raycast: THREE.BufferGeometry;
+}
+
+/** What a build reads of its SkinDeformer (nothing here is changed by a build). */
+export interface BuildSource {
+  readonly source: THREE.SkinnedMesh;
+  readonly rig: Rig;
+  /** The rig fed the tangents as its normals, or null. */
+  readonly tangentRig: Rig | null;
+  /** tangent w per source vertex (handedness), or null. */
+  readonly tangentW: Float32Array | null;
+  /** The options of the current build (what `options` of prepareBuild do not change). */
+  readonly options: SkinDeformerOptions;
+  /** The material drawn by the CPU backend. */
+  readonly baseMaterial: THREE.Material | THREE.Material[];
+  readonly kit: GpuMaterialKit;
+  /** The output mesh (its current material decides multi-material groups). */
+  readonly mesh: THREE.Mesh;
+  /** The bounds every geometry of the skin shares (updated per frame by the deformer). */
+  readonly box: THREE.Box3;
+  readonly sphere: THREE.Sphere;
+}
+
+/** Builds the next deformer and its geometry without showing them; on a failure nothing is left allocated. */
+export function prepareBuild(from: BuildSource, method: DeformerKind, options: RebuildOptions = {}): PendingBuild {
+  const gcsOptions = { ...from.options.gcs, ...options.gcs };
+  const classicOptions = { ...from.options.classic, ...options.classic };
+  const backend = options.backend ?? from.options.backend ?? 'cpu';
+  if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got '${String(backend)}'`);
+  const note = backend === 'gpu' ? gpuUnsupported(from, method) : '';
+  const onGpu = backend === 'gpu' && !note;
+  const gpuPath = options.gpuPath ?? from.options.gpuPath ?? 'auto';
+  if (gpuPath !== 'auto' && gpuPath !== 'joints' && gpuPath !== 'sections')
+    throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got '${String(gpuPath)}'`);
+  const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
+    : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
+  const deformer = build(from.rig);
+  let tangentDeformer: Deformer | null = null;
+  let gpu: GpuBuild | null = null;
+  try {
+    const sourceVertex = deformer.sourceVertex;
+    const morph = method === 'classic' ? null : morphData(from.source.geometry);
+    if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
+    if (onGpu) {
+      gpu = prepareGpu(from, deformer as GcsDeformer, gpuPath === 'auto' ? undefined : gpuPath);
+      const geometry = makeGeometry(from, deformer, sourceVertex, null, gpu);
+      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
+    }
+    if (from.tangentRig && sourceVertex) {
+      tangentDeformer = build(from.tangentRig);
+      // Same positions and weights, so the same vertex order; checked, not assumed.
+      const order = tangentDeformer.sourceVertex;
+      if (!order || order.length !== sourceVertex.length || order.some((v, i) => v !== sourceVertex[i])) {
+        tangentDeformer.dispose();
+        tangentDeformer = null;
+      }
+    }
+    const geometry = makeGeometry(from, deformer, sourceVertex, tangentDeformer, null);
+    return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend, gpuPath };
+  } catch (e) {
+    if (gpu) disposeGpu(gpu);
+    tangentDeformer?.dispose();
+    deformer.dispose();
+    throw e;
+  }
+}
+
+/** Frees a prepared build that will not be shown. */
+export function discardBuild(next: PendingBuild): void {
+  if (next.gpu) disposeGpu(next.gpu);
+  next.tangentDeformer?.dispose();
+  next.deformer.dispose();
+  next.geometry.dispose();
+}
+
+/** Frees a GPU build: its wasm buffers, texture, GCS materials and raycast geometry. */
+export function disposeGpu(gpu: GpuBuild): void {
+  gpu.sections.dispose();
+  disposeGpuMaterials(gpu.materials);
+  gpu.raycast.dispose();
+}
+
+/** Why this build cannot run on the GPU, or ''. */
+function gpuUnsupported(from: BuildSource, method: DeformerKind): string {
+  if (method !== 'gcs') return `the GPU backend runs GCS; '${method}' runs on the CPU`;
+  for (const m of Array.isArray(from.baseMaterial) ? from.baseMaterial : [from.baseMaterial]) {
+    const reason = from.kit.support(m);
+    if (reason) return reason;
+  }
+  return '';
+}
+
+/** The per-frame texture (joint poses or section transforms) and the GCS materials of a GPU build. */
+function prepareGpu(from: BuildSource, deformer: GcsDeformer, path?: GpuPath): GpuBuild {
+  const sections = new GpuSections(deformer, 1, 2048, path);
+  const materials = from.kit.build(from.baseMaterial, sections, null);
+  const raycast = new THREE.BufferGeometry();
+  raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
+  raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
+  raycast.boundingBox = from.box;
+  raycast.boundingSphere = from.sphere;
+  return { sections, materials, raycast };
+}
+
+/** The output geometry of a build: the deformer's buffers (CPU) or the bind pose with section data (GPU), and the source's other attributes. */
+function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null, gpu: GpuBuild | null): THREE.BufferGeometry {
+  const src = from.source.geometry;
+  const indices = deformer.indices;
+  let geometry: THREE.BufferGeometry;
+  if (gpu) {
+    // The bind pose, uploaded once, with the section data; three.js morphs in the shader, before GCS.
+    geometry = bindGeometry(deformer as GcsDeformer, from.rig.jointCount, src, { tangents: from.options.tangents !== 'drop', morphs: true });
+  } else {
+    geometry = new THREE.BufferGeometry();
+    geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    if (sourceVertex) {
+      for (const [name, attr] of Object.entries(src.attributes))
+        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+      if (tangentDeformer && from.tangentW) {
+        const w = new Float32Array(4 * sourceVertex.length);
+        for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = from.tangentW[sourceVertex[o]];
+        geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
+      }
+    } else if (deformer instanceof ClassicDeformer) {
+      // Resampled: the source's uv, colours and custom attributes from the closest source point.
+      deformer.deform(identitySkin(from.rig.jointCount));
+      transferSurfaceAttributes(src, geometry, deformer.positions, deformer.sourceOfVertex, SKINNING_ATTRIBUTES);
+    }
+  }
+  // Groups (multi-material) and the draw range count index entries: they carry over when the
+  // deformer kept the triangles in order (GCS, LBS, DQS remap vertex ids only; checked here).
+  let sameOrder = !!sourceVertex;
+  if (sourceVertex) {
+    const srcIndex = src.index;
+    for (let i = 0; i < indices.length && sameOrder; i++)
+      sameOrder = sourceVertex[indices[i]] === (srcIndex ? srcIndex.getX(i) : i);
+    if (srcIndex && indices.length !== srcIndex.count) sameOrder = false;
+  }
+  if (sameOrder) {
+    for (const g of src.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
+    geometry.setDrawRange(src.drawRange.start, src.drawRange.count);
+  } else if (Array.isArray(from.mesh.material)) {
+    geometry.addGroup(0, Infinity, 0); // resampled triangles: the first material for all
+  }
+  geometry.boundingBox = from.box;
+  geometry.boundingSphere = from.sphere;
+  return geometry;
+}

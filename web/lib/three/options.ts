@@ -1,0 +1,83 @@
+// The options of gcs-skin/three's SkinDeformer and GcsCharacter (and gcs-skin/webgpu's).
+import type * as THREE from 'three';
+import type { ClassicOptions, DeformerKind, GcsOptions } from '../index.js';
+import type { GpuMaterialKit } from '../gpu/kit.js';
+import type { GpuPath } from '../gpu/layout.js';
+
+/** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
+export type Backend = 'cpu' | 'gpu';
+
+export interface SkinDeformerOptions {
+  /** Which deformer drives the mesh. Default 'gcs'. */
+  method?: DeformerKind;
+  gcs?: GcsOptions;
+  classic?: ClassicOptions;
+  /** Material of the output mesh. Default: the source's own material (the same object, shared, not cloned). */
+  material?: THREE.Material | THREE.Material[];
+  /**
+   * Put the deformed mesh in the source's place: it is inserted under the source's parent, right
+   * after it, with the source's local transform (kept in step by update()), and it mirrors
+   * `source.visible`; the source leaves the render, the shadow passes and raycasts (its `layers`
+   * are cleared, so its children still render and its bones still move). `dispose()` undoes it.
+   * A source without a parent gets the deformed mesh as its child, at identity. Default false:
+   * `mesh` is free and carries the source's world transform (add it at the top level).
+   */
+  inPlace?: boolean;
+  /**
+   * When the source geometry has a `tangent` attribute: 'deform' (default) turns the tangents
+   * with the skin (a second deformer of the same kind, fed the tangents as its normals: one more
+   * deform and a copy per frame); 'drop' leaves them out, and three.js derives the tangent frame
+   * of normal maps from the deformed positions and uvs (screen-space derivatives). Carrying the
+   * bind-pose tangents unchanged would tilt normal maps wherever the skin bends, so that is not
+   * offered. Ignored by the classic model.
+   */
+  tangents?: 'deform' | 'drop';
+  /**
+   * 'cpu' (default): wasm deforms every vertex and three.js uploads the vertex buffers each frame.
+   * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the joint
+   * poses (weights criterion; about 1 KB) or the section transforms (a few KB), into a float
+   * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
+   * see gpuPath). GCS only: other methods, and materials that cannot be
+   * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
+   * `backendNote` why, and one console warning says so. The same happens at the first draw by a
+   * WebGPURenderer, which never runs the patch: gcs-skin/webgpu is the GPU backend for it (TSL).
+   */
+  backend?: Backend;
+  /**
+   * GPU backend: what wasm hands the GPU per frame. 'auto' (default): 'joints' for the weights
+   * criterion (the joint poses, 64 bytes per joint; the shader blends each section from them and a
+   * static table), 'sections' for 'y' and 'axial' (the section transforms, 48 bytes per section).
+   * 'sections' forces the section-level path; 'joints' with 'y' or 'axial' is GcsError
+   * 'INVALID_ARGUMENT'.
+   */
+  gpuPath?: GpuPath | 'auto';
+  /** @internal How materials run GCS on the GPU (gcs-skin/webgpu passes its TSL kit). Default: the GLSL kit (WebGLRenderer). */
+  gpuKit?: GpuMaterialKit;
+  /** @internal The backend notes already warned about (a GcsCharacter shares one set: one warning per cause). */
+  warned?: Set<string>;
+}
+
+/** What rebuild() may change. */
+export interface RebuildOptions {
+  gcs?: GcsOptions;
+  classic?: ClassicOptions;
+  backend?: Backend;
+  gpuPath?: GpuPath | 'auto';
+}
+
+export interface GcsCharacterOptions {
+  /** Which deformer drives every skin. Default 'gcs'. */
+  method?: DeformerKind;
+  gcs?: GcsOptions;
+  classic?: ClassicOptions;
+  /** See SkinDeformerOptions.tangents. Default 'deform'. */
+  tangents?: 'deform' | 'drop';
+  /** Which SkinnedMeshes under the root to drive. Default: all of them. */
+  filter?: (mesh: THREE.SkinnedMesh) => boolean;
+  /** See SkinDeformerOptions.backend: 'cpu' (default) or 'gpu' (GCS section transforms in the vertex shader). */
+  backend?: Backend;
+  /** See SkinDeformerOptions.gpuPath. Default 'auto'. */
+  gpuPath?: GpuPath | 'auto';
+  /** @internal See SkinDeformerOptions.gpuKit. */
+  gpuKit?: GpuMaterialKit;
+}
