@@ -302,7 +302,24 @@ const realRigs = await loadRealRigs(log);
 {
   const reps = quick ? 3 : 9;
   const slider = sliderRebuild(gcs, human.mesh, reps);
-  const rebuild = { gcsMs: slider.adapterMs, gcsCoreMs: slider.coreMs, classicMs: null, classicError: null };
+  // Centres of rotation (opt-in, GcsOptions.centres): a first build on a fresh rig (its per-triangle
+  // data included), then section counts the slider has not built yet (their nodes' centres
+  // integrated), then the same counts again (the pair sums kept on the rig).
+  const fresh = gcs.createRig(input);
+  let t0 = performance.now();
+  fresh.buildGcs({ sections, centres: true }).dispose();
+  const centresFirstMs = performance.now() - t0;
+  const counts = [3, 4, 5, 6, 7, 8, 9].filter((n) => n !== sections).slice(0, 6);
+  const firstVisit = [], seen = [];
+  for (const list of [firstVisit, seen])
+    for (const n of counts) {
+      t0 = performance.now();
+      fresh.buildGcs({ sections: n, centres: true }).dispose();
+      list.push(performance.now() - t0);
+    }
+  fresh.dispose();
+  const rebuild = { gcsMs: slider.adapterMs, gcsCoreMs: slider.coreMs, classicMs: null, classicError: null,
+    centres: { firstBuildMs: centresFirstMs, newCountMs: median(firstVisit), seenCountMs: median(seen) } };
   const classic = [];
   try {
     for (let i = 0; i < (quick ? 2 : 5); i++) {
@@ -438,6 +455,10 @@ console.log(fmtTable(rows2));
 
 console.log(`\nSection slider (SkinDeformer.rebuild, sections 3–8), median: ${ms(results.rebuild.gcsMs)} ms (core build alone ${ms(results.rebuild.gcsCoreMs)} ms); ` +
   `classic resampling ${results.rebuild.classicMs === null ? `n/a (${results.rebuild.classicError.code}: ${results.rebuild.classicError.message})` : `${ms(results.rebuild.classicMs)} ms`}`);
+const cr = results.rebuild.centres;
+console.log(`Centres of rotation (option): first build ${ms(cr.firstBuildMs)} ms (per-triangle data included), rebuild ${ms(cr.newCountMs)} ms ` +
+  `at a section count not built before, ${ms(cr.seenCountMs)} ms at one built before (medians, counts 3–9)`);
+
 console.log('\nThe demo\'s first picture (a GCS and a classic SkinDeformer per skinned mesh; the LBS view is three.js\'s own SkinnedMesh: nothing to build), median ms:');
 console.log(fmtTable([['character', 'vertices', 'GCS', 'classic', 'total'],
   ...results.firstPicture.map((p) => [p.name, String(p.vertices), ms(p.gcsMs), p.classicError ? `n/a (${p.classicError})` : ms(p.classicMs), ms(p.totalMs)])]));

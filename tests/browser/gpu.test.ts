@@ -54,9 +54,9 @@ interface Result {
 
 type Path = 'joints' | 'sections';
 
-async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path, boneScale?: number[]): Promise<Result> {
-  return page!.evaluate(([m, s, t, c, p, b]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
-    .__gpu.check(m as string, { smooth: s }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale] as const);
+async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path, boneScale?: number[], centres = false): Promise<Result> {
+  return page!.evaluate(([m, s, t, c, p, b, k]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
+    .__gpu.check(m as string, { smooth: s, centres: k }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale, centres] as const);
 }
 
 function expectEqual(r: Result, label: string, path: Path): void {
@@ -108,6 +108,22 @@ describe.skipIf(!!reason)('GPU backend = CPU backend (headless Chromium)', () =>
       expectEqual(r, `human scaled ${smooth ? 'smooth' : 'plain'}`, 'joints');
     });
   }
+});
+
+// Centres of rotation (gcs_gcs_section_centres): the joint-level shader turns each blended section
+// about its centre, the centre moved by LBS; the section-level path gets the CPU's matrices.
+describe.skipIf(!!reason)('centres of rotation: GPU backend = CPU backend (headless Chromium)', () => {
+  for (const gpuPath of ['joints', 'sections'] as const)
+    for (const smooth of [false, true]) {
+      const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
+      test(`default human, centres, ${mode}`, async () => {
+        expectEqual(await check('human', smooth, [0.15, 0.45, 0.8], 'run', gpuPath, undefined, true), `human centres ${mode}`, gpuPath);
+      });
+    }
+  const cesium = join(MODELS_DIR, 'CesiumMan.glb');
+  test.skipIf(!existsSync(cesium))('CesiumMan, centres, smooth, joints path, its first bone scaled (1.3, 0.7, 1.1)', async () => {
+    expectEqual(await check(`/@fs${cesium}`, true, [0.3, 0.9], undefined, 'joints', [1.3, 0.7, 1.1], true), 'CesiumMan centres scaled', 'joints');
+  });
 });
 
 const CESIUM = join(MODELS_DIR, 'CesiumMan.glb');

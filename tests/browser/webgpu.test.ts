@@ -72,6 +72,20 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     }
   }
 
+  // Centres of rotation: the TSL section blend turns about each section's centre (the table's last texel).
+  const cesiumFile = join(MODELS_DIR, 'CesiumMan.glb');
+  test.skipIf(!existsSync(cesiumFile))('CesiumMan.glb, smooth, joints path, centres of rotation: GPU backend = CPU backend, posed', async () => {
+    const r = await call<{ backends: string[]; paths: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number; warnings: string[] }>(
+      'check', `/@fs${cesiumFile}`, { smooth: true, centres: true }, [0.5, 1.0, 1.6], undefined, 'joints');
+    console.log(`CesiumMan centres: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+    expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+    expect(r.paths.every((p) => p === 'joints')).toBe(true);
+    expect(r.warnings).toEqual([]);
+    for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+    for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+    expect(errors).toEqual([]);
+  });
+
   // Morph targets apply before GCS (three.js's order, the CPU's too): a swelling morph at 0.8 on the human.
   for (const gpuPath of ['joints', 'sections'] as const) {
     test(`default human with a morph target, ${gpuPath} path: GPU backend = CPU backend`, async () => {

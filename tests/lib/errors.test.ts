@@ -127,11 +127,11 @@ describe('model settings', () => {
     const rig = gcs.createRig(makeTube().input);
     const core = gcs.core;
     const handle = (rig as unknown as { handle: number }).handle;
-    expect(core.gcs_build_gcs(handle, 2, 1, 1, 0, 0)).toBe(0);
+    expect(core.gcs_build_gcs(handle, 2, 1, 1, 0, 0, 0)).toBe(0);
     expect(core.gcs_last_error_code()).toBe(7);
-    expect(core.gcs_build_gcs(handle, 6, 9, 1, 0, 0)).toBe(0);
+    expect(core.gcs_build_gcs(handle, 6, 9, 1, 0, 0, 0)).toBe(0);
     expect(core.gcs_last_error_code()).toBe(1);
-    expect(core.gcs_build_gcs(0, 6, 1, 1, 0, 0)).toBe(0);
+    expect(core.gcs_build_gcs(0, 6, 1, 1, 0, 0, 0)).toBe(0);
     expect(core.gcs_last_error_code()).toBe(1);
     rig.dispose();
   });

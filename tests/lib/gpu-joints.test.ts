@@ -16,6 +16,7 @@ import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
 import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { identitySkin } from '../../web/lib/measure.js';
+import { sectionTable } from '../../web/lib/gpu/sections.js';
 import { loadGlb, MODELS_DIR } from '../helpers/models.js';
 import { maxDistance, scaledSkin as scaled } from '../helpers/skins.js';
 
@@ -61,7 +62,8 @@ function normalMatrix(r: number[], k: number[]): { n: number[]; renorm: boolean 
 /** The shader's section blend from the joint texels of one instance (at texel `base`) and the static table. */
 function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s: number): Blend {
   const at = (j: number) => (base + j * GPU_TEXELS_PER_JOINT) * 4;
-  const joint = (i: number) => table[8 * s + i], weight = (i: number) => table[8 * s + 4 + i];
+  const joint = (i: number) => table[12 * s + i], weight = (i: number) => table[12 * s + 4 + i];
+  const centre = table.subarray(12 * s + 8, 12 * s + 12);  // (x, y, z, 1), or w = 0: no centre of rotation
   /** K_j = R_jᵀ·S_j (row-major). */
   const scaleOf = (o: number, r: number[]) => {
     const k = new Array<number>(9).fill(0);
@@ -76,9 +78,12 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
   }
   const o0 = at(joint(0));
   const pivot = [poses[o0 + 12], poses[o0 + 13], poses[o0 + 14], poses[o0 + 15]];
-  const br = [0, 0, 0, 0], bd = [0, 0, 0, 0], k = new Array<number>(9).fill(0);
+  const br = [0, 0, 0, 0], bd = [0, 0, 0, 0], k = new Array<number>(9).fill(0), moved = [0, 0, 0];
   for (let i = 0; i < 4 && joint(i) >= 0; i++) {
     const o = at(joint(i)), w = weight(i);
+    // Σ w_i (S_i p − p): where linear blend skinning moves the centre p.
+    for (let r = 0; r < 3; r++)
+      moved[r] += w * (poses[o + 4 * r] * centre[0] + poses[o + 4 * r + 1] * centre[1] + poses[o + 4 * r + 2] * centre[2] + poses[o + 4 * r + 3] - centre[r]);
     const q = [poses[o + 12], poses[o + 13], poses[o + 14], poses[o + 15]];
     const t = [poses[o + 3], poses[o + 7], poses[o + 11]];
     // dual = ½ (0, t)·q
@@ -100,7 +105,8 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
   const p = new Float64Array(12);
   for (let i = 0; i < 3; i++) {
     for (let j = 0; j < 3; j++) for (let m = 0; m < 3; m++) p[4 * i + j] += rot[3 * i + m] * k[3 * m + j];
-    p[4 * i + 3] = tv[i];
+    // With a centre: M p + T = Σ w_i S_i p (the blend's rotation about p, p moved by LBS).
+    p[4 * i + 3] = centre[3] > 0.5 ? moved[i] - (p[4 * i] * centre[0] + p[4 * i + 1] * centre[1] + p[4 * i + 2] * centre[2] - centre[i]) : tv[i];
   }
   const nm = normalMatrix(rot, k);
   return { p, n: Float64Array.from(nm.n), renorm: nm.renorm };
@@ -109,7 +115,7 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
 /** Every vertex as the shader moves it: plain, or smooth (lerp of two sections, the CPU's normal length fix: none
  * for rotations under 2.8° apart, the cubic under 35°, else exact). */
 function shade(d: GcsDeformer, poses: Float32Array, base: number, rest: { p: Float32Array; n: Float32Array }, outP: Float64Array, outN: Float64Array): void {
-  const table = d.sectionInfluences()!;
+  const table = sectionTable(d);
   const sectionOf = d.sectionOfVertex(), other = d.blendOther(), factor = d.blendFactor();
   const third = d.blendThird(), thirdFactor = d.blendThirdFactor();
   const blends = Array.from({ length: d.sectionCount }, (_, s) => sectionBlend(poses, base, table, s));
@@ -160,8 +166,9 @@ const SCALES: { name: string; s: [number, number, number] }[] = [
  * largest skin): a small skin far from the origin (Soldier's visor, 12 of 185 cm, at head height)
  * is measured against the character it belongs to, as float32 rounding at its distance is.
  */
-function compare(rig: Rig, frames: Float32Array[], smooth: boolean, label: string, height = rig.height): void {
-  const d = rig.buildGcs({ smooth });
+function compare(rig: Rig, frames: Float32Array[], smooth: boolean, label: string, height = rig.height, centres = false): void {
+  const d = rig.buildGcs({ smooth, centres });
+  if (centres) expect(d.sectionCentres()!.some((x, i) => i % 4 === 3 && x === 1)).toBe(true);
   expect(d.jointLevel).toBe(true);
   d.deform(identitySkin(d.jointCount));
   const rest = { p: Float32Array.from(d.positions), n: Float32Array.from(d.normals) };
@@ -199,7 +206,7 @@ describe('joint poses + static section table, shaded in JS = gcs_deformer_deform
       const human = createHuman();
       const rig = gcs.createRig(rigInputFromSkinnedMesh(human.mesh));
       const frames = ['walk', 'run'].flatMap((n) => sampleClip(human.mesh, human.clips.find((c) => c.name === n)!, 5));
-      compare(rig, frames, smooth, `human ${smooth ? 'smooth' : 'plain'}`);
+      for (const centres of [false, true]) compare(rig, frames, smooth, `human ${smooth ? 'smooth' : 'plain'}${centres ? ', centres' : ''}`, rig.height, centres);
       rig.dispose();
     });
   }
@@ -215,7 +222,8 @@ describe('joint poses + static section table, shaded in JS = gcs_deformer_deform
         const rig = rigs[i];
         const clip = model.clips.find((c) => c.name === 'Run') ?? model.clips[0];
         const frames = sampleClip(mesh, clip, 5);
-        for (const smooth of [false, true]) compare(rig, frames, smooth, `${file} ${mesh.name} ${smooth ? 'smooth' : 'plain'}`, height);
+        for (const smooth of [false, true])
+          for (const centres of [false, true]) compare(rig, frames, smooth, `${file} ${mesh.name} ${smooth ? 'smooth' : 'plain'}${centres ? ', centres' : ''}`, height, centres);
         rig.dispose();
       }
     }, 60000);

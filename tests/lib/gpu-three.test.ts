@@ -83,7 +83,13 @@ describe('GPU backend (three.js adapter)', () => {
     expect(sections.uniforms.gcsJoints!.value).toBe(sections.texture);
     expect(sections.uniforms.gcsTable!.value).toBe(sections.table);
     const table = sections.table!.image.data as Float32Array;
-    expect(Array.from(table.subarray(0, skin.deformer.sectionCount * 8))).toEqual(Array.from((skin.deformer as import('../../web/lib/index.js').GcsDeformer).sectionInfluences()!));
+    // Per section: its joints, its weights (gcs_gcs_section_influences), its centre of rotation (gcs_gcs_section_centres).
+    const gcsDeformer = skin.deformer as import('../../web/lib/index.js').GcsDeformer;
+    const influences = gcsDeformer.sectionInfluences()!, centres = gcsDeformer.sectionCentres()!;
+    for (let s = 0; s < gcsDeformer.sectionCount; s++) {
+      expect(Array.from(table.subarray(12 * s, 12 * s + 8))).toEqual(Array.from(influences.subarray(8 * s, 8 * s + 8)));
+      expect(Array.from(table.subarray(12 * s + 8, 12 * s + 12))).toEqual(Array.from(centres.subarray(4 * s, 4 * s + 4)));
+    }
     const positionVersion = position.version, textureVersion = sections.texture.version, tableVersion = sections.table!.version;
     mixer.setTime(0.6);
     character.update();

@@ -7,26 +7,13 @@ import { beforeAll, describe, expect, test } from 'vitest';
 import { initGcsSkin, type GcsDeformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
 import { createHuman } from '../../web/lib/human/index.js';
+import { cleanWeights } from '../helpers/clean-weights.js';
 import { loadGlb, sharedModels } from '../helpers/models.js';
 
 let gcs: GcsSkin;
 beforeAll(async () => {
   gcs = await initGcsSkin();
 });
-
-/** A vertex's weights as the builder reads them: under 0.5 % dropped (but the largest), the same joint merged, summing to 1. */
-function cleanWeights(input: RigInput, v: number): Map<number, number> {
-  const slots = input.influences ?? 4;
-  const raw = new Map<number, number>();
-  for (let i = 0; i < slots; i++) {
-    const w = input.weights[slots * v + i];
-    if (w > 0) raw.set(input.joints[slots * v + i], (raw.get(input.joints[slots * v + i]) ?? 0) + w);
-  }
-  const biggest = Math.max(...raw.values());
-  const kept = [...raw].filter(([, w]) => w >= Math.fround(0.005) || w === biggest);  // the builder compares in float32
-  const sum = kept.reduce((s, [, w]) => s + w, 0);
-  return new Map(kept.map(([j, w]) => [j, w / sum]));
-}
 
 /** Section s's blend weights from the joint-level table. */
 function nodeWeights(table: Float32Array, slots: number, s: number): Map<number, number> {

@@ -9,7 +9,7 @@
 // triangle soup; mostly valid, sometimes broken in exactly one documented way (then
 // gcs_rig_create must reject it with the documented error code, or accept it where the header
 // says the input is fine). A valid rig gets every deformer: GCS with each criterion (fuzzed section
-// count, influence width, smooth, twist), classic, LBS and DQS, plus builds with out-of-range
+// count, influence width, smooth, twist, centres of rotation), classic, LBS and DQS, plus builds with out-of-range
 // settings that must be rejected. The rig is then destroyed (a deformer keeps no pointer to it) and
 // the deformers run through fuzzed frames of skin matrices: identity, rigid, uniform and
 // non-uniform scales (0.01 … ×1e20, 1e-20), mirrors, shears, collapsed and raw matrices; GCS, LBS
@@ -630,10 +630,10 @@ struct Built {
   std::vector<uint32_t> outputOf;  // GCS, LBS, DQS: the output vertex of each rig vertex
   uint32_t a = 0, c = 0;           // build settings (GCS: sections, criterion; classic: contours, rays)
   float w = 0.0f;                  // GCS: influence width; classic: bulge
-  int smooth = 0, twist = 0;
+  int smooth = 0, twist = 0, centres = 0;
   GcsDeformer* rebuild(const GcsRig* rig) const {
     switch (kind) {
-      case GCS_KIND_GCS: return gcs_build_gcs(rig, a, c, w, smooth, twist);
+      case GCS_KIND_GCS: return gcs_build_gcs(rig, a, c, w, smooth, twist, centres);
       case GCS_KIND_CLASSIC: return gcs_build_classic(rig, a, c, w);
       case GCS_KIND_LBS: return gcs_build_lbs(rig);
       default: return gcs_build_dqs(rig);
@@ -708,7 +708,7 @@ void checkStructure(Built& b, const RigInput& in) {
               gcs_deformer_stat(d, GCS_STAT_ADJUSTED_SECTIONS) == 0.0f,
           "LBS/DQS stats %g %g", double(statSections), double(statParts));
     CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d) &&
-              !gcs_gcs_section_influences(d),
+              !gcs_gcs_section_influences(d) && !gcs_gcs_section_centres(d),
           "GCS introspection on LBS/DQS");
   }
   if (b.kind == GCS_KIND_GCS) {
@@ -744,7 +744,7 @@ void checkStructure(Built& b, const RigInput& in) {
   if (b.kind == GCS_KIND_CLASSIC) {
     CHECK(src == nullptr, "classic source vertices not null");
     CHECK(!gcs_gcs_section_of_vertex(d) && !gcs_gcs_section_info(d) && !gcs_gcs_section_matrices(d) &&
-              !gcs_gcs_section_influences(d),
+              !gcs_gcs_section_influences(d) && !gcs_gcs_section_centres(d),
           "GCS introspection on classic");
     const uint32_t P = gcs_classic_part_count(d);
     const int32_t* parts = gcs_classic_parts(d);
@@ -894,13 +894,21 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
   const float* table = gcs_gcs_section_influences(d);
   std::vector<float> out(size_t(J) * 32, -7.0f);
   if (b.c != GCS_CRITERION_WEIGHTS) {
-    CHECK(!table, "criterion %u has a joint-level table", b.c);
+    CHECK(!table && !gcs_gcs_section_centres(d), "criterion %u has a joint-level table", b.c);
     CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 1, out.data()) == 0, "compute_joint_poses took criterion %u", b.c);
     checkRejected("compute_joint_poses(criterion)", [](int c) { return c == GCS_ERR_INVALID_ARGUMENT; });
     return;
   }
   CHECK(table != nullptr, "no joint-level table for the weights criterion");
   const float* info = gcs_gcs_section_info(d);
+  const float* centres = gcs_gcs_section_centres(d);
+  CHECK(centres != nullptr, "no centres table for the weights criterion");
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (uint32_t v = 0; v < in.vertexCount; ++v)
+    for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], in.positions[3 * v + k]), hi[k] = std::fmax(hi[k], in.positions[3 * v + k]);
+  // Float sums of centroids: a rounding allowance relative to the extent and to the distance from the origin.
+  float slack = 1e-4f * std::fmax(hi[0] - lo[0], std::fmax(hi[1] - lo[1], hi[2] - lo[2]));
+  for (int k = 0; k < 3; ++k) slack += 1e-5f * std::fmax(std::fabs(lo[k]), std::fabs(hi[k]));
   for (uint32_t s = 0; s < S; ++s) {
     const float* e = &table[8 * size_t(s)];
     uint32_t n = 0;
@@ -919,6 +927,19 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
     }
     CHECK(std::fabs(sum - 1.0) < 1e-4, "section %u weights sum to %g", s, sum);
     CHECK((n == 1) == (info[8 * size_t(s) + 4] == 2.0f), "section %u: %u joints, kind %g", s, n, double(info[8 * size_t(s) + 4]));
+    // Its centre of rotation: none for a rigid core or without centres; else a weighted average of
+    // triangle centroids, so inside the bind-pose bounds (and finite).
+    const float* c = &centres[4 * size_t(s)];
+    CHECK(c[3] == 0.0f || c[3] == 1.0f, "section %u centre flag %g", s, double(c[3]));
+    if (c[3] == 0.0f) {
+      CHECK(c[0] == 0.0f && c[1] == 0.0f && c[2] == 0.0f, "section %u without a centre has (%g, %g, %g)", s, double(c[0]),
+            double(c[1]), double(c[2]));
+      continue;
+    }
+    CHECK(b.centres != 0 && n >= 2, "section %u has a centre (centres %d, %u joints)", s, b.centres, n);
+    for (int k = 0; k < 3; ++k)
+      CHECK(std::isfinite(c[k]) && c[k] >= lo[k] - slack && c[k] <= hi[k] + slack,
+            "section %u centre %g outside the bounds [%g, %g] (axis %d)", s, double(c[k]), double(lo[k]), double(hi[k]), k);
   }
   const size_t last = size_t(J) * 16 + 16 * size_t(J - 1) + 3;
   const float broken = skins[last];
@@ -1227,12 +1248,12 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
   // ---- deformers
   std::vector<Built> built;
   auto add = [&](GcsDeformer* d, uint32_t kind, const std::string& label, uint32_t a = 0, uint32_t c = 0, float w = 0.0f,
-                 int smooth = 0, int twist = 0) {
+                 int smooth = 0, int twist = 0, int centres = 0) {
     Built b;
     b.d = d;
     b.kind = kind;
     b.label = label;
-    b.a = a, b.c = c, b.w = w, b.smooth = smooth, b.twist = twist;
+    b.a = a, b.c = c, b.w = w, b.smooth = smooth, b.twist = twist, b.centres = centres;
     g_context = std::string(ctx) + "; " + label;
     log("built: %s\n", label.c_str());
     checkStructure(b, in);
@@ -1242,13 +1263,13 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
     const uint32_t sections = fuzzSections(f);
     const float width = fuzzWidth(f);
     static const int flags[] = {0, 0, 1, -1, 2};
-    const int smooth = f.PickValueInArray(flags), twist = f.PickValueInArray(flags);
+    const int smooth = f.PickValueInArray(flags), twist = f.PickValueInArray(flags), centres = f.PickValueInArray(flags);
     const bool valid = sections >= GCS_MIN_SECTIONS && sections <= GCS_MAX_SECTIONS && width > 0.0f && width <= 1.0f;
     char label[160];
-    std::snprintf(label, sizeof label, "gcs criterion %u sections %u width %g smooth %d twist %d", criterion, sections,
-                  double(width), smooth, twist);
+    std::snprintf(label, sizeof label, "gcs criterion %u sections %u width %g smooth %d twist %d centres %d", criterion,
+                  sections, double(width), smooth, twist, centres);
     g_context = std::string(ctx) + "; " + label;
-    GcsDeformer* d = gcs_build_gcs(rig, sections, criterion, width, smooth, twist);
+    GcsDeformer* d = gcs_build_gcs(rig, sections, criterion, width, smooth, twist, centres);
     if (!valid) {
       CHECK(d == nullptr, "gcs_build_gcs accepted out-of-range settings");
       checkRejected("gcs_build_gcs with out-of-range settings", codeSections);
@@ -1260,12 +1281,12 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
       continue;
     }
     checkOk("gcs_build_gcs");
-    add(d, GCS_KIND_GCS, label, sections, criterion, width, smooth, twist);
+    add(d, GCS_KIND_GCS, label, sections, criterion, width, smooth, twist, centres);
   }
   {  // an unknown criterion
     const uint32_t criterion = 3 + f.ConsumeIntegral<uint8_t>() * (f.ConsumeBool() ? 1u : 0x1000000u);
     g_context = std::string(ctx) + "; unknown criterion";
-    CHECK(gcs_build_gcs(rig, 6, criterion, 1.0f, 0, 0) == nullptr, "criterion %u accepted", criterion);
+    CHECK(gcs_build_gcs(rig, 6, criterion, 1.0f, 0, 0, 1) == nullptr, "criterion %u accepted", criterion);
     checkRejected("gcs_build_gcs with an unknown criterion", codeInvalid);
   }
   {
@@ -1409,7 +1430,7 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
 // Calls on null handles and the memory helpers.
 void nullHandles() {
   g_context = "null handles";
-  CHECK(gcs_build_gcs(nullptr, 6, 2, 1.0f, 0, 0) == nullptr, "build on a null rig");
+  CHECK(gcs_build_gcs(nullptr, 6, 2, 1.0f, 0, 0, 1) == nullptr, "build on a null rig");
   checkRejected("gcs_build_gcs(null)", codeInvalid);
   CHECK(gcs_build_classic(nullptr, 25, 20, 1.0f) == nullptr, "classic on a null rig");
   checkRejected("gcs_build_classic(null)", codeInvalid);

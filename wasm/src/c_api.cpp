@@ -73,7 +73,7 @@ static bool checkRig(const GcsRig* rig) {
 }
 
 GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
-                           float influenceWidth, int smooth, int twistSpread) {
+                           float influenceWidth, int smooth, int twistSpread, int centres) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
   if (criterion > GCS_CRITERION_WEIGHTS) {  // checked before the value becomes an enum
@@ -89,6 +89,7 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
   settings.influenceWidth = influenceWidth;
   settings.smooth = smooth != 0;
   settings.twistSpread = twistSpread != 0;
+  settings.centres = centres != 0;
   return wrap(gcs::buildGcs(rig->rig, settings));
 }
 
@@ -291,6 +292,11 @@ int gcs_gcs_compute_sections(GcsDeformer* deformer, const float* skinMatrices, u
 const float* gcs_gcs_section_influences(const GcsDeformer* d) {
   const gcs::GcsDeformerImpl* g = asGcs(d);
   return g && !g->influenceTable.empty() ? g->influenceTable.data() : nullptr;
+}
+
+const float* gcs_gcs_section_centres(const GcsDeformer* d) {
+  const gcs::GcsDeformerImpl* g = asGcs(d);
+  return g && !g->centreTable.empty() ? g->centreTable.data() : nullptr;
 }
 
 uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* d) {

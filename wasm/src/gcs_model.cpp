@@ -6,6 +6,7 @@
 #include <tuple>
 #include <unordered_map>
 #include "error.h"
+#include "rotation_centres.h"
 
 namespace gcs {
 namespace {
@@ -149,6 +150,13 @@ void finishModel(GcsDeformerImpl& m) {
         texels[4 + k % 4] = used ? m.influences[sec.influenceFirst + k].weight : 0.0f;
       }
     }
+    m.centreTable.assign(size_t(S) * 4, 0.0f);
+    for (uint32_t i = 0; i < S; ++i)
+      if (m.sections[i].aboutCentre) {
+        float* texel = &m.centreTable[size_t(i) * 4];
+        for (int c = 0; c < 3; ++c) texel[c] = m.sections[i].rotationCentre[c];
+        texel[3] = 1.0f;
+      }
   }
   m.poses.resize(m.jointCount);
   std::vector<uint8_t> used(m.jointCount, m.settings.criterion == GCS_CRITERION_WEIGHTS ? 0 : 1);
@@ -185,6 +193,11 @@ void finishModel(GcsDeformerImpl& m) {
   const size_t padded = (m.blendedSections.size() + 3) / 4 * 4;
   m.nodeReal.assign(padded, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   m.nodeDual.assign(padded, glm::vec4(0.0f));
+  m.nodeCentre.assign(padded, glm::vec4(0.0f));
+  for (size_t b = 0; b < m.blendedSections.size(); ++b) {
+    const Section& sec = m.sections[m.blendedSections[b]];
+    if (sec.aboutCentre) m.nodeCentre[b] = glm::vec4(sec.rotationCentre, 1.0f);
+  }
   std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
   std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
 }
@@ -275,28 +288,6 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
     sec.t = sec.beta;
   }
   return sectionOfKey;
-}
-
-// A welded vertex's weights as the criterion reads them: influences below 0.5 % dropped, the
-// same joint listed twice merged, the rest normalised to sum 1.
-uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
-  uint32_t n = 0;
-  float sum = 0.0f;
-  for (uint32_t i = 0; i < rig.influenceSlots; ++i) {
-    float w = rig.weightAt(v, i);
-    if (!(w > 0.0f)) continue;
-    uint32_t j = rig.jointAt(v, i), k = 0;
-    while (k < n && joint[k] != j) ++k;
-    if (k == n) joint[n] = j, weight[n] = 0.0f, ++n;
-    weight[k] += w;
-  }
-  uint32_t kept = 0;
-  float biggest = 0.0f;
-  for (uint32_t i = 0; i < n; ++i) biggest = std::max(biggest, weight[i]);
-  for (uint32_t i = 0; i < n; ++i)
-    if (weight[i] >= 0.005f || weight[i] == biggest) joint[kept] = joint[i], weight[kept] = weight[i], sum += weight[i], ++kept;
-  for (uint32_t i = 0; i < kept; ++i) weight[i] /= sum;
-  return kept;
 }
 
 // The weights criterion (docs/method.md §2): sections are bins of the welded vertices' skin weights on
@@ -503,6 +494,24 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
 }
 
+// Weights criterion with centres: each blended section's centre of rotation from its blend weights
+// (a rigid core needs none: it is S_j; where the integral is empty the section keeps the plain blend).
+bool placeRotationCentres(const Rig& rig, GcsDeformerImpl& m) {
+  const CentreSurface* surface = centreSurfaceOf(rig);
+  if (!surface) return false;
+  uint32_t joints[kMaxInfluences];
+  float weights[kMaxInfluences];
+  for (Section& sec : m.sections) {
+    if (sec.rigid) continue;
+    for (uint32_t k = 0; k < sec.influenceCount; ++k) {
+      joints[k] = m.influences[sec.influenceFirst + k].joint;
+      weights[k] = m.influences[sec.influenceFirst + k].weight;
+    }
+    sec.aboutCentre = rotationCentre(*surface, joints, weights, sec.influenceCount, sec.rotationCentre);
+  }
+  return true;
+}
+
 }  // namespace
 
 float Deformer::stat(GcsStat) const { return std::nanf(""); }
@@ -518,67 +527,116 @@ float GcsDeformerImpl::stat(GcsStat which) const {
   return std::nanf("");
 }
 
-GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
-  if (settings.sections < GCS_MIN_SECTIONS || settings.sections > GCS_MAX_SECTIONS) {
-    fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
-         GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, settings.sections);
-    return nullptr;
-  }
-  if (!(settings.influenceWidth > 0.0f && settings.influenceWidth <= 1.0f)) {
-    fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(settings.influenceWidth));
-    return nullptr;
-  }
-  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL &&
-      settings.criterion != GCS_CRITERION_WEIGHTS) {
-    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)",
-         unsigned(settings.criterion));
-    return nullptr;
-  }
-  GcsDeformerImpl* model = nullptr;
-  try {
-    model = new GcsDeformerImpl();
-    GcsDeformerImpl& m = *model;
-    m.settings = settings;
-    m.jointCount = rig.jointCount;
-    m.jointCentres = rig.jointCentres;
-    m.adjustTolerance = 1e-3f * rig.height;
-    const uint32_t J = rig.jointCount;
+namespace {
 
-    // 1. Parts by dominant weight (per welded position).
-    std::vector<uint32_t> representative;
-    std::vector<uint32_t> group = weldByPosition(rig, representative);
-    const uint32_t G = uint32_t(representative.size());
-    if (settings.criterion == GCS_CRITERION_WEIGHTS) {
-      std::vector<uint32_t> sectionOfGroup, otherOfGroup, thirdOfGroup;
-      std::vector<float> blendOfGroup, blendThirdOfGroup;
-      if (settings.smooth)
-        buildWeightNodes(rig, m, representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
-                         blendThirdOfGroup);
-      else buildWeightSections(rig, m, representative, sectionOfGroup);
-      std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
-      if (settings.smooth) {
-        m.blendOther.resize(rig.vertexCount);
-        m.blendF.resize(rig.vertexCount);
-        m.blendThird.resize(rig.vertexCount);
-        m.blendThirdF.resize(rig.vertexCount);
-        for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-          m.blendOther[outputOf[v]] = otherOfGroup[group[v]];
-          m.blendF[outputOf[v]] = blendOfGroup[group[v]];
-          m.blendThird[outputOf[v]] = thirdOfGroup[group[v]];
-          m.blendThirdF[outputOf[v]] = blendThirdOfGroup[group[v]];
-        }
-      }
-      finishModel(m);
-      return model;
+// The build, raw → runtime (ozz's builders): each criterion as a sequence of named steps over the
+// welded rig. Every step leaves the model consistent for the next; finishModel ends both.
+
+bool checkSettings(const GcsSettings& settings) {
+  if (settings.sections < GCS_MIN_SECTIONS || settings.sections > GCS_MAX_SECTIONS)
+    return fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
+                GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, settings.sections);
+  if (!(settings.influenceWidth > 0.0f && settings.influenceWidth <= 1.0f))
+    return fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(settings.influenceWidth));
+  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL &&
+      settings.criterion != GCS_CRITERION_WEIGHTS)
+    return fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)",
+                unsigned(settings.criterion));
+  return true;
+}
+
+// The welded rig: each vertex's group (vertices at one bind-pose position) and each group's first vertex.
+struct Welded {
+  std::vector<uint32_t> group, representative;
+};
+
+// Weights criterion: sections (plain) or nodes (smooth) from the weights, their centres of
+// rotation, the output layout, the per-vertex blends. False (the error recorded) on failure.
+bool buildWeightsCriterion(const Rig& rig, GcsDeformerImpl& m, const Welded& welded) {
+  const bool smooth = m.settings.smooth;
+  std::vector<uint32_t> sectionOfGroup, otherOfGroup, thirdOfGroup;
+  std::vector<float> blendOfGroup, blendThirdOfGroup;
+  if (smooth)
+    buildWeightNodes(rig, m, welded.representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
+                     blendThirdOfGroup);
+  else buildWeightSections(rig, m, welded.representative, sectionOfGroup);
+  if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
+  const std::vector<uint32_t> outputOf = layoutSections(rig, m, welded.group, sectionOfGroup);
+  if (smooth) {
+    m.blendOther.resize(rig.vertexCount);
+    m.blendF.resize(rig.vertexCount);
+    m.blendThird.resize(rig.vertexCount);
+    m.blendThirdF.resize(rig.vertexCount);
+    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
+      const uint32_t o = outputOf[v], g = welded.group[v];
+      m.blendOther[o] = otherOfGroup[g];
+      m.blendF[o] = blendOfGroup[g];
+      m.blendThird[o] = thirdOfGroup[g];
+      m.blendThirdF[o] = blendThirdOfGroup[g];
     }
-    std::vector<uint32_t> partOfGroup(G);
+  }
+  finishModel(m);
+  return true;
+}
+
+// The Y and axial criteria (the paper, docs/method.md §4), step by step: parts, shared sections,
+// branches, their ends, bins, sections, smooth blends. Each step reads what the ones before wrote.
+class PaperBuild {
+ public:
+  PaperBuild(const Rig& rig, GcsDeformerImpl& m, const Welded& welded)
+      : rig(rig), m(m), group(welded.group), representative(welded.representative), G(uint32_t(representative.size())),
+        J(rig.jointCount), axial(m.settings.criterion == GCS_CRITERION_AXIAL) {}
+
+  bool run() {
+    assignParts();
+    findSharedSections();
+    if (!makeBranches()) return false;
+    chooseBranches();
+    measureBranchEnds();
+    binGroups();
+    makeSections();
+    if (m.settings.smooth) blendAlongBranches();
+    m.motions.resize(J);
+    m.swings.resize(J);
+    m.twists.resize(J);
+    finishModel(m);
+    return true;
+  }
+
+ private:
+  const Rig& rig;
+  GcsDeformerImpl& m;
+  const std::vector<uint32_t>& group;
+  const std::vector<uint32_t>& representative;
+  const uint32_t G, J;
+  const bool axial;
+  std::vector<uint32_t> partOfGroup;
+  std::vector<std::vector<uint32_t>> childParts;
+  std::vector<int32_t> sgsOf;           // child part joint whose proximal SGS holds the group, or -1
+  std::vector<Branch> branches;
+  std::vector<uint32_t> firstBranch;    // branches of part j: [firstBranch[j], firstBranch[j + 1])
+  std::vector<uint32_t> branchOfGroup;
+  std::vector<float> tOfGroup;
+  // Section slots: per part, one shared (proximal SGS) slot, then per branch `inner` slots.
+  std::vector<int32_t> slotOfGroup, sectionOfSlot;
+  std::vector<uint32_t> sharedSlot, branchSlot, slotBranch, slotPart;
+  std::vector<uint8_t> slotShared;
+  uint32_t slots = 0;
+  std::vector<float> tOfOutput;
+
+  float coordinate(const Branch& b, const glm::vec3& x) const {
+    return axial ? glm::dot(x - rig.jointCentres[b.part], b.axis) : x.y;
+  }
+
+  // 1. Parts by dominant weight (per welded position); parent part: the nearest ancestor joint that owns vertices.
+  void assignParts() {
+    partOfGroup.resize(G);
     m.parts.assign(J, PartInfo());
     for (uint32_t g = 0; g < G; ++g) {
       partOfGroup[g] = rig.dominantJoint(representative[g]);
       m.parts[partOfGroup[g]].isPart = true;
     }
-    // Parent part: the nearest ancestor joint that owns vertices.
-    std::vector<std::vector<uint32_t>> childParts(J);
+    childParts.assign(J, {});
     for (uint32_t j = 0; j < J; ++j) {
       if (!m.parts[j].isPart) continue;
       ++m.partCount;
@@ -587,9 +645,11 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       m.parts[j].parent = p;
       if (p >= 0) childParts[p].push_back(j);
     }
+  }
 
-    // 2. Shared sections: vertices on a triangle that spans a part and its parent part.
-    std::vector<int32_t> sgsOf(G, -1);  // child part joint whose proximal SGS holds the group
+  // 2. Shared sections: vertices on a triangle that spans a part and its parent part.
+  void findSharedSections() {
+    sgsOf.assign(G, -1);
     for (size_t t = 0; t < rig.indices.size(); t += 3) {
       for (int e = 0; e < 3; ++e) {
         uint32_t a = group[rig.indices[t + e]], b = group[rig.indices[t + (e + 1) % 3]];
@@ -603,12 +663,12 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
         if (sgsOf[b] < 0) sgsOf[b] = child;
       }
     }
+  }
 
-    // 3. Branches and their axes.
-    const bool axial = settings.criterion == GCS_CRITERION_AXIAL;
+  // 3. Branches and their axes (and each part's twist axis). False on a zero-length bone.
+  bool makeBranches() {
     const float minBone = 1e-4f * rig.height;
-    std::vector<Branch> branches;
-    std::vector<uint32_t> firstBranch(J + 1, 0);
+    firstBranch.assign(J + 1, 0);
     for (uint32_t j = 0; j < J; ++j) {
       firstBranch[j] = uint32_t(branches.size());
       if (!m.parts[j].isPart) continue;
@@ -624,13 +684,10 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       } else {
         for (uint32_t k : childParts[j]) {
           glm::vec3 bone = rig.jointCentres[k] - cj;
-          if (glm::length(bone) < minBone) {
-            fail(GCS_ERR_ZERO_LENGTH_BONE,
-                 "part of joint %u and its child part of joint %u have their joints at the same point (a zero-length bone)",
-                 j, k);
-            delete model;
-            return nullptr;
-          }
+          if (glm::length(bone) < minBone)
+            return fail(GCS_ERR_ZERO_LENGTH_BONE,
+                        "part of joint %u and its child part of joint %u have their joints at the same point (a zero-length bone)",
+                        j, k);
           Branch b;
           b.part = j;
           b.child = int32_t(k);
@@ -643,12 +700,12 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       m.parts[j].twistAxis = glm::length(twist) > 1e-6f ? glm::normalize(twist) : branches[firstBranch[j]].axis;
     }
     firstBranch[J] = uint32_t(branches.size());
+    return true;
+  }
 
-    auto coordinate = [&](const Branch& b, const glm::vec3& x) {
-      return axial ? glm::dot(x - rig.jointCentres[b.part], b.axis) : x.y;
-    };
-    // Branch of an inner group: the nearest child segment.
-    std::vector<uint32_t> branchOfGroup(G, 0);
+  // 4. Branch of an inner group: the nearest child segment.
+  void chooseBranches() {
+    branchOfGroup.assign(G, 0);
     for (uint32_t g = 0; g < G; ++g) {
       uint32_t j = sgsOf[g] >= 0 ? uint32_t(sgsOf[g]) : partOfGroup[g];
       uint32_t best = firstBranch[j];
@@ -662,52 +719,53 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       }
       branchOfGroup[g] = best;
     }
+  }
 
-    // 4. Proximal and distal ends of each branch: the means of its shared sections.
-    {
-      std::vector<double> proxSum(branches.size(), 0.0), distSum(branches.size(), 0.0);
-      std::vector<uint32_t> proxN(branches.size(), 0), distN(branches.size(), 0);
-      std::vector<float> extreme(branches.size(), 0.0f);
-      std::vector<uint8_t> hasExtreme(branches.size(), 0);
-      for (uint32_t g = 0; g < G; ++g) {
-        const glm::vec3& x = rig.positions[representative[g]];
-        if (sgsOf[g] >= 0) {
-          uint32_t k = uint32_t(sgsOf[g]);
-          for (uint32_t bi = firstBranch[k]; bi < firstBranch[k + 1]; ++bi)
-            proxSum[bi] += coordinate(branches[bi], x), ++proxN[bi];
-          int32_t p = m.parts[k].parent;
-          for (uint32_t bi = firstBranch[p]; bi < firstBranch[p + 1]; ++bi)
-            if (branches[bi].child == int32_t(k)) distSum[bi] += coordinate(branches[bi], x), ++distN[bi];
-        }
+  // 5. Proximal and distal ends of each branch: the means of its shared sections; leaves end at
+  // their vertex farthest from the proximal end.
+  void measureBranchEnds() {
+    std::vector<double> proxSum(branches.size(), 0.0), distSum(branches.size(), 0.0);
+    std::vector<uint32_t> proxN(branches.size(), 0), distN(branches.size(), 0);
+    std::vector<float> extreme(branches.size(), 0.0f);
+    std::vector<uint8_t> hasExtreme(branches.size(), 0);
+    for (uint32_t g = 0; g < G; ++g) {
+      const glm::vec3& x = rig.positions[representative[g]];
+      if (sgsOf[g] >= 0) {
+        uint32_t k = uint32_t(sgsOf[g]);
+        for (uint32_t bi = firstBranch[k]; bi < firstBranch[k + 1]; ++bi)
+          proxSum[bi] += coordinate(branches[bi], x), ++proxN[bi];
+        int32_t p = m.parts[k].parent;
+        for (uint32_t bi = firstBranch[p]; bi < firstBranch[p + 1]; ++bi)
+          if (branches[bi].child == int32_t(k)) distSum[bi] += coordinate(branches[bi], x), ++distN[bi];
       }
-      for (size_t bi = 0; bi < branches.size(); ++bi) {
-        Branch& b = branches[bi];
-        b.sProximal = proxN[bi] ? float(proxSum[bi] / proxN[bi]) : coordinate(b, rig.jointCentres[b.part]);
-        if (b.child >= 0)
-          b.sDistal = distN[bi] ? float(distSum[bi] / distN[bi]) : coordinate(b, rig.jointCentres[b.child]);
-      }
-      // Leaves end at their vertex farthest from the proximal end.
-      for (uint32_t g = 0; g < G; ++g) {
-        if (sgsOf[g] >= 0) continue;
-        uint32_t bi = branchOfGroup[g];
-        if (branches[bi].child >= 0) continue;
-        float s = coordinate(branches[bi], rig.positions[representative[g]]);
-        if (!hasExtreme[bi] || std::fabs(s - branches[bi].sProximal) > std::fabs(extreme[bi] - branches[bi].sProximal))
-          extreme[bi] = s, hasExtreme[bi] = 1;
-      }
-      for (size_t bi = 0; bi < branches.size(); ++bi)
-        if (branches[bi].child < 0)
-          branches[bi].sDistal = hasExtreme[bi] ? extreme[bi] : branches[bi].sProximal + 1.0f;
     }
+    for (size_t bi = 0; bi < branches.size(); ++bi) {
+      Branch& b = branches[bi];
+      b.sProximal = proxN[bi] ? float(proxSum[bi] / proxN[bi]) : coordinate(b, rig.jointCentres[b.part]);
+      if (b.child >= 0)
+        b.sDistal = distN[bi] ? float(distSum[bi] / distN[bi]) : coordinate(b, rig.jointCentres[b.child]);
+    }
+    for (uint32_t g = 0; g < G; ++g) {
+      if (sgsOf[g] >= 0) continue;
+      uint32_t bi = branchOfGroup[g];
+      if (branches[bi].child >= 0) continue;
+      float s = coordinate(branches[bi], rig.positions[representative[g]]);
+      if (!hasExtreme[bi] || std::fabs(s - branches[bi].sProximal) > std::fabs(extreme[bi] - branches[bi].sProximal))
+        extreme[bi] = s, hasExtreme[bi] = 1;
+    }
+    for (size_t bi = 0; bi < branches.size(); ++bi)
+      if (branches[bi].child < 0)
+        branches[bi].sDistal = hasExtreme[bi] ? extreme[bi] : branches[bi].sProximal + 1.0f;
+  }
 
-    // 5. Bins: sections−2 inner sections uniform in t between the shared sections.
-    const uint32_t inner = settings.sections - 2;
-    std::vector<float> tOfGroup(G, 0.0f);
-    // Section slots: per part, one shared (proximal SGS) slot, then per branch `inner` slots.
-    // slot id = partSlot[j] (shared) ; branchSlot[bi] + bin (inner)
-    std::vector<int32_t> slotOfGroup(G, -1);
-    std::vector<uint32_t> sharedSlot(J, 0), branchSlot(branches.size(), 0);
-    uint32_t slots = 0;
+  // 6. Bins: sections−2 inner sections uniform in t between the shared sections.
+  //    slot id = sharedSlot[j] (shared) ; branchSlot[bi] + bin (inner)
+  void binGroups() {
+    const uint32_t inner = m.settings.sections - 2;
+    tOfGroup.assign(G, 0.0f);
+    slotOfGroup.assign(G, -1);
+    sharedSlot.assign(J, 0);
+    branchSlot.assign(branches.size(), 0);
     for (uint32_t j = 0; j < J; ++j) {
       if (!m.parts[j].isPart) continue;
       sharedSlot[j] = slots++;
@@ -716,9 +774,9 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
         slots += inner;
       }
     }
-    std::vector<uint32_t> slotBranch(slots, 0);
-    std::vector<uint8_t> slotShared(slots, 0);
-    std::vector<uint32_t> slotPart(slots, 0);
+    slotBranch.assign(slots, 0);
+    slotShared.assign(slots, 0);
+    slotPart.assign(slots, 0);
     for (uint32_t j = 0; j < J; ++j) {
       if (!m.parts[j].isPart) continue;
       slotShared[sharedSlot[j]] = 1;
@@ -741,8 +799,10 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       uint32_t bin = std::min(inner - 1, uint32_t(t * float(inner)));
       slotOfGroup[g] = int32_t(branchSlot[branchOfGroup[g]] + bin);
     }
+  }
 
-    // 6. Sections: non-empty slots, vertices stored section-contiguous (counting sort).
+  // 7. Sections: non-empty slots with their fractions, vertices stored section-contiguous.
+  void makeSections() {
     std::vector<uint32_t> slotCount(slots, 0);
     std::vector<double> slotT(slots, 0.0);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) {
@@ -750,8 +810,8 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
       ++slotCount[slotOfGroup[g]];
       slotT[slotOfGroup[g]] += tOfGroup[g];
     }
-    std::vector<int32_t> sectionOfSlot(slots, -1);
-    const float w = settings.influenceWidth;
+    sectionOfSlot.assign(slots, -1);
+    const float w = m.settings.influenceWidth;
     uint32_t first = 0;
     for (uint32_t sl = 0; sl < slots; ++sl) {
       if (!slotCount[sl]) continue;
@@ -783,54 +843,73 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     std::vector<uint32_t> sectionOfGroup(G);
     for (uint32_t g = 0; g < G; ++g) sectionOfGroup[g] = uint32_t(sectionOfSlot[slotOfGroup[g]]);
     std::vector<uint32_t> outputOf = layoutSections(rig, m, group, sectionOfGroup);
-    std::vector<float> tOfOutput(rig.vertexCount);
+    tOfOutput.resize(rig.vertexCount);
     for (uint32_t v = 0; v < rig.vertexCount; ++v) tOfOutput[outputOf[v]] = tOfGroup[group[v]];
+  }
 
-    // 7. Smooth mode: each inner vertex blends the two sections whose mean t brackets its own t,
-    // along its branch: proximal SGS (t = 0), the inner sections, the distal SGS (t = 1).
-    if (settings.smooth) {
-      m.blendOther.resize(rig.vertexCount);
-      m.blendF.assign(rig.vertexCount, 0.0f);
-      m.blendThird = m.sectionOfVertex;  // two sections at most per vertex here
-      m.blendThirdF.assign(rig.vertexCount, 0.0f);
-      for (uint32_t o = 0; o < rig.vertexCount; ++o) m.blendOther[o] = m.sectionOfVertex[o];
-      std::vector<std::pair<float, uint32_t>> chain;
-      for (size_t bi = 0; bi < branches.size(); ++bi) {
-        const Branch& b = branches[bi];
-        chain.clear();
-        int32_t prox = sectionOfSlot[sharedSlot[b.part]];
-        if (prox >= 0 && m.sections[prox].parent >= 0) chain.push_back({0.0f, uint32_t(prox)});
-        for (uint32_t s = 0; s < inner; ++s) {
-          int32_t id = sectionOfSlot[branchSlot[bi] + s];
-          if (id >= 0) chain.push_back({m.sections[id].t, uint32_t(id)});
-        }
-        if (b.child >= 0) {
-          int32_t dist = sectionOfSlot[sharedSlot[b.child]];
-          if (dist >= 0) chain.push_back({1.0f, uint32_t(dist)});
-        }
-        for (uint32_t s = 0; s < inner; ++s) {
-          int32_t id = sectionOfSlot[branchSlot[bi] + s];
-          if (id < 0) continue;
-          const Section& sec = m.sections[id];
-          for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) {
-            // The two sections whose mean t brackets the vertex's t; its own is one of them.
-            float t = tOfOutput[o];
-            size_t k = 0;
-            while (k + 1 < chain.size() && chain[k + 1].first < t) ++k;
-            uint32_t a = chain[k].second, bsec = k + 1 < chain.size() ? chain[k + 1].second : a;
-            float ta = chain[k].first, tb = k + 1 < chain.size() ? chain[k + 1].first : ta;
-            float f = tb > ta ? glm::clamp((t - ta) / (tb - ta), 0.0f, 1.0f) : 0.0f;
-            if (a == uint32_t(id)) m.blendOther[o] = bsec, m.blendF[o] = f;
-            else if (bsec == uint32_t(id)) m.blendOther[o] = a, m.blendF[o] = 1.0f - f;
-          }
+  // 8. Smooth mode: each inner vertex blends the two sections whose mean t brackets its own t,
+  //    along its branch: proximal SGS (t = 0), the inner sections, the distal SGS (t = 1).
+  void blendAlongBranches() {
+    const uint32_t inner = m.settings.sections - 2;
+    m.blendOther.resize(rig.vertexCount);
+    m.blendF.assign(rig.vertexCount, 0.0f);
+    m.blendThird = m.sectionOfVertex;  // two sections at most per vertex here
+    m.blendThirdF.assign(rig.vertexCount, 0.0f);
+    for (uint32_t o = 0; o < rig.vertexCount; ++o) m.blendOther[o] = m.sectionOfVertex[o];
+    std::vector<std::pair<float, uint32_t>> chain;
+    for (size_t bi = 0; bi < branches.size(); ++bi) {
+      const Branch& b = branches[bi];
+      chain.clear();
+      int32_t prox = sectionOfSlot[sharedSlot[b.part]];
+      if (prox >= 0 && m.sections[prox].parent >= 0) chain.push_back({0.0f, uint32_t(prox)});
+      for (uint32_t s = 0; s < inner; ++s) {
+        int32_t id = sectionOfSlot[branchSlot[bi] + s];
+        if (id >= 0) chain.push_back({m.sections[id].t, uint32_t(id)});
+      }
+      if (b.child >= 0) {
+        int32_t dist = sectionOfSlot[sharedSlot[b.child]];
+        if (dist >= 0) chain.push_back({1.0f, uint32_t(dist)});
+      }
+      for (uint32_t s = 0; s < inner; ++s) {
+        int32_t id = sectionOfSlot[branchSlot[bi] + s];
+        if (id < 0) continue;
+        const Section& sec = m.sections[id];
+        for (uint32_t o = sec.first; o < sec.first + sec.count; ++o) {
+          // The two sections whose mean t brackets the vertex's t; its own is one of them.
+          float t = tOfOutput[o];
+          size_t k = 0;
+          while (k + 1 < chain.size() && chain[k + 1].first < t) ++k;
+          uint32_t a = chain[k].second, bsec = k + 1 < chain.size() ? chain[k + 1].second : a;
+          float ta = chain[k].first, tb = k + 1 < chain.size() ? chain[k + 1].first : ta;
+          float f = tb > ta ? glm::clamp((t - ta) / (tb - ta), 0.0f, 1.0f) : 0.0f;
+          if (a == uint32_t(id)) m.blendOther[o] = bsec, m.blendF[o] = f;
+          else if (bsec == uint32_t(id)) m.blendOther[o] = a, m.blendF[o] = 1.0f - f;
         }
       }
     }
+  }
+};
 
-    m.motions.resize(J);
-    m.swings.resize(J);
-    m.twists.resize(J);
-    finishModel(m);
+}  // namespace
+
+GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
+  if (!checkSettings(settings)) return nullptr;
+  GcsDeformerImpl* model = nullptr;
+  try {
+    model = new GcsDeformerImpl();
+    GcsDeformerImpl& m = *model;
+    m.settings = settings;
+    m.jointCount = rig.jointCount;
+    m.jointCentres = rig.jointCentres;
+    m.adjustTolerance = 1e-3f * rig.height;
+    Welded welded;
+    welded.group = weldByPosition(rig, welded.representative);
+    const bool built = settings.criterion == GCS_CRITERION_WEIGHTS ? buildWeightsCriterion(rig, m, welded)
+                                                                    : PaperBuild(rig, m, welded).run();
+    if (!built) {
+      delete model;
+      return nullptr;
+    }
   } catch (const std::bad_alloc&) {
     delete model;
     fail(GCS_ERR_OUT_OF_MEMORY, "out of memory while building the GCS model");
@@ -854,8 +933,24 @@ glm::mat4 rigidInverse(const glm::mat4& m) {
 }
 }  // namespace
 
+// A section with a centre of rotation p* (rotation_centres.h): its 3×3 part M (the blend's rotation
+// and scale) stays; its translation makes M p* + t = Σ w_j S_j p*, p* moved by linear blend
+// skinning. Written t = Σ w_j (S_j p* − p*) − (M p* − p*): identity poses give t = 0 exactly.
+void GcsDeformerImpl::turnAboutCentre(const glm::mat4* skin, const Section& sec, glm::mat4& position) const {
+  const glm::vec3 p = sec.rotationCentre;
+  glm::vec3 moved(0.0f);
+  for (uint32_t k = 0; k < sec.influenceCount; ++k) {
+    const Influence& in = influences[sec.influenceFirst + k];
+    const glm::mat4& s = skin[in.joint];
+    moved += in.weight * (glm::vec3(s[0]) * p.x + glm::vec3(s[1]) * p.y + glm::vec3(s[2]) * p.z + glm::vec3(s[3]) - p);
+  }
+  const glm::vec3 turned = glm::vec3(position[0]) * p.x + glm::vec3(position[1]) * p.y + glm::vec3(position[2]) * p.z - p;
+  position[3] = glm::vec4(moved - turned, 1.0f);
+}
+
 // Weights criterion: each section's transform is the dual-quaternion blend of its joints at its
-// mean weights (a rigid core: S_j itself). O(sections × influences).
+// mean weights (a rigid core: S_j itself), or with centres the blend's rotation about its centre of
+// rotation. O(sections × influences).
 void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale) {
 #if defined(__wasm_simd128__)
   if (moderateUniform(scale)) return sectionTransformsWeightsUniform(skin, scale.s);
@@ -876,6 +971,7 @@ void GcsDeformerImpl::sectionTransformsWeights(const glm::mat4* skin, const Scal
         w[k] = in.weight;
       }
       blendPoses(blendPoseScratch.data(), w, sec.influenceCount, scale, sectionMatrices[i], normalMatrices[i], renorm);
+      if (sec.aboutCentre) turnAboutCentre(skin, sec, sectionMatrices[i]);
     }
     renormalise[i] = renorm;
   }
@@ -979,6 +1075,12 @@ void GcsDeformerImpl::sectionTransformsWeightsUniform(const glm::mat4* skin, flo
       wasm_v128_store(m + 12, translation[k]);
     }
   }
+  if (settings.centres)  // the centres' translations replace the blends' (none otherwise: no pass)
+    for (uint32_t b2 = 0; b2 < B; ++b2)
+      if (nodeCentre[b2].w != 0.0f) {
+        const uint32_t i = blendedSections[b2];
+        turnAboutCentre(skin, sections[i], sectionMatrices[i]);
+      }
 }
 #endif
 

@@ -16,6 +16,9 @@ struct GcsSettings {
   float influenceWidth = 1.0f;              // (0, 1]
   bool smooth = false;
   bool twistSpread = false;
+  // Weights criterion: blended sections rotate about their centre of rotation (rotation_centres.h)
+  // instead of moving by the dual-quaternion blend's translation.
+  bool centres = false;
 };
 
 // One generalized section: a run of output vertices that share one transform per frame.
@@ -34,6 +37,10 @@ struct Section {
   float radius = 0.0f;
   bool rigid = false;             // weights criterion: a rigid core, transform exactly S_part
   uint32_t influenceFirst = 0, influenceCount = 0;  // weights criterion: its blend
+  // Weights criterion with centres: the section turns by its blend's rotation about this bind-pose
+  // point, which itself moves by linear blend skinning (false: the dual-quaternion blend).
+  bool aboutCentre = false;
+  glm::vec3 rotationCentre{0.0f};
 };
 
 struct Influence {
@@ -73,6 +80,9 @@ class GcsDeformerImpl final : public Deformer {
   // empty for the other criteria. 4 slots unless a section blends more than 4 joints, then 8.
   std::vector<float> influenceTable;
   uint32_t influenceTableSlots = 0;
+  // Weights criterion: each section's centre of rotation as gcs_gcs_section_centres packs it (x, y,
+  // z, 1), or 0, 0, 0, 0 where the section moves by the plain blend; empty for the other criteria.
+  std::vector<float> centreTable;
   // Smooth mode: per output vertex, the other section it blends with and the factor towards it
   // (its own section is the run it sits in).
   std::vector<uint32_t> blendOther;
@@ -105,6 +115,8 @@ class GcsDeformerImpl final : public Deformer {
   // blendedSections is ordered by joint count: nodesWithCount[c] of them blend fewer than c joints;
   // nodeInfluenceFirst[b] is blendedSections[b]'s first influence. rigidSections: the rigid cores.
   std::vector<glm::vec4> nodeReal, nodeDual;
+  // blendedSections[b]'s centre of rotation (x, y, z, 1), or w = 0 where it moves by the plain blend.
+  std::vector<glm::vec4> nodeCentre;
   std::vector<uint32_t> blendedSections, rigidSections, nodeInfluenceFirst, nodesWithCount;
   std::vector<glm::mat4> lastSkin;          // the last frame's S_j, for the adjusted statistic
   ScaleState frameScale;                    // what the last frame's scales have in common
@@ -116,6 +128,7 @@ class GcsDeformerImpl final : public Deformer {
   void sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale);
   void sectionTransformsWeightsUniform(const glm::mat4* skin, float s);
   void sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale);
+  void turnAboutCentre(const glm::mat4* skin, const Section& sec, glm::mat4& position) const;
 };
 
 // Builds the GCS model of a rig. Returns null with the error recorded on failure.

@@ -28,8 +28,9 @@ uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
 }
 uint64_t gcsPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
   // Smooth weights nodes: up to two sections per welded vertex (~300 bytes each, tables included;
-  // keys and blends of 8 influences add ~40 bytes a slot).
-  return (v * (860 + 40 * (slots - 4)) + i * 8 + j * 4096) * 3 / 2 + 65536;
+  // keys and blends of 8 influences add ~40 bytes a slot); the centres' memo up to 4 pair sums per
+  // vertex (~60 bytes each in its hash map; the surface it reads reserves its own).
+  return (v * (860 + 240 + 40 * (slots - 4)) + i * 8 + j * 4096) * 3 / 2 + 65536;
 }
 uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
   return (v * (24 + 24 + 24 + 8 * slots + 4) + i * 4 + j * 128) * 3 / 2 + 65536;

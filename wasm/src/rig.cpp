@@ -225,4 +225,24 @@ bool buildRig(const float* positions, const float* normals, uint32_t vertexCount
   return true;
 }
 
+uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight) {
+  uint32_t n = 0;
+  float sum = 0.0f;
+  for (uint32_t i = 0; i < rig.influenceSlots; ++i) {
+    float w = rig.weightAt(v, i);
+    if (!(w > 0.0f)) continue;
+    uint32_t j = rig.jointAt(v, i), k = 0;
+    while (k < n && joint[k] != j) ++k;
+    if (k == n) joint[n] = j, weight[n] = 0.0f, ++n;
+    weight[k] += w;
+  }
+  uint32_t kept = 0;
+  float biggest = 0.0f;
+  for (uint32_t i = 0; i < n; ++i) biggest = std::max(biggest, weight[i]);
+  for (uint32_t i = 0; i < n; ++i)
+    if (weight[i] >= 0.005f || weight[i] == biggest) joint[kept] = joint[i], weight[kept] = weight[i], sum += weight[i], ++kept;
+  for (uint32_t i = 0; i < kept; ++i) weight[i] /= sum;
+  return kept;
+}
+
 }  // namespace gcs

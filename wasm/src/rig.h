@@ -1,11 +1,14 @@
 // The raw input, validated: a skinned mesh and its skeleton in the bind pose.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 #include <glm/glm.hpp>
 #include "../include/gcs_skin.h"
 
 namespace gcs {
+
+struct CentreSurface;
 
 constexpr uint32_t kMaxInfluences = GCS_MAX_INFLUENCES;  // per vertex, and so per section
 
@@ -39,6 +42,9 @@ struct Rig {
   // change, and the sliders rebuild the same rig again and again.
   mutable std::vector<uint32_t> weldGroup, weldRepresentative;
   mutable bool welded = false;
+  // The surface the centres of rotation integrate over (rotation_centres.h), built by the first
+  // build that asks and kept, like the weld.
+  mutable std::shared_ptr<const CentreSurface> centreSurface;
 };
 
 // Validates the raw arrays (see gcs_rig_create in gcs_skin.h) and fills `rig`.
@@ -57,6 +63,10 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 // each group). Both models group by it, so a seam can never open.
 // (Computed once per rig, then copied from its cache.)
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
+
+// A vertex's skin weights as the GCS criteria read them: influences below 0.5 % dropped (but the
+// largest), the same joint listed twice merged, the rest normalised to sum 1. Returns their count.
+uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight);
 
 // Checks that `count` floats are all finite.
 bool allFinite(const float* values, size_t count);

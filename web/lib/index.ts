@@ -21,6 +21,8 @@ export const MIN_SECTIONS = 3;
 /** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
 export const MAX_INFLUENCES = 8;
 export const MAX_SECTIONS = 256;
+/** GcsOptions.centres when not given. */
+const DEFAULT_CENTRES = false;
 export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
 
 type ArrayLikeNumbers = ArrayLike<number>;
@@ -79,6 +81,14 @@ export interface GcsOptions {
   smooth?: boolean;
   /** Y/axial only: spread a joint's twist along the child part. Default false. */
   twistSpread?: boolean;
+  /**
+   * Weights criterion: each blended section turns by its joints' blended rotation about its centre
+   * of rotation (Le & Hodgins 2016: the average of the bind-pose surface whose weights resemble
+   * the section's, computed once at build time), the centre moving by linear blend skinning: DQS's
+   * volume at a bent joint without its bulge. `false`: the dual-quaternion blend. Default false.
+   * Ignored by 'y' and 'axial'.
+   */
+  centres?: boolean;
 }
 
 export interface ClassicOptions {
@@ -348,8 +358,9 @@ export class Rig {
       throw new GcsError(typeof width === 'number' ? 'OUT_OF_RANGE' : 'INVALID_ARGUMENT', `the influence width must be a number in (0, 1]; got ${asGiven(width)}`);
     checkFlag(options.smooth, 'smooth');
     checkFlag(options.twistSpread, 'twistSpread');
+    checkFlag(options.centres, 'centres');
     const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
-      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0);
+      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0, (options.centres ?? DEFAULT_CENTRES) ? 1 : 0);
     if (!h) this.gcs.raise('the GCS model could not be built');
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }
@@ -656,6 +667,17 @@ export class GcsDeformer extends Deformer {
    */
   get sectionInfluenceSlots(): number {
     return this.gcs.core.gcs_gcs_section_influence_slots(this.live());
+  }
+  /**
+   * Weights criterion: each section's centre of rotation, 4 floats per section (x, y, z, 1) in the
+   * bind pose, or (0, 0, 0, 0) where it has none (a rigid core, built with `centres: false`, or no
+   * triangle weighing on two of its joints), a copy; null for the Y and axial criteria. A section
+   * with a centre turns by its blend's rotation about it while the centre moves by linear blend
+   * skinning (gcs_gcs_section_centres).
+   */
+  sectionCentres(): Float32Array | null {
+    const ptr = this.gcs.core.gcs_gcs_section_centres(this.live());
+    return ptr ? this.gcs.viewF32(ptr, this.sectionCount * 4).slice() : null;
   }
   /** True when the joint-level GPU path can drive this deformer (the weights criterion). */
   get jointLevel(): boolean {

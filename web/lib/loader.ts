@@ -18,7 +18,7 @@ export interface CoreExports {
   gcs_rig_vertex_count(rig: number): number;
   gcs_rig_joint_count(rig: number): number;
   gcs_rig_height(rig: number): number;
-  gcs_build_gcs(rig: number, sections: number, criterion: number, width: number, smooth: number, twist: number): number;
+  gcs_build_gcs(rig: number, sections: number, criterion: number, width: number, smooth: number, twist: number, centres: number): number;
   gcs_build_lbs(rig: number): number;
   gcs_build_dqs(rig: number): number;
   gcs_build_classic(rig: number, contours: number, rays: number, bulge: number): number;
@@ -44,6 +44,7 @@ export interface CoreExports {
   gcs_gcs_compute_sections(d: number, skin: number, jointCount: number, instances: number, out: number): number;
   gcs_gcs_section_influences(d: number): number;
   gcs_gcs_section_influence_slots(d: number): number;
+  gcs_gcs_section_centres(d: number): number;
   gcs_gcs_compute_joint_poses(d: number, skin: number, jointCount: number, instances: number, out: number): number;
   gcs_classic_set_bulge(d: number, bulge: number): number;
   gcs_classic_part_count(d: number): number;
@@ -102,7 +103,7 @@ const UNSIGNED_RESULTS = [
   'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
   'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
   'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
-  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_section_influences', 'gcs_gcs_section_influence_slots', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
+  'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_section_influences', 'gcs_gcs_section_influence_slots', 'gcs_gcs_section_centres', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
 ] as const;
 
 function unsignedResults(raw: CoreExports): CoreExports {

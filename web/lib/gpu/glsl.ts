@@ -158,7 +158,8 @@ mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
 	return r * ( c / big );
 }
 // Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
-// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first.
+// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first,
+// or with a centre of rotation the blend's M about it.
 // GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
 void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
 	int row = GCS_TABLE_TEXELS * s;
@@ -176,6 +177,9 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 	#endif
 	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
 	mat3 K = mat3( 0.0 );
+	// The centre of rotation p (w = 1; w = 0: none) and Σ w_i (S_i p − p), where LBS moves it.
+	vec4 centre = gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 );
+	vec3 moved = vec3( 0.0 );
 	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
 		#if GCS_TABLE_SLOTS > 4
 		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
@@ -190,11 +194,14 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 		br += sw * q;
 		bd += sw * d;
 		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
+		moved += w * ( S * centre.xyz + t - centre.xyz );
 	}
 	float inv2 = 1.0 / dot( br, br );
 	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
 	mat3 rot = gcsRotation( br, 2.0 * inv2 );
 	M = rot * K;
+	// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
+	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
 	N = gcsNormalMatrix( rot, K, renorm );
 }
 // A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both

@@ -18,8 +18,12 @@ export type GpuPath = 'joints' | 'sections';
  * or 8 where some section blends more than 4 (a rig with up to 8 influences per vertex).
  */
 export type TableSlots = 4 | 8;
-/** Texels per section in the static table: per 4 slots, its joints (−1 past the last), then their weights. */
-export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2;
+/**
+ * Texels per section in the static table: per 4 slots, its joints (−1 past the last), then their
+ * weights; last, its centre of rotation (x, y, z, 1), or (0, 0, 0, 0) where it moves by the plain
+ * dual-quaternion blend (gcs_gcs_section_centres).
+ */
+export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2 + 1;
 
 /** Per-vertex attribute, plain mode: the vertex's section (a float). */
 export const SECTION_ATTRIBUTE = 'gcsSection';

@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
-import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, type GpuPath, type TableSlots } from './layout.js';
+import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuPath, type TableSlots } from './layout.js';
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
@@ -38,7 +38,7 @@ export class GpuSections {
   readonly transforms: PoseTexels;
   /** The per-frame texture (joint poses or section transforms). */
   readonly texture: THREE.DataTexture;
-  /** Path 'joints': the static texture of each section's joints and weights; null otherwise. */
+  /** Path 'joints': the static texture of each section's joints, weights and centre of rotation; null otherwise. */
   readonly table: THREE.DataTexture | null;
   /** Path 'joints': joints per section in `table` (4, or 8 where a section blends more); 4 otherwise. */
   readonly tableSlots: TableSlots;
@@ -55,10 +55,10 @@ export class GpuSections {
     this.tableSlots = 4;
     if (this.path === 'joints') {
       this.tableSlots = deformer.sectionInfluenceSlots === 8 ? 8 : 4;
-      const influences = deformer.sectionInfluences()!;
-      const texels = influences.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+      const table = sectionTable(deformer);
+      const texels = table.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
       const data = new Float32Array(width * height * 4);
-      data.set(influences);
+      data.set(table);
       this.table = floatTexture(data, width, height);
       this.uniforms = { gcsJoints: { value: this.texture }, gcsTable: { value: this.table }, ...base };
     } else {
@@ -96,6 +96,23 @@ export class GpuSections {
     this.table?.dispose();
     this.transforms.dispose();
   }
+}
+
+/**
+ * The joint-level path's static table (weights criterion; layout.ts, tableTexelsPerSection): per
+ * section its joints and weights (gcs_gcs_section_influences), then its centre of rotation
+ * (gcs_gcs_section_centres).
+ */
+export function sectionTable(deformer: GcsDeformer): Float32Array {
+  const influences = deformer.sectionInfluences(), centres = deformer.sectionCentres();
+  if (!influences || !centres) throw new GcsError('INVALID_ARGUMENT', 'the joint-level table exists for the weights criterion only');
+  const slots = deformer.sectionInfluenceSlots as TableSlots, perSection = 4 * tableTexelsPerSection(slots);
+  const table = new Float32Array(deformer.sectionCount * perSection);
+  for (let s = 0; s < deformer.sectionCount; s++) {
+    table.set(influences.subarray(2 * slots * s, 2 * slots * (s + 1)), perSection * s);
+    table.set(centres.subarray(4 * s, 4 * s + 4), perSection * s + 2 * slots);
+  }
+  return table;
 }
 
 /** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */

@@ -118,6 +118,9 @@ function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
   const pivot = j0.q;
   let br: N = vec4(0), bd: N = vec4(0);
   let k: M3 = ZERO();
+  // The centre of rotation p (w = 1; w = 0: none) and Σ w_i (S_i p − p), where LBS moves it.
+  const centre = texel(inputs.table, row.add(tableTexelsPerSection(inputs.slots) - 1)).toVar();
+  let moved: N = vec3(0);
   for (let c = 0; c < inputs.slots; c++) {
     const id = jointTexels[c >> 2][lanes[c & 3]];
     const { s: S, t, q } = c === 0 ? j0 : joint(inputs, max(int(id), int(0)));
@@ -127,6 +130,7 @@ function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
     br = br.add(q.mul(sw));
     bd = bd.add(d.mul(sw));
     k = add(k, scale(mulMM(transpose(rotation(q, float(2))), S), w));
+    moved = moved.add(mulMV(S, centre.xyz).add(t).sub(centre.xyz).mul(w));
   }
   br = br.toVar();
   bd = bd.toVar();
@@ -136,9 +140,12 @@ function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
   const rot = toVar(rotation(br, inv2.mul(2)));
   const blended = normalMatrix(rot, k);
   const rigid = joints.y.lessThan(0);
+  const m = toVar(mulMM(rot, k));
+  // With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
+  const aboutCentre = moved.sub(mulMV(m, centre.xyz).sub(centre.xyz));
   return {
-    m: toVar(pick(rigid, j0.s, mulMM(rot, k))),
-    t: select(rigid, j0.t, t).toVar(),
+    m: toVar(pick(rigid, j0.s, m)),
+    t: select(rigid, j0.t, select(centre.w.greaterThan(0.5), aboutCentre, t)).toVar(),
     n: toVar(pick(rigid, rigidNormal.n, blended.n)),
     renorm: select(rigid, rigidNormal.renorm, blended.renorm).toVar(),
   };
