@@ -38,6 +38,13 @@
 extern "C" {
 #endif
 
+/* The version of this header and of the core built from it (the npm package's version):
+   major · 10000 + minor · 100 + patch, so 0.1.0 is 100. gcs_version() returns the built core's. */
+#define GCS_VERSION_MAJOR 0
+#define GCS_VERSION_MINOR 1
+#define GCS_VERSION_PATCH 0
+#define GCS_VERSION (GCS_VERSION_MAJOR * 10000 + GCS_VERSION_MINOR * 100 + GCS_VERSION_PATCH)
+
 typedef enum GcsError {
   GCS_OK = 0,
   GCS_ERR_INVALID_ARGUMENT = 1,   /* a null pointer, a bad enum value, a bad handle */
@@ -60,7 +67,10 @@ typedef enum GcsError {
 #define GCS_MAX_VERTICES 16777216
 #define GCS_MAX_INFLUENCES 8  /* skin influences (joint, weight pairs) per vertex: glTF JOINTS_0/1, WEIGHTS_0/1 */
 
-/* ---------------------------------------------------------------- errors and memory */
+/* ---------------------------------------------------------------- version, errors and memory */
+
+/* GCS_VERSION of the header the core was built from: a wrapper checks it against its own. */
+uint32_t gcs_version(void);
 
 /* The code of the last call's outcome (GCS_OK after a successful call). */
 int gcs_last_error_code(void);

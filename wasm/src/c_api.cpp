@@ -17,6 +17,7 @@ using gcs::fail;
 
 extern "C" {
 
+uint32_t gcs_version(void) { return GCS_VERSION; }
 int gcs_last_error_code(void) { return gcs::lastErrorCode(); }
 const char* gcs_last_error_message(void) { return gcs::lastErrorMessage(); }
 
@@ -76,8 +77,18 @@ GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criter
                            float influenceWidth, int smooth, int twistSpread, int centres) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
-  if (criterion > GCS_CRITERION_WEIGHTS) {  // checked before the value becomes an enum
+  // The settings, checked here once (buildGcs takes them as valid); the criterion before it becomes an enum.
+  if (sections < GCS_MIN_SECTIONS || sections > GCS_MAX_SECTIONS) {
+    fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
+         GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, sections);
+    return nullptr;
+  }
+  if (criterion > GCS_CRITERION_WEIGHTS) {
     fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)", criterion);
+    return nullptr;
+  }
+  if (!(influenceWidth > 0.0f && influenceWidth <= 1.0f)) {
+    fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(influenceWidth));
     return nullptr;
   }
   const gcs::Rig& r = rig->rig;

@@ -532,19 +532,6 @@ namespace {
 // The build, raw → runtime (ozz's builders): each criterion as a sequence of named steps over the
 // welded rig. Every step leaves the model consistent for the next; finishModel ends both.
 
-bool checkSettings(const GcsSettings& settings) {
-  if (settings.sections < GCS_MIN_SECTIONS || settings.sections > GCS_MAX_SECTIONS)
-    return fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
-                GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, settings.sections);
-  if (!(settings.influenceWidth > 0.0f && settings.influenceWidth <= 1.0f))
-    return fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(settings.influenceWidth));
-  if (settings.criterion != GCS_CRITERION_Y && settings.criterion != GCS_CRITERION_AXIAL &&
-      settings.criterion != GCS_CRITERION_WEIGHTS)
-    return fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)",
-                unsigned(settings.criterion));
-  return true;
-}
-
 // The welded rig: each vertex's group (vertices at one bind-pose position) and each group's first vertex.
 struct Welded {
   std::vector<uint32_t> group, representative;
@@ -892,8 +879,8 @@ class PaperBuild {
 
 }  // namespace
 
+// The settings are the C API's, checked there once (gcs_build_gcs).
 GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
-  if (!checkSettings(settings)) return nullptr;
   GcsDeformerImpl* model = nullptr;
   try {
     model = new GcsDeformerImpl();

@@ -4,7 +4,7 @@
 // paper's criteria). Loading is not done here: the Character folder calls the actions it is given.
 import Stats from 'three/addons/libs/stats.module.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
-import { CLASSIC_LIMITS } from '../lib/index.js';
+import { CLASSIC_LIMITS, MAX_SECTIONS, MIN_SECTIONS } from '../lib/index.js';
 import { playClip, stepFrame } from './animate.js';
 import { applyMaterials } from './colours.js';
 import { CRITERION_MENU, PAPER_CRITERIA_NOTE } from './criteria.js';
@@ -63,7 +63,7 @@ export function initControls(menu: MenuEntry[], characterActions: CharacterActio
   criterionNote.className = 'criterion-note';
   criterionNote.textContent = PAPER_CRITERIA_NOTE;
   criterion.domElement.after(criterionNote);
-  sectionsController = g.add(params, 'sections', 3, 48, 1).name('sections').onChange(() => { state.pendingGcs = true; }) as unknown as ValueCtl<number>;
+  sectionsController = g.add(params, 'sections', MIN_SECTIONS, MAX_SECTIONS, 1).name('sections').onChange(() => { state.pendingGcs = true; }) as unknown as ValueCtl<number>;
   g.add(params, 'smooth').name('smooth (no steps)').onChange(() => { state.pendingGcs = true; });
   const costShown = { text: 'measuring…' };
   const cost = g.add(costShown, 'text').name('cost / frame').disable();

@@ -1,6 +1,6 @@
 // The label over each view: which model, its settings, and (classic) the parts it carries and why.
 // Names from files (bones, errors) reach the page escaped.
-import type { ClassicReason } from '../lib/index.js';
+import { weightGridSteps, type ClassicReason } from '../lib/index.js';
 import { CRITERION_TEXT } from './criteria.js';
 import { escapeHtml as esc } from './gui-text.js';
 import { sidebarWidth, viewRects } from './layout.js';
@@ -17,7 +17,7 @@ export function updateLabels(): void {
     if (r.kind === 'gcs') {
       const byWeights = state.builtCriterion === 'weights';
       const detail = byWeights
-        ? `${params.sections} sections: weight step 1/${2 * (params.sections - 2)}`
+        ? `${params.sections} sections: weight step 1/${weightGridSteps(params.sections)}`
         : `${params.sections} sections per part`;
       body = '<h2>GCS — generalized cross-sections</h2><div class="sub">Li, Wang, Mao · ' +
         `${esc(CRITERION_TEXT[state.builtCriterion].name)} criterion · ${detail}` +

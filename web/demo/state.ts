@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import type { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type Stats from 'three/addons/libs/stats.module.js';
-import type { ClassicReason, Criterion, GcsSkin } from '../lib/index.js';
+import { CRITERIA, MAX_SECTIONS, MIN_SECTIONS, type ClassicReason, type Criterion, type GcsSkin } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import type { DemoRenderer } from './renderer.js';
 import { FrameCost } from './cost.js';
@@ -50,16 +50,16 @@ export const queryNumber = (key: string, fallback: number) => {
 };
 const queryBool = (key: string, fallback: boolean) => (query.has(key) ? query.get(key) !== '0' && query.get(key) !== 'false' : fallback);
 
-/** ?criterion=weights|y|axial (default weights, the library's default). */
+/** ?criterion=weights|y|axial (default weights, the library's default; any other value too). */
 function parseCriterion(value: string | null): Criterion {
   const v = (value ?? '').toLowerCase();
-  return v === 'y' || v === 'axial' ? v : 'weights';
+  return CRITERIA.find((c) => c === v) ?? 'weights';
 }
 
 /** What the GUI edits (lil-gui binds to these properties). */
 export const params = {
   // GCS model (left)
-  sections: Math.round(Math.min(48, Math.max(3, queryNumber('sections', 6)))),
+  sections: Math.round(Math.min(MAX_SECTIONS, Math.max(MIN_SECTIONS, queryNumber('sections', 6)))), // the slider's range
   criterion: parseCriterion(query.get('criterion')),
   influenceWidth: 1,
   smooth: queryBool('smooth', true), // the default: no steps (false: the stepped, faster level of detail)

@@ -12,12 +12,17 @@ export type GcsErrorCode =
   | 'NO_SKIN'
   | 'OUT_OF_MEMORY'
   | 'DEGENERATE'
+  | 'UNKNOWN_CORE_ERROR' // the core reported a code this version of the wrapper does not know (a mismatched binary)
   | 'DISPOSED'
   | 'WASM_LOAD'
   | 'MISSING_PACKAGE'; // JS only: an optional package a function needs is not installed
 
-const CODES: GcsErrorCode[] = [
-  'INVALID_ARGUMENT', // 0 is OK: never thrown; index 0 stands in for an unknown code
+/**
+ * The core's error codes by number (gcs_skin.h GcsError; tests/lib/boundary.test.ts checks this
+ * table against the header). 0 is GCS_OK, never thrown.
+ */
+export const CORE_ERROR_CODES: readonly (GcsErrorCode | null)[] = [
+  null,
   'INVALID_ARGUMENT',
   'LENGTH_MISMATCH',
   'INDEX_OUT_OF_RANGE',
@@ -40,8 +45,8 @@ export class GcsError extends Error {
     this.name = 'GcsError';
     this.code = code;
   }
-  /** Maps a numeric core code (gcs_last_error_code) to its name. */
+  /** Maps a numeric core code (gcs_last_error_code) to its name; 'UNKNOWN_CORE_ERROR' for any other number (GCS_OK included: a failure reported as success). */
   static codeFromNumber(n: number): GcsErrorCode {
-    return CODES[n] ?? 'INVALID_ARGUMENT';
+    return CORE_ERROR_CODES[n] ?? 'UNKNOWN_CORE_ERROR';
   }
 }

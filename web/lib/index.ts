@@ -11,11 +11,14 @@
  * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
  * 'DISPOSED'. Every failure is a GcsError with a `code`.
  */
+import { DEFORMER_KINDS, STATS } from './core-enums.js';
 import { GcsError, type GcsErrorCode } from './errors.js';
 import { instantiateCore, type CoreExports, type WasmSource } from './loader.js';
+import { VERSION, versionNumber, versionString } from './version.js';
 
 export { GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
+export { version } from './version.js';
 
 export const MIN_SECTIONS = 3;
 /** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
@@ -24,6 +27,15 @@ export const MAX_SECTIONS = 256;
 /** GcsOptions.centres when not given. */
 const DEFAULT_CENTRES = false;
 export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
+
+/**
+ * Weights criterion: the steps of the weight grid at a section count, Q = 2·(sections − 2); node
+ * weights are multiples of 1/Q (6 sections → eighths; docs/method.md §2). The core uses the same
+ * formula (gcs_model.cpp); this is the one JavaScript copy.
+ */
+export function weightGridSteps(sections: number): number {
+  return 2 * (sections - 2);
+}
 
 type ArrayLikeNumbers = ArrayLike<number>;
 
@@ -100,8 +112,7 @@ export interface ClassicOptions {
   bulge?: number;
 }
 
-export type DeformerKind = 'gcs' | 'classic' | 'lbs' | 'dqs';
-const KINDS: DeformerKind[] = ['gcs', 'classic', 'lbs', 'dqs'];
+export type DeformerKind = (typeof DEFORMER_KINDS)[number];
 
 export interface SectionInfo {
   first: number;
@@ -193,7 +204,10 @@ export class GcsSkin {
   raise(fallback: string): never {
     const code = this.core.gcs_last_error_code();
     const message = this.readString(this.core.gcs_last_error_message()) || fallback;
-    throw new GcsError(GcsError.codeFromNumber(code), message);
+    const name = GcsError.codeFromNumber(code);
+    if (name === 'UNKNOWN_CORE_ERROR')
+      throw new GcsError(name, `the core failed with error code ${code}, which gcs-skin ${VERSION} does not know (is gcs-skin.wasm from another version?): ${message}`);
+    throw new GcsError(name, message);
   }
 
   private readString(ptr: number): string {
@@ -288,6 +302,11 @@ export async function initGcsSkin(options: { wasm?: WasmSource } = {}): Promise<
   } catch (e) {
     throw new GcsError('WASM_LOAD', `could not load gcs-skin.wasm: ${(e as Error).message}`);
   }
+  // A binary of another version would answer the same calls differently: refuse it here.
+  const coreVersion = typeof core.gcs_version === 'function' ? core.gcs_version() : null;
+  if (coreVersion !== versionNumber(VERSION))
+    throw new GcsError('WASM_LOAD', `gcs-skin.wasm is ${coreVersion === null ? 'from before 0.1.0 (no gcs_version)' : `version ${versionString(coreVersion)}`}, ` +
+      `but this gcs-skin is ${VERSION}: load the gcs-skin.wasm of the same package`);
   return new GcsSkin(core);
 }
 
@@ -435,7 +454,7 @@ export class Deformer {
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
     const core = gcs.core;
     this.handle = handle;
-    this.kind = KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
+    this.kind = DEFORMER_KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
     this.vertexCount = core.gcs_deformer_vertex_count(handle);
     this.jointCount = jointCount;
     this.positionsPtr = core.gcs_deformer_positions(handle);
@@ -557,11 +576,11 @@ export class Deformer {
 
   /** Sections (GCS) or contours (classic) in the model; 0 for LBS/DQS. */
   get sectionCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 0);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.sections);
   }
   /** Parts (joints that own vertices) in the model; 0 for LBS/DQS. */
   get partCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 1);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.parts);
   }
 
   /** Frees the deformer's wasm memory; its views must not be used afterwards. */
@@ -583,10 +602,10 @@ export class Deformer {
 export class GcsDeformer extends Deformer {
   /** Last frame: share of sections whose transform is not their part's rigid transform. */
   get adjustedShare(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 2);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedShare);
   }
   get adjustedSections(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), 3);
+    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedSections);
   }
   /** Section id of each output vertex (a copy). */
   sectionOfVertex(): Uint32Array {

@@ -7,6 +7,7 @@ export type WasmSource = URL | string | ArrayBuffer | Uint8Array | WebAssembly.M
 export interface CoreExports {
   memory: WebAssembly.Memory;
   _initialize(): void;
+  gcs_version(): number;
   gcs_last_error_code(): number;
   gcs_last_error_message(): number;
   gcs_alloc(bytes: number): number;
@@ -95,11 +96,12 @@ export async function instantiateCore(source?: WasmSource): Promise<CoreExports>
   return exports;
 }
 
-// Functions whose result is a pointer or a uint32 count. wasm returns i32, which JavaScript reads
-// as signed: above 2 GiB of memory a pointer would come back negative (and typed-array views on it
-// throw RangeError). `>>> 0` reads it as the unsigned value the C API means.
-const UNSIGNED_RESULTS = [
-  'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
+// Functions whose result is a pointer or a uint32 (tests/lib/boundary.test.ts checks the list
+// against the header). wasm returns i32, which JavaScript reads as signed: above 2 GiB of memory a
+// pointer would come back negative (and typed-array views on it throw RangeError). `>>> 0` reads it
+// as the unsigned value the C API means.
+export const UNSIGNED_RESULTS = [
+  'gcs_version', 'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
   'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
   'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
   'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
