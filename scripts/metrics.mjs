@@ -8,8 +8,12 @@
 //   triangles, normals off unit length, non-finite values, seam gap;
 // - where the skeleton has human bone names: joint thickness under 90°/135° knee and elbow bends,
 //   forearm width under 90°/180° twist, volume ratio under bends (closed meshes), the rest error
-//   and flipped triangles over those poses, and the classic model's resampling loss.
-// --markdown prints one fidelity table (rows: character × method) for the README, nothing else.
+//   and flipped triangles over those poses, and the classic model's resampling loss;
+// - joints (measureJoints, web/lib/measure/joints.ts): the knees and elbows found from the skeleton's
+//   layout, each bent alone to 45°, 90°, 135°: volume change, bulge, collapse, creases, new
+//   self-intersecting triangle pairs, per method (largest mesh).
+// --markdown prints one fidelity table (rows: character × method) for the README, nothing else;
+// --joints-markdown the README's joint table (every knee and elbow at 135°), nothing else.
 import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -18,7 +22,9 @@ import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh, writeSkinMatrices } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
-import { FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, restOfOutput } from '../dist/measure.js';
+import {
+  FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, restOfOutput,
+} from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import {
   bindCentres, dominantJoints, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
@@ -35,6 +41,7 @@ try {
   args = parseArgs(process.argv.slice(2), {
     json: { type: 'flag', default: false },
     markdown: { type: 'flag', default: false },
+    jointsMarkdown: { type: 'flag', default: false },
     noModels: { type: 'flag', default: false },
     vertices: { parse: positive, default: undefined },
     sections: { parse: positive, default: 6 },
@@ -45,11 +52,11 @@ try {
   process.exit(2);
 }
 if (args.help) {
-  console.log('usage: npm run metrics -- [--json] [--markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
+  console.log('usage: npm run metrics -- [--json] [--markdown] [--joints-markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
   process.exit(0);
 }
 // Progress on stderr whenever stdout carries a document (JSON or the markdown table).
-const log = args.json || args.markdown ? (...a) => console.error(...a) : (...a) => console.log(...a);
+const log = args.json || args.markdown || args.jointsMarkdown ? (...a) => console.error(...a) : (...a) => console.log(...a);
 const { sections, frames: framesPerClip } = args;
 const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../shared/models');
 const deg = Math.PI / 180;
@@ -254,10 +261,25 @@ function shapeOf(mesh, height) {
   return { mesh: mesh.name, poses: Object.keys(poses), notes, methods };
 }
 
-/** Everything measured on one character: its skinned meshes (the human measures on the largest). */
+/** The knees and elbows of one mesh, each bent alone (measureJoints), with the time it took. */
+function jointsOf(mesh) {
+  const input = rigInputFromSkinnedMesh(mesh);
+  const rig = gcs.createRig(input);
+  try {
+    const t0 = performance.now();
+    const m = measureJoints(rig, input, { methods: jointMethods({ sections }), names: mesh.skeleton.bones.map((b) => b.name) });
+    return { ...m, mesh: mesh.name, ms: performance.now() - t0 };
+  } finally {
+    rig.dispose();
+  }
+}
+
+/** Everything measured on one character: its skinned meshes (the human measures and the joints on the largest). */
 function measureCharacter(name, meshes, clips) {
   const heights = characterHeight(meshes);
   const largest = meshes.reduce((a, b) => (b.geometry.getAttribute('position').count > a.geometry.getAttribute('position').count ? b : a));
+  const joints = jointsOf(largest);
+  if (args.jointsMarkdown) return { name, joints };
   const shape = shapeOf(largest, heights.meshUnits[meshes.indexOf(largest)]);
   const fidelity = fidelityOf(meshes, clips, heights);
   const notes = [...shape.notes];
@@ -265,7 +287,7 @@ function measureCharacter(name, meshes, clips) {
   if (!clips.length) notes.push('no animation clip: fidelity over the bind pose only');
   return {
     name, height: heights.world, meshes: fidelity.meshes.map(({ methods, ...m }) => m), clips: clips.map((c) => c.name),
-    frames: fidelity.meshes[0].frames, notes, fidelity: fidelity.methods, shape,
+    frames: fidelity.meshes[0].frames, notes, fidelity: fidelity.methods, shape, joints,
   };
 }
 
@@ -299,6 +321,28 @@ if (args.json) {
 }
 
 // ---------------------------------------------------------------- tables
+if (args.jointsMarkdown) {
+  // README: per character and joint at 135°, bulge p95 / max per method, then the volume changes.
+  const methods = reports[0].joints.methods;
+  const rows = [['character, joint (135°)', ...methods.map((m) => `bulge p95 / max: ${m.key}`), `volume change %: ${methods.map((m) => m.key).join(' / ')}`]];
+  for (const rep of reports) {
+    const j = rep.joints;
+    const at = j.angles.indexOf(135);
+    if (!j.joints.length) rows.push([`${rep.name}: ${j.notes.join('; ') || 'no knee or elbow found'}`, ...methods.map(() => ''), '']);
+    for (const joint of j.joints) {
+      const f = ({ key }) => (joint.methods[key].error ? null : joint.methods[key][at]);
+      rows.push([`${rep.name}, ${joint.hinge.label}`, ...methods.map((m) => (f(m) ? `${num(f(m).bulgeP95, 2)} / ${num(f(m).bulgeMax, 2)}` : 'n/a')),
+        methods.map((m) => (f(m) ? f(m).volumeChange.toFixed(1) : 'n/a')).join(' / ')]);
+    }
+  }
+  console.log(markdownTable(rows));
+  console.log(`\nEach knee and elbow found from the skeleton's layout, bent alone from the bind pose to 135° about its hinge; ` +
+    'GCS at ' + `${sections} sections. Region: the triangles with a vertex weighted on the joint or its parent and nearest (at bind) ` +
+    'to the limb\'s bones there. Bulge: distance to the nearest posed bone over the same at bind (p95 / max over the region\'s ' +
+    'vertices). Volume: signed cone volumes about the joint centre, posed against bind.');
+  process.exit(0);
+}
+
 /** One row per method of a character's fidelity; `first` labels the character on its first row. */
 function fidelityRows(rep, first) {
   const lbs = rep.fidelity.lbs, dqs = rep.fidelity.dqs;
@@ -357,5 +401,8 @@ for (const rep of reports) {
   rows.push([`flipped, ${s.poses.length === 1 ? 'reference pose' : `reference + ${s.poses.length - 1} bend/twist poses`}`, ...cols.map((c) => (s.methods[c].error ? 'n/a'
     : c === 'lbs' || lbsPoses === undefined ? String(s.methods[c].flippedPoses) : `${s.methods[c].flippedPoses} (LBS ${lbsPoses})`))]);
   console.log(`\n${table(rows)}`);
+  const j = rep.joints;
+  console.log(`\njoints of '${j.mesh}' (each bent alone from the bind pose; ${j.ms.toFixed(0)} ms)${j.notes.map((n) => `\n  note: ${n}`).join('')}`);
+  if (j.joints.length) console.log(table(jointTableRows(j)));
 }
 for (const f of failures) console.log(`  ${f}`);

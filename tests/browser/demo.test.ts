@@ -106,6 +106,7 @@ const CONTROLS: Record<string, string> = {
   'colour by section': 'the section-count slider rebuilds the GCS model live …',
   'show skeleton': 'wireframe and show skeleton change every view',
   'three.js LBS view': 'the other controls: clip, third (three.js LBS) view, classic contours, rays and bulge',
+  'joint close-up (knees, elbows) ↗': 'joint-mode.test.ts: the comparison page\'s joint close-up button opens ?joint on the character on screen',
   'renderer': 'the renderer switch reloads the page with ?renderer=webgpu …',
 };
 

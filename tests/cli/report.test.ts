@@ -225,6 +225,16 @@ describe('gcs-skin report', () => {
     expect(gcs.dqsMax).toBeLessThanOrEqual(4);
     expect(m.methods.dqs.fidelity!.dqsMax).toBeLessThanOrEqual(0.01);
     expect(Number.isInteger(m.methods.lbs.fidelity!.flipped)).toBe(true);
+    // Its knees and elbows (no bone names), each bent alone: LBS loses volume where DQS keeps more; the table prints them.
+    expect(m.joints.joints.map((j) => j.hinge.label)).toEqual(['left knee', 'right knee', 'left elbow', 'right elbow']);
+    expect(m.joints.angles).toEqual([45, 90, 135]);
+    for (const j of m.joints.joints) {
+      const lbs = j.methods.lbs as { volumeChange: number }[], dqs = j.methods.dqs as { volumeChange: number }[];
+      expect(lbs[2].volumeChange).toBeLessThan(dqs[2].volumeChange - 5);
+    }
+    const text = formatReport(r);
+    expect(text).toMatch(/joints: left knee, right knee, left elbow, right elbow; each bent alone/);
+    for (const line of text.slice(text.indexOf('joints: ')).split('\n')) expect(line.length).toBeLessThanOrEqual(120);
   });
   if (!cesium && !reason) console.log('report.test: skipped the CesiumMan test: no CesiumMan.glb in ../shared/models');
 

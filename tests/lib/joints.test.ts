@@ -182,6 +182,23 @@ describe.each(Object.keys(CASES))('knees and elbows of %s from the skeleton alon
   });
 });
 
+describe('what findHinges makes of skeletons without two pairs of limbs', () => {
+  test('a tube, a skeleton collapsed to one point, a NaN centre, a cycle: no hinge, a note, no throw', () => {
+    expect(findHinges(makeTube().input)).toMatchObject({ hinges: [], frame: null });
+    const human = rigInputFromSkinnedMesh(createHuman({ vertices: 2000 }).mesh);
+    const J = human.parents.length;
+    const collapsed = { ...human, inverseBindMatrices: Float32Array.from({ length: 16 * J }, (_, i) => (i % 5 === 0 ? 1 : 0)) };
+    const nan = { ...human, inverseBindMatrices: Float32Array.from(human.inverseBindMatrices, (x, i) => (i === 16 * 14 + 13 ? NaN : x)) };
+    const cycle = { ...human, parents: Int32Array.from(human.parents, (p, j) => (j === 0 ? J - 1 : p)) };
+    for (const input of [collapsed, nan, cycle]) {
+      const found = findHinges(input);
+      for (const h of found.hinges) for (const x of [...h.axis, ...h.centre]) expect(Number.isFinite(x)).toBe(true);
+      if (!found.hinges.length) expect(found.notes.length).toBeGreaterThan(0);
+    }
+    expect(findHinges(collapsed).hinges).toEqual([]);
+  });
+});
+
 describe('every method at the joints of our human', () => {
   test('LBS loses volume at 90° and 135°, DQS keeps it within 1 point and bulges more than LBS; every figure finite', () => {
     const mesh = createHuman().mesh;
@@ -192,7 +209,7 @@ describe('every method at the joints of our human', () => {
     console.log(`joints.test: measureJoints on our human (${rig.vertexCount} vertices, ${m.joints.length} joints, ${m.methods.length} methods, 3 angles): ${(performance.now() - t0).toFixed(0)} ms`);
     rig.dispose();
     expect(m.joints.map((j) => j.hinge.label)).toEqual(['left knee (LeftLeg)', 'right knee (RightLeg)', 'left elbow (LeftForeArm)', 'right elbow (RightForeArm)']);
-    expect(m.methods.map((x) => x.key)).toEqual(['gcs', 'gcs-plain', 'classic', 'lbs', 'dqs']);
+    expect(m.methods.map((x) => x.key)).toEqual(['gcs', 'gcs-centres', 'dqs', 'lbs', 'gcs-plain', 'classic']);
     for (const j of m.joints) {
       expect(j.regionTriangles).toBeGreaterThan(500);
       const lbs = j.methods.lbs as JointFigures[], dqs = j.methods.dqs as JointFigures[];

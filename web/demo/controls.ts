@@ -91,6 +91,9 @@ export function initControls(menu: MenuEntry[], characterActions: CharacterActio
   v.add(params, 'colourBySection').name('colour by section').onChange(onMaterials);
   v.add(params, 'showSkeleton').name('show skeleton').onChange(() => { if (state.current) state.current.skeletonHelper.visible = params.showSkeleton; });
   v.add(params, 'lbsView').name('three.js LBS view').onChange(relayout);
+  // The joint close-up (joint-mode.ts) of the character on screen (a dropped file: drop it there again).
+  v.add({ open: () => { location.search = `?joint&model=${state.current?.key === 'file' ? 'human' : state.current?.key ?? 'human'}`; } }, 'open')
+    .name('joint close-up (knees, elbows) ↗');
   addRendererSwitch(v, rendererKind());
   childrenOf(gui).appendChild(dom.hint);
 

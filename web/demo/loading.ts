@@ -16,14 +16,14 @@ import { dom, LAYER, params, query, queryNumber, state, type Character } from '.
 import { frameCharacter } from './views.js';
 
 /** A character shipped with the demo (public/, licences in public/LICENSES.md). */
-interface Shipped {
+export interface Shipped {
   key: string;
   label: string;
   file: string;
   /** One line: who made it, under which licence. */
   credit: string;
 }
-const SHIPPED: Shipped[] = [
+export const SHIPPED: Shipped[] = [
   { key: 'fox', label: 'Fox', file: 'Fox.glb',
     credit: 'Fox: model by PixelMannen (CC0 1.0), rigging and animation by @tomkranis (CC BY 4.0), glTF by @AsoboStudio and @scurest' },
   { key: 'cesiumman', label: 'Cesium Man', file: 'CesiumMan.glb',
@@ -219,7 +219,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
 }
 
 /** Scales a glTF's object to 1.8 units, feet on y = 0, centred on the origin. */
-function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group): void {
+export function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group): void {
   const box = new THREE.Box3().setFromObject(object);
   const size = box.getSize(new THREE.Vector3());
   const extent = Math.max(size.x, size.y, size.z);
@@ -231,7 +231,7 @@ function normaliseSize(name: string, object: THREE.Object3D, holder: THREE.Group
   holder.updateMatrixWorld(true);
 }
 
-function disposeObject(root: THREE.Object3D): void {
+export function disposeObject(root: THREE.Object3D): void {
   root.traverse((o) => {
     const mesh = o as THREE.Mesh;
     if (!mesh.isMesh) return;

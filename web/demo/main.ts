@@ -16,13 +16,14 @@
 //   models.ts    GCS / classic builds      colours.ts  colour by section, wireframe
 //   labels.ts, readouts.ts  the text over and under each view
 //   animate.ts   the frame loop
-// ?crowd=N opens the crowd mode instead (crowd.ts). A small hook on window.__demo lets browser
+// ?crowd=N opens the crowd mode instead (crowd.ts), ?joint the joint close-up (joint-mode.ts). A small hook on window.__demo lets browser
 // tests drive the page.
 import { initGcsSkin } from '../lib/index.js';
 import { animate } from './animate.js';
 import { initControls, setPaused, setSections } from './controls.js';
 import { crowdRequested, startCrowd } from './crowd.js';
 import { attributesNeeded } from './material-attributes.js';
+import { jointHook, jointRequested, startJointMode } from './joint-mode.js';
 import { CHARACTER_MENU, chooseCharacter, initFileInput, loadFirstCharacter, loadsDone } from './loading.js';
 import { viewRects } from './layout.js';
 import { describeError, shownMessage, showMessage, showStatus } from './page.js';
@@ -55,6 +56,7 @@ function afterFrames(start: Promise<unknown>, frame: () => number): Promise<void
 // ?crowd=N: the crowd mode (web/demo/crowd.ts) instead of the comparison views.
 const ready = crowdRequested()
   ? startCrowd().catch((e) => showMessage(`The crowd could not start: ${describeError(e)}`))
+  : jointRequested() ? startJointMode().catch((e) => showMessage(`The joint close-up could not start: ${describeError(e)}`))
   : afterFrames(init().catch((e) => showMessage(`The demo could not start: ${describeError(e)}`)), () => state.frameCount);
 
 Object.assign(window, {
@@ -125,5 +127,7 @@ Object.assign(window, {
     },
     /** Settles when every queued load has finished. */
     idle: loadsDone,
+    /** The joint close-up (?joint): its joints, bend, figures. */
+    joint: jointHook,
   },
 });

@@ -1,17 +1,19 @@
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--wide] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
 // method, build ms, ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe over the
-// sampled frames of every clip, distances in % of the character's height). Frame times come from
-// one interleaved timing per clip (every method in turn: timeInterleaved, as `npm run bench`), and
-// a method's one figure is the median of its clips'. Progress on stderr when it is a terminal.
-// The JSON shape is documented in docs/report-json.md.
+// sampled frames of every clip, distances in % of the character's height), and the mesh's knees and
+// elbows bent alone (measureJoints: volume change, bulge, collapse, creases, new self-intersections
+// per method). Frame times come from one interleaved timing per clip (every method in turn:
+// timeInterleaved, as `npm run bench`), and a method's one figure is the median of its clips'.
+// Progress on stderr when it is a terminal. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
 import { GcsError } from '../../../web/lib/errors.js';
 import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
-  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, median, timeInterleaved, type Fidelity, type MethodName,
+  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, median, timeInterleaved,
+  type Fidelity, type JointsMeasure, type MethodName,
 } from '../../../web/lib/measure.js';
 
 /** Fidelity frames in all (default --frames: this many spread over the clips, at least MIN_FRAMES_PER_CLIP each, at most 60). */
@@ -29,7 +31,9 @@ export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME
   method, build ms, ms per frame (the median of the clips', all methods timed in turn) and its
   fidelity over the sampled frames of every clip: rigid error, distance from an independent DQS
   (p95, max), flipped, creased and stretched triangles, non-finite values (distances in % of the
-  character's height). Progress goes to stderr when it is a terminal.
+  character's height); then the knees and elbows (found from the skeleton) each bent alone to 45°,
+  90°, 135°: volume change, bulge, collapse, creases, new self-intersections per method. Progress
+  goes to stderr when it is a terminal.
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
   --frames N      frames sampled per clip (default: 60 for one clip, fewer per clip for more
@@ -93,6 +97,8 @@ export interface MeshReport {
   frames: { count: number; source: 'clips' | 'bind pose' };
   methods: Record<MethodName, MethodReport>;
   clips: { name: string; duration: number; frames: number; methods: Partial<Record<MethodName, ClipMethodReport>> }[];
+  /** The knees and elbows found on this mesh, each bent alone (docs/report-json.md, "Joints"). */
+  joints: JointsMeasure;
 }
 
 export interface Report {
@@ -268,6 +274,8 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       methods[method].medianMs = round(median(perClip.map((t) => t[k].medianMs)));
       methods[method].p95Ms = round(Math.max(...perClip.map((t) => t[k].p95Ms)));
     });
+    s.progress('knees and elbows, each bent alone');
+    const joints = roundJoints(measureJoints(rig, input, { methods: jointMethods({ sections: s.sections }), names: mesh.skeleton.bones.map((b) => b.name) }));
     return {
       name: mesh.name,
       counts: {
@@ -280,11 +288,29 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       frames: { count: frames.length, source: all.length ? 'clips' : 'bind pose' },
       methods,
       clips: clips.map((clip, c) => ({ name: clip.name, duration: round(clip.duration), frames: clipFrames[c].length, methods: clipMethods[c] })),
+      joints,
     };
   } finally {
     for (const { d } of built) d.dispose();
     rig.dispose();
   }
+}
+
+/** The joints' figures and geometry to 4 significant digits. */
+function roundJoints(m: JointsMeasure): JointsMeasure {
+  const vec = (v: number[]) => v.map((x) => round(x)) as [number, number, number];
+  return {
+    ...m,
+    frame: m.frame && { up: vec(m.frame.up), forward: vec(m.frame.forward), left: vec(m.frame.left) },
+    joints: m.joints.map((j) => ({
+      ...j,
+      hinge: { ...j.hinge, centre: vec(j.hinge.centre), end: vec(j.hinge.end), axis: vec(j.hinge.axis) },
+      methods: Object.fromEntries(Object.entries(j.methods).map(([k, r]) => [k, 'error' in r ? r : r.map((f) => ({
+        ...f, volumeChange: round(f.volumeChange), bulgeP95: round(f.bulgeP95), bulgeMax: round(f.bulgeMax),
+        collapseP5: round(f.collapseP5), collapseMin: round(f.collapseMin),
+      }))])),
+    })),
+  };
 }
 
 /** How many vertices have more than 4 influences (weights > 0). */
@@ -371,17 +397,22 @@ export function formatReport(r: Report, options: { wide?: boolean } = {}): strin
       const names = m.clips.map((clip) => printable(clip.name)).join(', ');
       out.push(`${m.clips.length} clip(s)${names.length <= 70 ? `: ${names}` : ''} (per clip: --wide or --json)`);
     }
-    if (!wide) continue;
-    for (const clip of m.clips) {
-      out.push('', `clip '${printable(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
-      const rows2 = [['method', 'median ms', 'p95 ms', 'samples', 'adjusted']];
-      for (const name of METHODS) {
-        const x = clip.methods[name];
-        if (!x) { rows2.push([name, 'n/a', '', '', '']); continue; }
-        rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), String(x.samples), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
+    const j = m.joints;
+    out.push('', `joints: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}; each bent alone from the bind pose`,
+      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone over the same at bind');
+    for (const note of j.notes) out.push(`  note: ${printable(note)}`);
+    if (j.joints.length) out.push(table(jointTableRows(j).map((row) => row.map(printable))));
+    if (wide)
+      for (const clip of m.clips) {
+        out.push('', `clip '${printable(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
+        const rows2 = [['method', 'median ms', 'p95 ms', 'samples', 'adjusted']];
+        for (const name of METHODS) {
+          const x = clip.methods[name];
+          if (!x) { rows2.push([name, 'n/a', '', '', '']); continue; }
+          rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), String(x.samples), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
+        }
+        out.push(table(rows2));
       }
-      out.push(table(rows2));
-    }
   }
   return out.join('\n');
 }

@@ -135,15 +135,25 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
       pairs.push([c.a, c.b]);
     }
   }
-  if (!pairs.length) {
-    notes.push('no mirrored pair of limbs in the skeleton: no knee or elbow found');
+  // Limbs, not fingers or ears: each pair as long as a fifth of the skeleton's extent at least, its
+  // hinges skinned on this mesh.
+  const lo: Vec3 = [Infinity, Infinity, Infinity], hi: Vec3 = [-Infinity, -Infinity, -Infinity];
+  for (const c of centres) for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], c[k]); hi[k] = Math.max(hi[k], c[k]); }
+  const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  const skinned = new Set<number>(); // joints with weight on some vertex of this mesh
+  for (let i = 0; i < input.weights.length; i++) if (input.weights[i] > 0) skinned.add(input.joints[i]);
+  const limbs = pairs.filter(([a, b]) => Math.min(a.length, b.length) >= 0.2 * extent &&
+    skinned.has(a.path[a.hinge]) && skinned.has(b.path[b.hinge]));
+  if (limbs.length < 2) {
+    notes.push(limbs.length ? 'one mirrored pair of limbs only (legs and arms need two, with skin on this mesh): no knee or elbow found'
+      : 'no mirrored pair of limbs in the skeleton: no knee or elbow found');
     return { hinges: [], frame: null, notes };
   }
 
   // Up: against the pair whose limbs reach furthest from their roots, taken together (the legs).
   const reachVector = ([a, b]: [Limb, Limb]): Vec3 =>
     add(sub(a.end, centres[a.path[0]]), sub(b.end, centres[b.path[0]]));
-  const longest = pairs.reduce((x, y) => (norm(reachVector(y)) > norm(reachVector(x)) ? y : x));
+  const longest = limbs.reduce((x, y) => (norm(reachVector(y)) > norm(reachVector(x)) ? y : x));
   const down = reachVector(longest);
   if (!(norm(down) > 0)) {
     notes.push('the limbs reach nowhere: no knee or elbow found');
@@ -151,10 +161,16 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
   }
   let up = scale(down, -1 / norm(down));
   const height = (j: number) => dot(centres[j], up);
-  const legs = pairs.reduce((x, y) => (height(y[0].branch) < height(x[0].branch) ? y : x));
-  const above = pairs.filter((p) => p !== legs && height(p[0].branch) > height(legs[0].branch));
+  const legs = limbs.reduce((x, y) => (height(y[0].branch) < height(x[0].branch) ? y : x));
+  // The arms hang off a branch above the legs' and outside them (not toes, not fingers of a hand).
+  const inLegs = (j: number) => legs.some((leg) => leg.path.includes(j));
+  const above = limbs.filter((p) => p !== legs && height(p[0].branch) > height(legs[0].branch) && !inLegs(p[0].branch));
   const arms = above.length ? above.reduce((x, y) => (y[0].length + y[1].length > x[0].length + x[1].length ? y : x)) : null;
-  if (!arms) notes.push('no second pair of limbs above the legs: no elbow found');
+  if (!arms) {
+    // Without a second pair there is no telling legs from arms (nor toes, fingers, ears).
+    notes.push('no second pair of limbs above the first: no knee or elbow found');
+    return { hinges: [], frame: null, notes };
+  }
 
   // Forward: perpendicular to up and to the hips' left–right line; the sign from the feet.
   const across = normalize(sub(centres[legs[0].path[0]], centres[legs[1].path[0]]));
@@ -216,7 +232,7 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
     }
   };
   addPair(legs, 'knee');
-  if (arms) addPair(arms, 'elbow');
+  addPair(arms, 'elbow');
   return { hinges, frame, notes };
 }
 

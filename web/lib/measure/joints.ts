@@ -1,7 +1,8 @@
 /**
- * Joints measured one at a time (docs/report-json.md, "joints"): a knee or elbow (measure/hinges.ts)
- * bent alone from the bind pose about its hinge, everything else at rest, and its region — the
- * triangles with weight on the bent joint or its parent — compared posed against bind:
+ * Joints measured one at a time (docs/report-json.md, "Joints"; docs/method.md): a knee or elbow
+ * (measure/hinges.ts) bent alone from the bind pose about its hinge, everything else at rest, and
+ * its region — the triangles with a vertex weighted on the bent joint or its parent and nearest (at
+ * bind) to the limb's bones at the hinge — compared posed against bind:
  * - volume change: the sum of signed cone volumes a·(b×c)/6 about the joint centre (which the bend
  *   leaves in place; a rigid motion about it keeps every cone), % of the bind value;
  * - bulge: each region vertex's distance to the nearest posed bone segment over the same at bind
@@ -46,11 +47,22 @@ export interface JointMethod {
 }
 
 /** The methods the report compares at the joints, built as `buildMethod` builds them. */
-export const JOINT_METHOD_NAMES: readonly MethodName[] = ['gcs', 'gcs-plain', 'classic', 'lbs', 'dqs'];
+export const JOINT_METHOD_NAMES: readonly MethodName[] = ['gcs', 'dqs', 'lbs', 'gcs-plain', 'classic'];
 
-export function jointMethods(settings: BuildSettings = {}, names: readonly MethodName[] = JOINT_METHOD_NAMES): JointMethod[] {
-  return names.map((m) => ({ key: m, label: METHOD_LABELS[m], build: (rig: Rig) => buildMethod(rig, m, settings) }));
+/**
+ * The methods measured at the joints: `names` built as `buildMethod` builds them and, with
+ * `centres` (default true), GCS with centres of rotation (`centres: true`) right after the default.
+ */
+export function jointMethods(settings: BuildSettings = {}, names: readonly MethodName[] = JOINT_METHOD_NAMES, centres = true): JointMethod[] {
+  const list: JointMethod[] = names.map((m) => ({ key: m, label: METHOD_LABELS[m], build: (rig: Rig) => buildMethod(rig, m, settings) }));
+  if (centres) list.splice(names.includes('gcs') ? names.indexOf('gcs') + 1 : 0, 0, CENTRES_METHOD(settings));
+  return list;
 }
+
+/** GCS with centres of rotation per node (rig.buildGcs's `centres: true`), key 'gcs-centres'. */
+export const CENTRES_METHOD = (settings: BuildSettings = {}): JointMethod => ({
+  key: 'gcs-centres', label: 'GCS, centres of rotation', build: (rig: Rig) => rig.buildGcs({ sections: settings.sections, centres: true }),
+});
 
 /**
  * Skin matrices (J × 16) of the bind pose with `hinge.joint` and everything below it turned by
@@ -228,6 +240,7 @@ export class JointProbe {
   private readonly bones: BoneSegments;
   private readonly rigRegionFlags: Uint8Array;
   private rigRegion: JointRegion | null = null;
+  private readonly resampledRegions = new WeakMap<Deformer, JointRegion>();
   private readonly posed: Float64Array;
 
   constructor(readonly input: RigInput, readonly hinge: Hinge, angles: readonly number[] = JOINT_ANGLES) {
@@ -253,20 +266,32 @@ export class JointProbe {
     return this.rigRegion;
   }
 
-  /** The figures at each angle, in the order of `angles`. Leaves the deformer in the last bend. */
-  measure(deformer: Deformer): JointFigures[] {
+  /**
+   * The figures at each angle (default: the probe's), in that order. Leaves the deformer in the
+   * last bend.
+   */
+  measure(deformer: Deformer, angles: readonly number[] = this.angles): JointFigures[] {
+    if (!angles.every(Number.isFinite)) throw new GcsError('INVALID_ARGUMENT', 'the bend angles must be finite numbers of degrees');
+    const skins = angles === this.angles ? this.skins : angles.map((a) => bendSkin(this.input.parents, this.hinge, a));
     const n = Math.floor(this.input.positions.length / 3);
     const source = deformer.sourceVertex ?? (deformer.kind !== 'classic' && deformer.vertexCount === n ? null : undefined);
-    if (source === undefined) return this.measureResampled(deformer as ClassicDeformer);
+    if (source === undefined) {
+      const region = this.resampledRegion(deformer as ClassicDeformer);
+      return angles.map((degrees, i) => {
+        deformer.deform(skins[i]);
+        return region.figures(deformer.positions, skins[i], degrees);
+      });
+    }
     const region = this.region();
     if (source) {
+      this.posed.fill(NaN); // a rig vertex the deformer does not output shows as non-finite figures, not a stale pose
       const covered = new Uint8Array(n);
       for (const v of source) if (v < n) covered[v] = 1;
       if (covered.some((c, v) => !c && this.rigRegionFlags[v]))
         throw new GcsError('LENGTH_MISMATCH', 'the deformer leaves out vertices of the joint region: measure a deformer built from the same rig');
     }
-    return this.angles.map((degrees, i) => {
-      deformer.deform(this.skins[i]);
+    return angles.map((degrees, i) => {
+      deformer.deform(skins[i]);
       const out = deformer.positions;
       if (source) {
         for (let o = 0; o < source.length; o++) {
@@ -274,26 +299,37 @@ export class JointProbe {
           if (v < n) for (let c = 0; c < 3; c++) this.posed[3 * v + c] = out[3 * o + c];
         }
       } else this.posed.set(out);
-      return region.figures(this.posed, this.skins[i], degrees);
+      return region.figures(this.posed, skins[i], degrees);
     });
   }
 
   /** A model with its own vertices: its region is its parts of the two joints and the carried skin weighted on them. */
-  private measureResampled(deformer: ClassicDeformer): JointFigures[] {
+  private resampledRegion(deformer: ClassicDeformer): JointRegion {
+    let region = this.resampledRegions.get(deformer);
+    if (region) return region;
     const m = deformer.vertexCount;
     const flags = new Uint8Array(m);
     for (const p of deformer.parts ?? [])
       if (p.resampled && (p.joint === this.hinge.joint || p.joint === this.hinge.parent)) flags.fill(1, p.firstVertex, p.firstVertex + p.vertexCount);
     const from = deformer.sourceOfVertex;
     for (let o = 0; o < Math.min(m, from.length); o++) if (from[o] >= 0 && this.rigRegionFlags[from[o]]) flags[o] = 1;
+    const { rest, indices, weld } = outputAtRest(deformer);
+    region = new JointRegion(rest, indices, flags, this.hinge.centre, this.bones, this.input.parents.length, weld);
+    this.resampledRegions.set(deformer, region);
+    return region;
+  }
+}
+
+/** A resampled model's output at the bind pose, its triangles and their weld, once per deformer (every hinge shares them). */
+const restOutputs = new WeakMap<Deformer, { rest: Float64Array; indices: Uint32Array; weld: Uint32Array }>();
+function outputAtRest(deformer: Deformer): { rest: Float64Array; indices: Uint32Array; weld: Uint32Array } {
+  let out = restOutputs.get(deformer);
+  if (!out) {
     deformer.deform(identitySkin(deformer.jointCount));
     const rest = Float64Array.from(deformer.positions);
-    const region = new JointRegion(rest, deformer.indices, flags, this.hinge.centre, this.bones, this.input.parents.length);
-    return this.angles.map((degrees, i) => {
-      deformer.deform(this.skins[i]);
-      return region.figures(deformer.positions, this.skins[i], degrees);
-    });
+    restOutputs.set(deformer, (out = { rest, indices: deformer.indices, weld: weldByPosition(rest) }));
   }
+  return out;
 }
 
 /** weldByPosition of a rig's positions, once per array (every hinge of a rig shares it). */
@@ -332,7 +368,7 @@ export interface JointResult {
 }
 
 export interface JointsOptions {
-  /** Default: jointMethods() (GCS default and plain, classic, LBS, DQS). */
+  /** Default: jointMethods() (GCS default, GCS with centres of rotation, DQS, LBS, GCS plain, classic). */
   methods?: readonly JointMethod[];
   /** Default JOINT_ANGLES. */
   angles?: readonly number[];
@@ -401,4 +437,28 @@ function minOf(a: Float64Array): number {
   let m = Infinity;
   for (let i = 0; i < a.length; i++) if (a[i] < m) m = a[i];
   return a.length ? m : NaN;
+}
+
+/**
+ * A compact table of a JointsMeasure (header first; fits 120 columns with two spaces between
+ * columns): per joint and method the volume change at every angle, and at `degrees` (default the
+ * largest angle) bulge p95 / max, collapse p5 / min, creases and new self-intersecting pairs.
+ */
+export function jointTableRows(m: JointsMeasure, degrees = Math.max(...m.angles)): string[][] {
+  const at = m.angles.indexOf(degrees);
+  const f2 = (x: number) => (Number.isFinite(x) ? x.toFixed(2) : String(x));
+  const f1 = (x: number) => (Number.isFinite(x) ? (Math.abs(x) < 0.05 ? 0 : x).toFixed(1) : String(x));
+  const rows = [['joint', 'method', `volume % ${m.angles.map((a) => `${a}°`).join('/')}`, `bulge p95/max ${degrees}°`,
+    `collapse p5/min ${degrees}°`, 'creases', 'new self-x']];
+  for (const j of m.joints) {
+    m.methods.forEach(({ key }, i) => {
+      const r = j.methods[key];
+      const head = [i === 0 ? j.hinge.label : '', key];
+      if (!r || 'error' in r) { rows.push([...head, `n/a: ${r ? r.error.code : 'not measured'}`, '', '', '', '']); return; }
+      const f = r[at];
+      rows.push([...head, r.map((x) => f1(x.volumeChange)).join(' / '), f ? `${f2(f.bulgeP95)} / ${f2(f.bulgeMax)}` : 'n/a',
+        f ? `${f2(f.collapseP5)} / ${f2(f.collapseMin)}` : 'n/a', f ? String(f.creases) : 'n/a', f ? String(f.newIntersections) : 'n/a']);
+    });
+  }
+  return rows;
 }
