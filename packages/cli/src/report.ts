@@ -347,6 +347,18 @@ function table(rows: string[][]): string {
   return rows.map((r) => r.map((cell, c) => (left(c) ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ').trimEnd()).join('\n');
 }
 
+/** `text` in lines of at most REPORT_COLUMNS, broken at spaces (a word longer than that stays whole). */
+function wrap(text: string): string[] {
+  const lines: string[] = [];
+  let line = '';
+  for (const word of text.split(' ')) {
+    if (line && line.length + 1 + word.length > REPORT_COLUMNS) { lines.push(line); line = `  ${word}`; }
+    else line = line ? `${line} ${word}` : word;
+  }
+  if (line) lines.push(line);
+  return lines;
+}
+
 /** The text report fits this many columns (its tables; --wide and JSON carry the rest). */
 export const REPORT_COLUMNS = 120;
 
@@ -398,10 +410,21 @@ export function formatReport(r: Report, options: { wide?: boolean } = {}): strin
       out.push(`${m.clips.length} clip(s)${names.length <= 70 ? `: ${names}` : ''} (per clip: --wide or --json)`);
     }
     const j = m.joints;
-    out.push('', `joints: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}; each bent alone from the bind pose`,
-      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone over the same at bind');
-    for (const note of j.notes) out.push(`  note: ${printable(note)}`);
-    if (j.joints.length) out.push(table(jointTableRows(j).map((row) => row.map(printable))));
+    out.push('', ...wrap(`joints, each bent alone from the bind pose: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}`),
+      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone',
+      'over the same at bind');
+    for (const note of j.notes) out.push(...wrap(`  note: ${printable(note)}`));
+    if (j.joints.length) {
+      // The joint on a row of its own above its methods: a column of joint names would not fit.
+      const [head, ...body] = jointTableRows(j).map((row) => row.map(printable));
+      const rows = [head.slice(1)];
+      for (const row of body) {
+        if (row[0]) rows.push([row[0], ...head.slice(2).map(() => '')]);
+        rows.push([`  ${row[1]}`, ...row.slice(2)]);
+      }
+      rows[0][0] = 'joint / method';
+      out.push(table(rows));
+    }
     if (wide)
       for (const clip of m.clips) {
         out.push('', `clip '${printable(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
