@@ -13,6 +13,7 @@ import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs
 import { crowdBench } from './bench/crowd.mjs';
 import { loadRealRigs, realRigBench, realRigRows, RATIO_GOAL } from './bench/real-rigs.mjs';
 import { firstPicture, sliderRebuild } from './bench/builds.mjs';
+import { saveFigures } from './bench/figures.mjs';
 
 const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
   const n = Number(x.replace(/k$/i, '000').replace(/m$/i, '000000'));
@@ -29,6 +30,7 @@ try {
     sections: { parse: (s) => Number(s), default: 6 },
     crowdOnly: { type: 'flag', default: false },
     noCrowd: { type: 'flag', default: false },
+    save: { type: 'flag', default: false },
   });
 } catch (e) {
   console.error(`bench: ${e.message}`);
@@ -41,7 +43,8 @@ if (args.help) {
   --json      machine-readable results on stdout
   --markdown  tables as markdown (for docs/benchmarks.md)
   --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)
-  --no-crowd  everything but the crowd bench`);
+  --no-crowd  everything but the crowd bench
+  --save      write the figures the README quotes to docs/figures.json (tests/readme-figures.test.ts checks them)`);
   process.exit(0);
 }
 const quick = args.quick;
@@ -269,7 +272,32 @@ if (built.gcs.deformer && built['gcs-plain'].deformer) {
   }
   comparisons.applyBoneTransform = { medianMs: a.medianMs, samples: a.samples, maxDiffToLbs: check };
 }
+comparisons.tangents = timeTangents(built.gcs.deformer, frames.walk, budget(400));
 results.comparisons = comparisons;
+
+/**
+ * A normal-mapped character: the default GCS with tangents (one deform writes positions, normals
+ * and tangents), timed frame by frame against the same GCS without them (timeInterleaved).
+ */
+function timeTangents(plain, fr, timing) {
+  if (!plain) return null;
+  const d = rig.buildGcs({ sections });
+  try {
+    // Unit tangents perpendicular to the rest normals (any unit tangents cost the same).
+    const n = input.normals, t = new Float32Array(4 * rig.vertexCount);
+    for (let v = 0; v < rig.vertexCount; v++) {
+      const x = n[3 * v], y = n[3 * v + 1], z = n[3 * v + 2], side = Math.abs(y) < 0.9;
+      const a = side ? -z : 0, b = side ? 0 : z, c = side ? x : -y, l = Math.hypot(a, b, c) || 1; // n × (0,1,0) or n × (1,0,0)
+      t.set([a / l, b / l, c / l, 1], 4 * v);
+    }
+    d.setTangents(t);
+    const r = timeInterleaved(fr.length, [(f) => plain.deform(fr[f]), (f) => d.deform(fr[f])], timing);
+    log(`bench: GCS default with tangents (walk): ${ms(r[1].medianMs)} ms, without ${ms(r[0].medianMs)} ms`);
+    return { medianMs: r[1].medianMs, withoutMs: r[0].medianMs, ratio: r[1].medianMs / r[0].medianMs };
+  } finally {
+    d.dispose();
+  }
+}
 
 function skinOfCurrentPose(mesh) {
   const out = new Float32Array(mesh.skeleton.bones.length * 16);
@@ -420,6 +448,7 @@ target('classic resampling (17 k)', results.rebuild.classicMs, '≤ 30 ms',
   results.rebuild.classicError ? `n/a: ${results.rebuild.classicError.code}: ${results.rebuild.classicError.message}` : '');
 
 results.targets.push(...results.crowd.targets);
+if (args.save) saveFigures(results, new URL('../docs/figures.json', import.meta.url));
 
 // ---------------------------------------------------------------- output
 if (args.json) {
@@ -449,6 +478,8 @@ if (c.js) rows2.push(['GCS in plain JavaScript', ms(c.js.medianMs), c.js.medianM
 rows2.push([`wasm memcpy of ${(c.memcpy.bytes / 1024).toFixed(0)} KiB`, ms(c.memcpy.medianMs), `${(walkMs / c.memcpy.medianMs).toFixed(2)}× the memcpy`, 'bytes read = bytes written']);
 rows2.push(['three.js applyBoneTransform', ms(c.applyBoneTransform.medianMs), `${(c.applyBoneTransform.medianMs / walkMs).toFixed(0)}× faster`,
   `positions only; vs our LBS ${c.applyBoneTransform.maxDiffToLbs === null ? 'n/a' : c.applyBoneTransform.maxDiffToLbs.toExponential(1)}`]);
+if (c.tangents) rows2.push(['GCS default with tangents (normal maps)', ms(c.tangents.medianMs), `${c.tangents.ratio.toFixed(2)}× without tangents`,
+  'one deform: positions, normals, tangents']);
 rows2.push(['SkinDeformer.update() (GCS)', ms(results.adapter.updateMs), '', 'world + skin matrices + deform']);
 rows2.push(['AnimationMixer.setTime', ms(results.adapter.mixerMs), '', 'three.js, for scale']);
 console.log(fmtTable(rows2));

@@ -16,7 +16,7 @@ import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { characterHeight, loadGltfFile, sampleClip } from '../packages/cli/dist/gltf-node.js';
-import { classicAtBudget, classicFigures, classicOffSurface, identitySkin, meshBorder } from '../dist/measure.js';
+import { classicAtBudget, classicBandQuality, classicFigures, classicOffSurface, identitySkin, meshBorder, rigidRebind } from '../dist/measure.js';
 import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';
 
@@ -69,11 +69,13 @@ console.log(args.markdown ? markdownTable(rows) : table(rows));
 
 // Off the skin: each classic output vertex's distance to the DQS-posed source surface.
 const FRAMES_PER_CLIP = 6;
-const off = [['character / mesh', 'frames', 'off-surface p99 %', 'max %', 'worst parts (reason: p99 / max %)', 'carried off-surface']];
+const off = [['character / mesh', 'frames', 'off-surface p99 %', 'max %', 'worst parts (reason: p99 / max %)', 'carried off-surface',
+  'band triangles: min angle ° / under 5° / aspect max']];
 for (const ch of characters) {
   const heights = characterHeight(ch.meshes);
-  ch.meshes.forEach((mesh, i) => {
-    const input = rigInputFromSkinnedMesh(mesh);
+  ch.meshes.flatMap((mesh, i) => [[mesh, i, false], [mesh, i, true]]).forEach(([mesh, i, rigid]) => {
+    const own = rigInputFromSkinnedMesh(mesh);
+    const input = rigid ? rigidRebind(own) : own;  // rigid: a rig of rigid parts, like X Bot
     const rig = gcs.createRig(input);
     const d = rig.buildClassic();
     const sampled = ch.clips.flatMap((clip) => sampleClip(mesh, clip, FRAMES_PER_CLIP));
@@ -83,8 +85,11 @@ for (const ch of characters) {
     const worst = [...r.parts].sort((a, b) => b.max - a.max).filter((p) => p.max > 0.005).slice(0, 3)
       .map((p) => `${name(p.joint)} (${p.reason}: ${num(p.p99, 2)} / ${num(p.max, 2)})`).join(', ');
     const offParts = d.parts.filter((p) => p.reason === 'off-surface').map((p) => name(p.joint));
-    off.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}`, String(frames.length), num(r.p99, 2), num(r.max, 2),
-      worst || '— (all carried: on the skin)', offParts.length ? offParts.join(', ') : '—']);
+    d.deform(identitySkin(rig.jointCount));
+    const q = classicBandQuality(d);
+    off.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}${rigid ? ' (rigid)' : ''}`, String(frames.length), num(r.p99, 2), num(r.max, 2),
+      worst || '— (all carried: on the skin)', offParts.length ? offParts.join(', ') : '—',
+      q.triangles ? `${num(q.minAngle, 2)} / ${q.under5} of ${q.triangles} / ${num(q.aspectMax, 1)}` : '—']);
     d.dispose();
     rig.dispose();
   });
@@ -95,4 +100,5 @@ console.log('\nLoss: distance of each input vertex the tubes and bands replace t
   '(GCS: 0, it keeps every vertex). GCS budget: the square setting contours = rays whose output is closest to the input\'s vertex ' +
   'count. Border: welded edges used by one triangle, input / output at 25 × 20 and at the budget. Off-surface: distance of each ' +
   `output vertex to the source surface as DQS poses it, ${FRAMES_PER_CLIP} frames per clip, bulge 0.3, % of the character's height ` +
-  '(targets: p99 ≤ 1, max ≤ 2.5); carried skin moves by DQS of its own weights, so it lies on that surface.');
+  '(targets: p99 ≤ 1, max ≤ 2.5); carried skin moves by DQS of its own weights, so it lies on that surface. (rigid): the same mesh ' +
+  'with every vertex bound 100 % to its dominant joint. Band triangles: those joining a tube\'s end ring to carried skin, at the bind pose.');

@@ -1,9 +1,11 @@
 #!/usr/bin/env node
 // Close-ups of the classic model against GCS for docs/classic.md: the demo with Cesium Man paused
 // in a stride, coloured by section / contour (carried skin pale grey), the shared camera moved close
-// to the hips and legs, then to the shoulder and arm (GCS left, classic right).
+// to the hips and legs, then to the shoulder and arm (GCS left, classic right); then our human's
+// left hip, where the zip band between the thigh's tube and the carried crotch has long slivers.
 //
-//   node scripts/screenshot-classic.mjs                     → docs/classic-hips.png, docs/classic-arm.png
+//   node scripts/screenshot-classic.mjs                     → docs/classic-hips.png, docs/classic-arm.png,
+//                                                             docs/classic-bands.png
 //   node scripts/screenshot-classic.mjs --out DIR --suffix -before
 //                                                           → DIR/classic-hips-before.png, …
 // (The "before" pictures in docs/ were taken with the wasm of commit a0a4518 copied over
@@ -24,18 +26,23 @@ try {
   const page = await context.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  await page.goto(`${url}?model=cesiumman&colour=1&paused=1`);
-  await page.waitForFunction(() => window.__demo !== undefined);
-  await page.evaluate(() => window.__demo.ready);
-  await page.evaluate(() => window.__demo.idle());
-  const message = await page.evaluate(() => window.__demo.error());
-  if (message) throw new Error(`the page says: ${message}`);
-  await page.evaluate(() => window.__demo.pause(0.9));
   const shots = [
-    { file: `classic-hips${suffix}.png`, eye: [0.75, 1.05, 1.25], target: [0, 0.78, 0] },
-    { file: `classic-arm${suffix}.png`, eye: [1.5, 1.2, 0.9], target: [0.15, 0.95, 0] },
+    { query: '?model=cesiumman&colour=1&paused=1', file: `classic-hips${suffix}.png`, eye: [0.75, 1.05, 1.25], target: [0, 0.78, 0] },
+    { query: '?model=cesiumman&colour=1&paused=1', file: `classic-arm${suffix}.png`, eye: [1.5, 1.2, 0.9], target: [0.15, 0.95, 0] },
+    { query: '?colour=1&paused=1&wireframe=1', file: `classic-bands${suffix}.png`, eye: [0.55, 0.95, 0.95], target: [0.08, 0.78, 0] },
   ];
+  let loaded = '';
   for (const shot of shots) {
+    if (shot.query !== loaded) {
+      await page.goto(`${url}${shot.query}`);
+      await page.waitForFunction(() => window.__demo !== undefined);
+      await page.evaluate(() => window.__demo.ready);
+      await page.evaluate(() => window.__demo.idle());
+      const message = await page.evaluate(() => window.__demo.error());
+      if (message) throw new Error(`the page says: ${message}`);
+      await page.evaluate(() => window.__demo.pause(0.9));
+      loaded = shot.query;
+    }
     await page.evaluate(([eye, target]) => window.__demo.lookAt(eye, target), [shot.eye, shot.target]);
     await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
     if (errors.length) throw new Error(`page errors: ${errors.join('; ')}`);

@@ -15,6 +15,7 @@ import { EXTMeshoptCompression, KHRMeshQuantization } from '@gltf-transform/exte
 import { meshopt, quantize } from '@gltf-transform/functions';
 import { MeshoptEncoder } from 'meshoptimizer';
 import { npm, packTarballs, ROOT, sizeOf, userEnv, type Tarballs } from './helpers/pack.js';
+import { quoted, quotes } from './helpers/readme.js';
 import { startRegistry, upstreamRegistry } from './helpers/registry.js';
 // @ts-expect-error: a plain .mjs script, no types
 import { installedSizes } from '../scripts/install-size.mjs';
@@ -66,6 +67,11 @@ describe("a library user: `npm install gcs-skin three` in an empty folder", () =
       'npm install gcs-skin three': sizes,
     })}`);
     expect(Object.keys(sizes.packages).sort()).toEqual(['gcs-skin', 'three']);
+    // As the README quotes them (MB of 10^6 bytes on disk, the tarball in kB of 1000): within 5 % or the quote's rounding.
+    const [library, three, tarball] = quoted(/([\d.]+) MB of gcs-skin beside three's ([\d.]+) MB, where it was [\d.]+ MB with the glTF\s+decoders\s+\(tarball (\d+) KB/);
+    const measured = { library: sizes.packages['gcs-skin'] / 1e6, three: sizes.packages.three / 1e6, tarball: sizeOf(packed.library) / 1000 };
+    expect({ library: quotes(library, measured.library), three: quotes(three, measured.three), tarball: quotes(tarball, measured.tarball) },
+      `README: ${library} MB, three ${three} MB, tarball ${tarball} KB; measured ${JSON.stringify(measured)}`).toEqual({ library: true, three: true, tarball: true });
     for (const name of CLI_ONLY) expect(existsSync(join(a, 'node_modules', name)), name).toBe(false);
     // The library's files only: no command-line modules (they are @gcs-skin/cli's).
     expect(existsSync(join(a, 'node_modules/gcs-skin/dist/cli'))).toBe(false);

@@ -1,11 +1,13 @@
 // The issue's acceptance test: the README's "Using it with three.js" path, followed to the letter
-// by a newcomer outside this repository. Both packages are packed into tarballs (from a copy of
-// their sources, so `prepack` builds there). A fresh Vite + TypeScript app is made in a temp folder
+// by a newcomer outside this repository. A fresh Vite + TypeScript app is made in a temp folder
 // as create-vite 9.3.0's vanilla-ts template makes it (tests/browser/app-fixture: its index.html,
 // without the template's favicon, and its tsconfig.json; vite and typescript at this repo's
 // versions); then each `npm install` line of the README's sh block runs there as written, the
-// package `gcs-skin` taken from its tarball and every other from this repo's versions (nothing
-// else is installed: a package the README forgets, like @types/three, fails `tsc`); src/main.ts is
+// library from the README's git URL pointing at a git repository of this checkout (npm clones it,
+// installs its dev dependencies and builds it there), then again from the library's tarball (packed
+// from a copy of the sources, so `prepack` builds there): both routes must install the same files.
+// Every other package comes at this repo's version (nothing else is installed: a package the README
+// forgets, like @types/three, fails `tsc`); src/main.ts is
 // the README's ts block itself, between one import and one call of a test hook
 // (app-fixture/src/test-hook.ts: a known scene, fixed clip times, switches). It must type-check
 // with `tsc --noEmit --strict`, build with `vite build` and, served by `vite preview` in headless
@@ -17,17 +19,21 @@
 // and keep doing it through a clip change, rebuilds ('gcs' → 'dqs' → 'gcs') and dispose (then
 // the original SkinnedMeshes draw again, the same pixels as three's), with no page or WebGL error,
 // with no scrollbar (the page needs no CSS the README does not show). The README's WebGPURenderer
-// block is type-checked in the same app. Characters from ../shared/models, served to the page as
+// block is the app's second page (webgpu.html, the same hook): it type-checks, fills the window
+// with no scrollbar and draws the character (GCS on the GPU backend, TSL) where three's own
+// skinning draws it. Characters from ../shared/models, served to the page as
 // the README's 'character.glb' (never copied into the repository; skipped, with the reason
 // printed, when absent): Soldier (two skinned meshes on their own skeletons) and CesiumMan (textured).
 import { spawn, spawnSync, type ChildProcess } from 'node:child_process';
+import { createHash } from 'node:crypto';
 import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
-import { packTarballs, userEnv } from '../helpers/pack.js';
+import { packTarballs, snapshotRepository, userEnv } from '../helpers/pack.js';
+import { README_REPOSITORY, readmeBlocks } from '../helpers/readme.js';
 import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
@@ -69,18 +75,6 @@ const SILHOUETTE_IOU = 0.93;
  * Required: three's above 0.1, and each method's at least 0.9× three's.
  */
 const SHADOW_MIN = 0.1;
-
-/** The README's fenced blocks of a language under a heading (up to the next heading of that level or higher). */
-function readmeBlocks(heading: string, lang: string): string[] {
-  const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
-  const start = readme.indexOf(`\n${heading}\n`);
-  if (start < 0) throw new Error(`README.md has no heading "${heading}"`);
-  const level = /^#+/.exec(heading)![0].length;
-  const rest = readme.slice(start + heading.length + 2);
-  const end = rest.search(new RegExp(`\\n#{1,${level}} `));
-  const section = end < 0 ? rest : rest.slice(0, end);
-  return [...section.matchAll(new RegExp(`\`\`\`${lang}\\n([\\s\\S]*?)\`\`\``, 'g'))].map((m) => m[1]);
-}
 
 const USING = '## Using it with three.js';
 /** The README's install commands: `npm install [-D] names…` lines of its sh block, comments dropped. */
@@ -137,9 +131,24 @@ function timed<T>(name: string, f: () => T): T {
   }
 }
 
-describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (installed tarball)', () => {
+/** Every file of an installed package, path → sha1 (to compare two installs of it). */
+function fileHashes(root: string, sub = ''): Record<string, string> {
+  const out: Record<string, string> = {};
+  for (const entry of readdirSync(join(root, sub), { withFileTypes: true })) {
+    const path = sub ? `${sub}/${entry.name}` : entry.name;
+    if (entry.isDirectory()) Object.assign(out, fileHashes(root, path));
+    else out[path] = createHash('sha1').update(readFileSync(join(root, path))).digest('hex');
+  }
+  return out;
+}
+
+/** The package gcs-skin as installed from the git URL and from the tarball (the README's two routes). */
+const installed: { git?: Record<string, string>; tarball?: Record<string, string> } = {};
+
+describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (installed from the git URL, then the tarball)', () => {
   beforeAll(async () => {
     dir = mkdtempSync(join(tmpdir(), 'gcs-skin-app-'));
+    const repository = timed('snapshot', () => snapshotRepository(join(dir, 'repo')));
     const packed = timed('pack', () => packTarballs(dir));
 
     // The app as create-vite writes it, with no dependency but its tools.
@@ -151,10 +160,16 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       devDependencies: { typescript: versionOf('typescript'), vite: versionOf('vite') },
     }, null, 2));
     timed('install', () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline'], app));
-    // The README's install lines, as written: gcs-skin from its tarball, any other at this repo's version.
-    for (const { flags, names } of readmeInstalls()) {
-      const specs = names.map((n) => (n === 'gcs-skin' ? packed.library : n === '@gcs-skin/cli' ? packed.cli : `${n}@${versionOf(n)}`));
-      timed(`npm install ${[...flags, ...names].join(' ')}`, () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', ...flags, ...specs], app));
+    // The README's install lines, as written: the library from its git URL (this checkout as a
+    // repository: npm clones it, installs its dev dependencies and builds there), any other package at
+    // this repo's version. Then the same lines with the library's tarball, the README's other route:
+    // both must install the same files (the app is built and drawn with the second).
+    for (const [route, library] of [['git', repository], ['tarball', packed.library]] as const) {
+      for (const { flags, names } of readmeInstalls()) {
+        const specs = names.map((n) => (n === `git+${README_REPOSITORY}` ? library : `${n}@${versionOf(n)}`));
+        timed(`${route}: npm install ${[...flags, ...names].join(' ')}`, () => run(npm, ['install', '--no-audit', '--no-fund', '--prefer-offline', ...flags, ...specs], app));
+      }
+      installed[route] = fileHashes(join(app, 'node_modules/gcs-skin'));
     }
     // The README's example itself, and the same without gcs-skin for the reference page.
     const [example] = readmeBlocks(USING, 'ts');
@@ -165,14 +180,22 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
     const page = readFileSync(join(app, 'index.html'), 'utf8');
     writeFileSync(join(app, 'reference.html'), page.replace('/src/main.ts', '/src/reference.ts'));
     const [webgpu] = readmeBlocks('### With WebGPURenderer', 'ts');
-    writeFileSync(join(app, 'src/webgpu.ts'), webgpu);
+    writeFileSync(join(app, 'src/webgpu.ts'), `import { installTestHook } from './test-hook';\n${webgpu}\n${hook}\n`);
+    writeFileSync(join(app, 'webgpu.html'), page.replace('/src/main.ts', '/src/webgpu.ts'));
 
     const port = await freePort();
     preview = spawn(join(app, 'node_modules/.bin/vite'), ['preview', '--host', '127.0.0.1', '--port', String(port), '--strictPort'], {
       cwd: app, stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, NO_COLOR: '1' }, detached: false,
     });
     url = `http://127.0.0.1:${port}/`;
-  }, 240000);
+  }, 480000);
+
+  test('the git URL and the tarball install the same package: built dist/ and the committed wasm', () => {
+    expect(installed.git?.['dist/three.js'], 'the git install has no built dist/').toBeDefined();
+    expect(installed.git).toEqual(installed.tarball);
+    const wasm = createHash('sha1').update(readFileSync(join(ROOT, 'web/lib/gcs-skin.wasm'))).digest('hex');
+    expect(installed.git?.['dist/gcs-skin.wasm']).toBe(wasm);
+  });
 
   afterAll(async () => {
     await context?.close();
@@ -267,6 +290,14 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       await gcsPage.close();
       lap('gcs lifecycle');
 
+      // The README's WebGPURenderer example (its WebGL2 backend here): GCS in the vertex stage.
+      const gpuPage = await open(context, `${url}webgpu.html?${clip}`, model);
+      lap('open webgpu');
+      expect(await gpuPage.page.evaluate(() => [window.__app.method(), window.__app.backend()])).toEqual(['gcs', 'gpu']);
+      const webgpuSil = await shot(gpuPage.page, { ground: false, character: true });
+      await gpuPage.close();
+      lap('webgpu shots');
+
       const m = {
         silhouetteArea: await area(lab, ref.sil),
         lbsFullDiff: await diff(lab, lbsFull, ref.full),
@@ -279,16 +310,17 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
         gcs2Iou: await iou(lab, gcs2Sil, ref2.sil),
         dqsIou: await iou(lab, dqsSil, ref2.sil),
         regcsDiff: await diff(lab, regcsFull, gcs2Full),
+        webgpuIou: await iou(lab, webgpuSil, ref.sil),
         disposedDiff: await diff(lab, disposedFull, ref2.full),
         disposedExact: await exact(lab, disposedFull, ref2.full),
         steps: (lap('measures'), steps),
-        errors: [...three.errors, ...lbs.errors, ...gcsPage.errors],
+        errors: [...three.errors, ...lbs.errors, ...gcsPage.errors, ...gpuPage.errors],
         ms: Math.round(performance.now() - t0),
       };
       console.log(`app test ${c.file}: ${JSON.stringify(m)}`);
       if (process.env.APP_TEST_SHOTS) { // keep the pictures to look at
         mkdirSync(process.env.APP_TEST_SHOTS, { recursive: true });
-        const shots = { refFull: ref.full, refSil: ref.sil, refEmpty: ref.empty, ref2Full: ref2.full, lbsFull, gcsFull, gcs2Full, dqsSil, disposedFull };
+        const shots = { webgpuSil, refFull: ref.full, refSil: ref.sil, refEmpty: ref.empty, ref2Full: ref2.full, lbsFull, gcsFull, gcs2Full, dqsSil, disposedFull };
         for (const [k, v] of Object.entries(shots)) writeFileSync(join(process.env.APP_TEST_SHOTS, `${c.file}-${k}.png`), Buffer.from(v, 'base64'));
       }
       expect(m.errors).toEqual([]);
@@ -300,6 +332,7 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
       expect(m.gcsIou).toBeGreaterThan(SILHOUETTE_IOU);
       expect(m.gcs2Iou).toBeGreaterThan(SILHOUETTE_IOU);
       expect(m.dqsIou).toBeGreaterThan(SILHOUETTE_IOU);
+      expect(m.webgpuIou).toBeGreaterThan(SILHOUETTE_IOU); // the WebGPURenderer example draws it where three does
       expect(m.regcsDiff).toBeLessThanOrEqual(LBS_TOLERANCE); // the same build again draws the same picture
       expect(m.disposedDiff).toBeLessThanOrEqual(LBS_TOLERANCE); // three's own skinning again
     }, 150000);
@@ -310,7 +343,7 @@ test("the README's install lines and example are what the app is made of", () =>
   // What the app test takes from README.md: the install lines (library, three, three's types) and
   // an example that loads 'character.glb' and keeps `character` (the hook's one call names it).
   const installs = readmeInstalls();
-  expect(installs.flatMap((i) => i.names)).toEqual(expect.arrayContaining(['gcs-skin', 'three', '@types/three']));
+  expect(installs.flatMap((i) => i.names)).toEqual(expect.arrayContaining([`git+${README_REPOSITORY}`, 'three', '@types/three']));
   const [example] = readmeBlocks(USING, 'ts');
   expect(example).toContain("loadAsync('character.glb')");
   for (const name of ['renderer', 'scene', 'camera', 'gltf', 'mixer', 'character'])
@@ -337,6 +370,7 @@ interface AppHook {
   skinnedMeshes(): number;
   deformedMeshes(): number;
   method(): string;
+  backend(): string;
   textured(): boolean;
   play(name: string): void;
   rebuild(method: 'gcs' | 'lbs' | 'dqs' | 'classic'): void;

@@ -237,3 +237,47 @@ describe.skipIf(!!reason || !!noCesium8)('8 influences per vertex on WebGPURende
     }
   }
 });
+
+/** Velocity: at most this share of the pixels either skin covers may differ from three.js's own skinning by more than 1 px (or 10 %). */
+const VELOCITY_SHARE = 0.05;
+
+describe.skipIf(!!reason || !!noCesium8)('velocity on WebGPURenderer: a velocity MRT pass (pass + mrt({ output, velocity }))', () => {
+  // A crowd in plain mode: with velocity, three.js adds the previous instance matrices (4 vertex
+  // attributes) to the crowd's 4 + 4, and the smooth mode's two section attributes would pass
+  // WebGL2's 16 (docs/gpu.md).
+  for (const kind of ['joints', 'sections', 'cpu', 'crowd'] as const) {
+    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : `GPU backend, ${kind} path`;
+    test(`CesiumMan walking, ${what}: velocity as three.js's skinning writes it; paused, zero`, async () => {
+      const r = await call<{ backends: string[]; vsThree: number; moving: number; largest: number; pausedLargest: number; threePausedLargest: number }>(
+        'velocity', `/@fs${CESIUM_8_SOURCE}`, kind, 0.5, 1 / 30, kind === 'crowd' ? { smooth: false } : {});
+      console.log(`velocity ${kind}: ${(100 * r.vsThree).toFixed(2)} % of the pixels differ from three.js's skinning (> 1 px or 10 %); ${(100 * r.moving).toFixed(1)} % of ours move > 1 px, the most ${r.largest.toFixed(2)} px; paused: ours ${r.pausedLargest.toExponential(2)} px, three's ${r.threePausedLargest.toExponential(2)} px`);
+      expect(r.backends.every((b) => b === (kind === 'cpu' ? 'cpu' : 'gpu'))).toBe(true);
+      expect(r.moving).toBeGreaterThan(0.2); // a walk, not a still picture
+      expect(r.vsThree).toBeLessThanOrEqual(VELOCITY_SHARE);
+      expect(r.pausedLargest).toBeLessThan(0.01);
+      expect(errors).toEqual([]);
+    });
+  }
+});
+
+const TANGENT_FILE = join(ROOT, 'build', 'test-models', 'cesium-tangents.glb');
+
+describe.skipIf(!!reason || !!noCesium8)('a normal-mapped character (CesiumMan with MikkTSpace tangents): tangents deformed in the core pass', () => {
+  beforeAll(async () => {
+    mkdirSync(join(ROOT, 'build', 'test-models'), { recursive: true });
+    const { tangentGlb } = await import('../helpers/tangents-glb.js');
+    expect(await tangentGlb(CESIUM_8_SOURCE, TANGENT_FILE)).toBeGreaterThan(0);
+  });
+  for (const which of ['webgl', 'webgpu'] as const) {
+    test(`${which === 'webgl' ? 'WebGLRenderer (gcs-skin/three)' : 'WebGPURenderer (gcs-skin/webgpu)'}: LBS lit as three.js's skinning; GCS on the GPU (both paths) as on the CPU`, async () => {
+      const r = await call<{ tangents: boolean[]; lbsVsThree: Diff; mapShows: Diff; gpuVsCpu: Diff[]; coverage: number }>('normalMapped', `/@fs${TANGENT_FILE}`, which, 1.0);
+      console.log(`normal-mapped CesiumMan, ${which}: our LBS vs three.js's skinning ${pct(r.lbsVsThree)}; the normal map changes ${pct(r.mapShows)}; GCS GPU vs CPU ${r.gpuVsCpu.map(pct).join('; ')}; coverage ${(100 * r.coverage).toFixed(1)} %`);
+      expect(r.tangents.every(Boolean)).toBe(true);
+      expect(r.coverage).toBeGreaterThan(0.02);
+      expect(r.mapShows.covered).toBeGreaterThan(0.1); // the lighting depends on the tangent frame
+      expect(r.lbsVsThree.image).toBeLessThanOrEqual(PIXEL_SHARE);
+      for (const d of r.gpuVsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+      expect(errors).toEqual([]);
+    });
+  }
+});

@@ -1,9 +1,10 @@
 // Packs both packages as `npm publish` would, from a copy of their sources (the library's
 // `prepack` builds dist/ and packages/cli/dist there, never under the feet of other test files
-// that use this checkout's builds). Used by tests/package.test.ts and tests/browser/app.test.ts.
+// that use this checkout's builds); and makes a git repository of this checkout for the README's
+// git-URL install. Used by tests/package.test.ts, tests/clone.test.ts and tests/browser/app.test.ts.
 import { execFileSync } from 'node:child_process';
-import { cpSync, existsSync, readFileSync, readdirSync, rmSync, statSync, symlinkSync, writeFileSync } from 'node:fs';
-import { join, resolve } from 'node:path';
+import { cpSync, existsSync, mkdirSync, readFileSync, readdirSync, rmSync, statSync, symlinkSync, writeFileSync } from 'node:fs';
+import { dirname, join, resolve } from 'node:path';
 
 export const ROOT = resolve(__dirname, '../..');
 export const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
@@ -57,6 +58,25 @@ export function packTarballs(dir: string, version?: string): Tarballs {
 export function userEnv(extra: Record<string, string> = {}): NodeJS.ProcessEnv {
   const env = Object.fromEntries(Object.entries(process.env).filter(([k]) => !/^npm_/i.test(k)));
   return { ...env, ...extra };
+}
+
+/**
+ * A git repository in `dir` holding this checkout's files as they are on disk (committed or not,
+ * untracked ones included, ignored ones left out) in one commit: what a push of the working tree
+ * would publish. Returns its `git+file://` URL, the form `npm install` takes for a git dependency.
+ */
+export function snapshotRepository(dir: string): string {
+  const files = execFileSync('git', ['ls-files', '-z', '--cached', '--others', '--exclude-standard'], { cwd: ROOT, encoding: 'utf8' })
+    .split('\0').filter((f) => f && existsSync(join(ROOT, f)));
+  for (const f of files) {
+    mkdirSync(dirname(join(dir, f)), { recursive: true });
+    cpSync(join(ROOT, f), join(dir, f));
+  }
+  const git = (...args: string[]) => execFileSync('git', args, { cwd: dir, stdio: 'ignore' });
+  git('init', '-q');
+  git('add', '-A');
+  git('-c', 'user.name=test', '-c', 'user.email=test@localhost', '-c', 'commit.gpgsign=false', 'commit', '-q', '-m', 'snapshot');
+  return `git+file://${dir}`;
 }
 
 /** Bytes of a file. */

@@ -13,8 +13,10 @@
 // settings that must be rejected. The rig is then destroyed (a deformer keeps no pointer to it) and
 // the deformers run through fuzzed frames of skin matrices: identity, rigid, uniform and
 // non-uniform scales (0.01 … ×1e20, 1e-20), mirrors, shears, collapsed and raw matrices; GCS, LBS
-// and DQS sometimes with morph targets (fuzzed influences per frame). Rejected calls (bad matrix
-// count, null or non-finite matrices, bad morph targets or influences, set_bulge) are mixed in.
+// and DQS sometimes with morph targets (fuzzed influences per frame) and tangents, any deformer
+// sometimes keeping its previous positions (each deform's previous = the last one's, bit for bit). Rejected calls
+// (bad matrix count, null or non-finite matrices, bad morph targets or influences, bad tangents,
+// set_bulge) are mixed in.
 //
 // Checks: every call reports its outcome through gcs_last_error_code (rejections with the
 // documented code and a message); a rejected call changes nothing (output arrays bit-identical
@@ -28,7 +30,8 @@
 // unit normals (|1 − |n|| ≤ 1e-3) where the input normal was unit (or computed by the rig): always
 // for LBS and DQS (their contract covers collapsed matrices), for GCS (and classic, when every
 // input normal was unit) when every skin matrix of the frame is a rotation times a positive
-// diagonal scale (finite, non-degenerate).
+// diagonal scale (finite, non-degenerate); tangents alike (unit xyz where normals are, finite, the
+// handedness w carried bit for bit).
 //
 // Value bounds: positions |x| ≤ 1e4 (morphed: ≤ 1e4 + 3 targets · influence 10 · 1e4 < 1e6) and
 // skin matrix entries |m| ≤ 1e21 (scales up to 1e20 times shears of at most 3), so the exact
@@ -507,7 +510,7 @@ double fuzzScale(FuzzedDataProvider& f) {
 // One skin matrix (16 floats). Returns true when it is "nice": a rotation times a positive
 // diagonal scale plus a translation (finite and non-degenerate).
 bool fuzzMatrix(FuzzedDataProvider& f, float* out, float coordScale) {
-  const int kind = f.ConsumeIntegralInRange<int>(0, 8);
+  const int kind = f.ConsumeIntegralInRange<int>(0, 10);
   double r[9], k[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 0};
   identity3(r);
   bool nice = true;
@@ -625,6 +628,9 @@ struct Built {
   std::string label;
   float* positions = nullptr;
   float* normals = nullptr;
+  bool keepPrevious = false;        // keep_previous_positions: positions alternate between two arrays
+  float* tangents = nullptr;        // set_tangents: the output, and the w of each rig vertex
+  std::vector<float> tangentW;
   uint32_t vertexCount = 0;
   uint32_t sections = 0;  // GCS
   std::vector<uint32_t> outputOf;  // GCS, LBS, DQS: the output vertex of each rig vertex
@@ -816,6 +822,17 @@ void checkFrame(Built& b, const RigInput& in, const Frame& fr, bool restExact) {
       CHECK(std::fabs(len - 1.0) <= 1e-3, "normal of output vertex %u (rig vertex %d) has length %.9g: (%g, %g, %g)", o,
             src ? int(src[o]) : -1, len, double(n[0]), double(n[1]), double(n[2]));
     }
+  if (b.tangents) {
+    CHECK(gcs_deformer_tangents(d) == b.tangents, "tangent array moved");
+    CHECK(finiteArray(b.tangents, size_t(N) * 4, bad), "non-finite tangent: vertex %zu", bad / 4);
+    for (uint32_t o = 0; o < N; ++o) {
+      const float* t = &b.tangents[4 * size_t(o)];
+      CHECK(t[3] == b.tangentW[src[o]], "tangent w of output vertex %u is %g, set %g", o, double(t[3]), double(b.tangentW[src[o]]));
+      if (!unitCheck) continue;
+      const double len = std::sqrt(double(t[0]) * t[0] + double(t[1]) * t[1] + double(t[2]) * t[2]);
+      CHECK(std::fabs(len - 1.0) <= 1e-3, "tangent of output vertex %u has length %.9g", o, len);
+    }
+  }
   if (b.kind == GCS_KIND_GCS && fr.identity && restExact) {
     for (uint32_t o = 0; o < N; ++o)
       for (int c = 0; c < 3; ++c) {
@@ -863,22 +880,34 @@ void checkGpuSections(const Built& b, const RigInput& in, const Frame& fr);  // 
 // restExact: no morph influence is active, so the identity frame must give the rig's positions
 // (and welded vertices must stay together).
 void deformOk(Built& b, const RigInput& in, const Frame& fr, bool restExact) {
+  std::vector<float> before;
+  if (b.keepPrevious) before.assign(b.positions, b.positions + size_t(b.vertexCount) * 3);
   const int rc = gcs_deformer_deform(b.d, fr.skin.data(), in.jointCount);
   CHECK(rc == 1, "deform rejected valid skin matrices");
   checkOk("deform");
+  if (b.keepPrevious) {
+    // The last frame's positions became the previous ones, bit for bit, in the other array.
+    const float* previous = gcs_deformer_previous_positions(b.d);
+    CHECK(previous == b.positions && gcs_deformer_positions(b.d) != previous, "previous positions: not the last frame's array");
+    CHECK(std::memcmp(previous, before.data(), before.size() * 4) == 0, "previous positions differ from the last frame's");
+    b.positions = gcs_deformer_positions(b.d);
+  }
   checkFrame(b, in, fr, restExact);
   if (b.kind == GCS_KIND_GCS) checkGpuSections(b, in, fr);
 }
 
 struct Snapshot {
-  std::vector<float> positions, normals;
+  std::vector<float> positions, normals, tangents;
   void take(const Built& b) {
     positions.assign(b.positions, b.positions + size_t(b.vertexCount) * 3);
     normals.assign(b.normals, b.normals + size_t(b.vertexCount) * 3);
+    if (b.tangents) tangents.assign(b.tangents, b.tangents + size_t(b.vertexCount) * 4);
+    else tangents.clear();
   }
   bool same(const Built& b) const {
     return std::memcmp(positions.data(), b.positions, positions.size() * 4) == 0 &&
-           std::memcmp(normals.data(), b.normals, normals.size() * 4) == 0;
+           std::memcmp(normals.data(), b.normals, normals.size() * 4) == 0 &&
+           tangents.empty() == !b.tangents && (!b.tangents || std::memcmp(tangents.data(), b.tangents, tangents.size() * 4) == 0);
   }
 };
 
@@ -1122,6 +1151,16 @@ void rejectedDeform(FuzzedDataProvider& f, Built& b, const RigInput& in, const F
   } else if (kind == 8) {  // set_bulge on a GCS / LBS / DQS deformer, or a bad gain on the classic one
     rc = gcs_classic_set_bulge(b.d, morphable ? 1.0f : -1.0f);
     expected = morphable ? GCS_ERR_INVALID_ARGUMENT : GCS_ERR_OUT_OF_RANGE;
+  } else if (kind == 9) {  // tangents on the classic model / a null deformer, or a wrong vertex count
+    std::vector<float> t(size_t(in.vertexCount + 1) * 4, 0.0f);
+    const bool wrongCount = morphable && f.ConsumeBool();
+    rc = gcs_deformer_set_tangents(wrongCount || !morphable ? b.d : nullptr, t.data(), in.vertexCount + (wrongCount ? 1 : 0));
+    expected = wrongCount ? GCS_ERR_LENGTH_MISMATCH : GCS_ERR_INVALID_ARGUMENT;
+  } else if (kind == 10) {  // NaN or infinity in the tangents (the classic model refuses any)
+    std::vector<float> t(size_t(in.vertexCount) * 4, 0.5f);
+    t[f.ConsumeIntegralInRange<size_t>(0, t.size() - 1)] = f.ConsumeBool() ? NAN : INFINITY;
+    rc = gcs_deformer_set_tangents(b.d, t.data(), in.vertexCount);
+    expected = morphable ? GCS_ERR_NON_FINITE : GCS_ERR_INVALID_ARGUMENT;
   } else if (kind == 0) {
     const uint32_t count = f.ConsumeBool() ? J + 1 : J - 1;
     std::vector<float> m(std::max<size_t>(size_t(count) * 16, 1), 1.0f);
@@ -1142,7 +1181,8 @@ void rejectedDeform(FuzzedDataProvider& f, Built& b, const RigInput& in, const F
         expected);
   CHECK(gcs_last_error_message()[0] != '\0', "rejected call without a message");
   CHECK(before.same(b), "a rejected call (kind %d) changed the output arrays", kind);
-  CHECK(gcs_deformer_positions(b.d) == b.positions && gcs_deformer_vertex_count(b.d) == b.vertexCount,
+  CHECK(gcs_deformer_positions(b.d) == b.positions && gcs_deformer_vertex_count(b.d) == b.vertexCount &&
+            gcs_deformer_tangents(b.d) == b.tangents,
         "a rejected call moved the output");
   // Nothing else changed either: the previous frame again gives the same output, bit for bit.
   deformOk(b, in, fr, !morphs.active());
@@ -1365,6 +1405,52 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
     }
   log("morphs: %u targets%s\n", morphs.targets, morphs.withNormals ? " with normals" : "");
 
+  // ---- tangents (GCS, LBS, DQS): unit directions (the rig's normals when given, else hashed), w ±1
+  if (f.ConsumeBool()) {
+    const uint32_t seed = f.ConsumeIntegral<uint32_t>();
+    std::vector<float> tangents(size_t(in.vertexCount) * 4);
+    for (uint32_t v = 0; v < in.vertexCount; ++v) {
+      float* t = &tangents[4 * size_t(v)];
+      for (int c = 0; c < 3; ++c) t[c] = in.withNormals ? in.normals[3 * size_t(v) + c] : hashValue(seed, 3 * v + c);
+      const float len = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      if (len > 1e-3f && std::isfinite(len)) for (int c = 0; c < 3; ++c) t[c] /= len;
+      else t[0] = 1.0f, t[1] = t[2] = 0.0f;
+      t[3] = hashValue(seed + 7, v) < 0.0f ? -1.0f : 1.0f;
+    }
+    for (Built& b : built) {
+      g_context = std::string(ctx) + "; " + b.label + "; set_tangents";
+      if (b.kind == GCS_KIND_CLASSIC) {
+        CHECK(gcs_deformer_set_tangents(b.d, tangents.data(), in.vertexCount) == 0, "the classic model took tangents");
+        checkRejected("set_tangents(classic)", codeInvalid);
+        CHECK(gcs_deformer_tangents(b.d) == nullptr, "the classic model has tangents");
+        continue;
+      }
+      CHECK(gcs_deformer_set_tangents(b.d, tangents.data(), in.vertexCount) == 1, "set_tangents rejected valid tangents");
+      checkOk("set_tangents");
+      b.tangents = gcs_deformer_tangents(b.d);
+      CHECK(b.tangents != nullptr, "no tangent output after set_tangents");
+      b.tangentW.resize(in.vertexCount);
+      for (uint32_t v = 0; v < in.vertexCount; ++v) b.tangentW[v] = tangents[4 * size_t(v) + 3];
+      // Until the next deform: the rest tangents in the output order.
+      const uint32_t* src = gcs_deformer_source_vertex(b.d);
+      for (uint32_t o = 0; o < b.vertexCount; ++o)
+        CHECK(std::memcmp(&b.tangents[4 * size_t(o)], &tangents[4 * size_t(src[o])], 16) == 0, "output vertex %u: not its rest tangent", o);
+    }
+  }
+  log("tangents: %s\n", built.front().tangents || built.back().tangents ? "set" : "none");
+
+  // ---- previous positions (velocity), any deformer
+  if (f.ConsumeBool())
+    for (Built& b : built) {
+      g_context = std::string(ctx) + "; " + b.label + "; keep_previous_positions";
+      CHECK(gcs_deformer_keep_previous_positions(b.d, 1) == 1, "keep_previous_positions failed");
+      checkOk("keep_previous_positions");
+      const float* previous = gcs_deformer_previous_positions(b.d);
+      CHECK(previous && previous != b.positions && std::memcmp(previous, b.positions, size_t(b.vertexCount) * 12) == 0,
+            "the previous positions do not start as the current ones");
+      b.keepPrevious = true;
+    }
+
   // ---- frames
   const uint32_t J = in.jointCount;
   const int frames = f.ConsumeIntegralInRange<int>(1, 4);
@@ -1439,6 +1525,12 @@ void nullHandles() {
   float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   CHECK(gcs_deformer_deform(nullptr, m, 1) == 0, "deform on a null deformer");
   checkRejected("gcs_deformer_deform(null)", codeInvalid);
+  CHECK(gcs_deformer_set_tangents(nullptr, m, 4) == 0, "set_tangents on a null deformer");
+  checkRejected("gcs_deformer_set_tangents(null)", codeInvalid);
+  CHECK(gcs_deformer_tangents(nullptr) == nullptr, "tangents of a null deformer");
+  CHECK(gcs_deformer_keep_previous_positions(nullptr, 1) == 0, "keep_previous_positions on a null deformer");
+  checkRejected("gcs_deformer_keep_previous_positions(null)", codeInvalid);
+  CHECK(gcs_deformer_previous_positions(nullptr) == nullptr, "previous positions of a null deformer");
   CHECK(gcs_deformer_set_morph_targets(nullptr, m, nullptr, 1, 1) == 0, "set_morph_targets on null");
   checkRejected("gcs_deformer_set_morph_targets(null)", codeInvalid);
   CHECK(gcs_deformer_set_morph_influences(nullptr, m, 1) == 0, "set_morph_influences on null");

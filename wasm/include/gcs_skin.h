@@ -9,7 +9,8 @@
  *   2. gcs_build_*()         builds a runtime deformer from a rig (GCS, classic, LBS, DQS).
  *                            A deformer keeps no pointer to the rig: the rig may be destroyed.
  *   3. gcs_deformer_deform() once per frame, from J skinning matrices; writes positions and
- *                            normals into arrays owned by the deformer (no allocation).
+ *                            normals (and tangents, when set) into arrays owned by the deformer
+ *                            (no allocation).
  *   4. gcs_deformer_destroy(), gcs_rig_destroy().
  *
  * Errors: every function that can fail returns 0 (or a null handle) and records an error code
@@ -238,7 +239,37 @@ int gcs_deformer_set_morph_targets(GcsDeformer* deformer, const float* deltas, c
    (O(vertices × non-zero targets) then). Returns 1, or 0 with the error recorded. */
 int gcs_deformer_set_morph_influences(GcsDeformer* deformer, const float* influences, uint32_t targetCount);
 
-/* The output mesh. Arrays are owned by the deformer and stay at the same address for its life. */
+/*
+ * Tangents (normal maps), deformed by the same gcs_deformer_deform call as positions and normals.
+ *   tangents      vertexCount × 4 floats in the RIG's vertex order (glTF TANGENT: xyz a unit
+ *                 direction, w = ±1 the bitangent's handedness); finite. Null removes them.
+ *   vertexCount   must equal the deformer's vertex count (the rig's); ignored when tangents is null.
+ * From then on every gcs_deformer_deform also writes gcs_deformer_tangents(): each xyz turned as the
+ * vertex's normal is (its normal matrix and length fix; a vanished one keeps its rest direction),
+ * its w carried. Until the next deform the output holds the rest tangents. GCS, LBS and DQS (the
+ * classic model resamples the mesh: GCS_ERR_INVALID_ARGUMENT). Replaces any previous tangents.
+ * Returns 1, or 0 with the error recorded (nothing changed).
+ */
+int gcs_deformer_set_tangents(GcsDeformer* deformer, const float* tangents, uint32_t vertexCount);
+/* vertexCount × 4 floats in the output order, or null when the deformer has no tangents. Owned by
+   the deformer; at the same address until the next gcs_deformer_set_tangents. */
+float* gcs_deformer_tangents(GcsDeformer* deformer);
+
+/*
+ * Previous positions (motion vectors: a velocity buffer needs each vertex where it was the frame
+ * before). keep = 1 gives the deformer a second positions array, holding the current positions;
+ * from then on each gcs_deformer_deform writes into the array that held the frame before last and
+ * swaps the two (no copy): gcs_deformer_positions() is this frame's, gcs_deformer_previous_positions()
+ * the last frame's. While kept, gcs_deformer_positions() alternates between the two addresses: read
+ * both pointers after every deform. keep = 0 frees the second array (positions then stay where they
+ * are). A rejected deform swaps nothing. Returns 1, or 0 with the error recorded (nothing changed).
+ */
+int gcs_deformer_keep_previous_positions(GcsDeformer* deformer, int keep);
+/* vertexCount × 3 floats: the positions of the deform before the last one, or null when not kept. */
+float* gcs_deformer_previous_positions(GcsDeformer* deformer);
+
+/* The output mesh. Arrays are owned by the deformer and stay at the same address for its life
+   (positions: see gcs_deformer_keep_previous_positions). */
 uint32_t gcs_deformer_vertex_count(const GcsDeformer* deformer);
 float* gcs_deformer_positions(GcsDeformer* deformer);   /* vertexCount × 3 */
 float* gcs_deformer_normals(GcsDeformer* deformer);     /* vertexCount × 3 */

@@ -145,8 +145,27 @@ int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32
   // glm::mat4 is 16 floats, column-major, no padding: the array can be read in place.
   static_assert(sizeof(glm::mat4) == 16 * sizeof(float), "glm::mat4 must be 16 packed floats");
   d.applyMorphs();
+  if (!d.previousPositions.empty()) d.positions.swap(d.previousPositions);  // last frame's become the previous
   d.deform(reinterpret_cast<const glm::mat4*>(skinMatrices));
   return 1;
+}
+
+int gcs_deformer_keep_previous_positions(GcsDeformer* deformer, int keep) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  gcs::Deformer& d = *deformer->impl;
+  if (!keep) {
+    std::vector<float>().swap(d.previousPositions);
+    return 1;
+  }
+  if (!d.previousPositions.empty()) return 1;
+  if (!gcs::reserveMemory(uint64_t(d.positions.size()) * 4 * 3 / 2 + 4096, "the previous positions")) return 0;
+  d.previousPositions = d.positions;
+  return 1;
+}
+
+float* gcs_deformer_previous_positions(GcsDeformer* d) {
+  return d && !d->impl->previousPositions.empty() ? d->impl->previousPositions.data() : nullptr;
 }
 
 int gcs_deformer_set_morph_targets(GcsDeformer* deformer, const float* deltas, const float* normalDeltas,
@@ -211,6 +230,39 @@ int gcs_deformer_set_morph_influences(GcsDeformer* deformer, const float* influe
   std::copy(influences, influences + targetCount, d.morphInfluences.begin());
   return 1;
 }
+
+int gcs_deformer_set_tangents(GcsDeformer* deformer, const float* tangents, uint32_t vertexCount) {
+  gcs::clearError();
+  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  gcs::Deformer& d = *deformer->impl;
+  if (!d.morphableRestNormals() || d.sourceVertex.size() != d.vertexCount)
+    return fail(GCS_ERR_INVALID_ARGUMENT, "tangents apply to the GCS, LBS and DQS deformers; the classic model resamples the mesh");
+  if (!tangents) {
+    d.restTangents.clear(), d.tangentSigns.clear(), d.tangents.clear(), d.turnedTangents.clear(), d.tangentPassPositions.clear();
+    return 1;
+  }
+  if (vertexCount != d.vertexCount)
+    return fail(GCS_ERR_LENGTH_MISMATCH, "got %u tangents, but the mesh has %u vertices", vertexCount, d.vertexCount);
+  const size_t n = d.vertexCount;
+  if (!gcs::allFinite(tangents, n * 4)) return fail(GCS_ERR_NON_FINITE, "a tangent is NaN or infinite");
+  // Rest xyz, signs, output, the kernels' output and their positions (each with a spare float).
+  if (!gcs::reserveMemory(uint64_t(n) * 4 * (3 + 1 + 4 + 3 + 3) * 3 / 2 + 4096, "the tangents")) return 0;
+  d.restTangents.assign(n * 3 + 1, 0.0f);
+  d.tangentSigns.assign(n, 0.0f);
+  d.tangents.assign(n * 4, 0.0f);
+  d.turnedTangents.assign(n * 3 + 1, 0.0f);
+  d.tangentPassPositions.assign(n * 3 + 1, 0.0f);
+  // Tangents come in rig vertex order; the deformer stores its vertices in its own order.
+  for (uint32_t o = 0; o < d.vertexCount; ++o) {
+    const float* t = tangents + 4 * size_t(d.sourceVertex[o]);
+    for (int c = 0; c < 3; ++c) d.restTangents[3 * size_t(o) + c] = d.turnedTangents[3 * size_t(o) + c] = t[c];
+    d.tangentSigns[o] = t[3];
+  }
+  d.packTangents();
+  return 1;
+}
+
+float* gcs_deformer_tangents(GcsDeformer* d) { return d && !d->impl->tangents.empty() ? d->impl->tangents.data() : nullptr; }
 
 uint32_t gcs_deformer_vertex_count(const GcsDeformer* d) { return d ? d->impl->vertexCount : 0; }
 float* gcs_deformer_positions(GcsDeformer* d) { return d ? d->impl->positions.data() : nullptr; }

@@ -77,6 +77,9 @@ class ClassicModel final : public Deformer {
  public:
   GcsDeformerKind kind() const override { return GCS_KIND_CLASSIC; }
   void deform(const glm::mat4* skin) override;
+  // The rings only (positions of every tube vertex, caps excepted; no normals): what the on-skin
+  // test poses. Returns the frame's scale state.
+  ScaleState poseRings(const glm::mat4* skin);
   float stat(GcsStat which) const override;
   float detailLoss(uint32_t which) const;  // 0: RMS, 1: max, % of height (computed on first use)
 

@@ -35,6 +35,20 @@ class Deformer {
   // Brings the rest arrays to base + Σ influence · delta when the influences changed.
   void applyMorphs();
 
+  // Velocity (gcs_deformer_keep_previous_positions): the last frame's positions, swapped with
+  // `positions` before each deform (no copy); empty when not kept.
+  std::vector<float> previousPositions;
+
+  // Tangents (normal maps, gcs_deformer_set_tangents), in output order: the rest tangents' xyz,
+  // turned like the normals by a second pass of the same kernels, and their w (handedness),
+  // carried; the output, 4 floats per vertex. All empty when the deformer has none.
+  std::vector<float> restTangents, tangentSigns, tangents;
+  // The tangent pass's scratch: the kernels' own output (xyz and a spare lane) and the positions
+  // they also write (discarded).
+  std::vector<float> turnedTangents, tangentPassPositions;
+  // Writes turnedTangents with their signs into `tangents`.
+  void packTangents();
+
   void allocateOutput(uint32_t count) {
     vertexCount = count;
     positions.assign(size_t(count) * 3 + 1, 0.0f);

@@ -1169,6 +1169,17 @@ void GcsDeformerImpl::computeSections(const glm::mat4* skin) {
 
 void GcsDeformerImpl::deform(const glm::mat4* skin) {
   computeSections(skin);
+  transformVertices(restNormals.data(), positions.data(), normals.data());
+  if (!tangents.empty()) {
+    // Tangents turn like normals: the same kernels over the rest tangents (positions discarded).
+    transformVertices(restTangents.data(), tangentPassPositions.data(), turnedTangents.data());
+    packTangents();
+  }
+}
+
+// Every vertex by this frame's section transforms: positions from the rest positions, and
+// `inNrm` (the rest normals, or the rest tangents) turned into `outNrm`.
+void GcsDeformerImpl::transformVertices(const float* inNrm, float* outPos, float* outNrm) {
   const uint32_t S = uint32_t(sections.size());
   // Every scale the same uniform s (and the weights criterion, whose normal matrices are then the
   // rotations of the position matrices, and are not written for blended sections): one matrix, or
@@ -1182,7 +1193,7 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
       if (uniform) {
         const float* f = &blendF[run.first];
         const float* p = &restPositions[o];
-        const float* n = &restNormals[o];
+        const float* n = inNrm + o;
         if (run.third != a) {  // a three-joint lattice cell
           const uint32_t c = run.third;
           const float* g = &blendThirdF[run.first];
@@ -1190,19 +1201,19 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
               rotationBlendFix3(leastRotationTrace(sectionMatrices[a], sectionMatrices[b], sectionMatrices[c]) * invS2);
           withUniformFix(fix3, invS == 1.0f, [&](auto fixTag, auto unitTag) {
             blendRun3UniformT<decltype(fixTag)::value, decltype(unitTag)::value>(
-                sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p, n, &positions[o], &normals[o],
+                sectionMatrices[a], sectionMatrices[b], sectionMatrices[c], invS, f, g, p, n, outPos + o, outNrm + o,
                 run.count);
           });
           continue;
         }
         if (a == b) {
-          transformRunUniform(sectionMatrices[a], invS, p, n, &positions[o], &normals[o], run.count);
+          transformRunUniform(sectionMatrices[a], invS, p, n, outPos + o, outNrm + o, run.count);
           continue;
         }
         const NormalFix fix = rotationBlendFix(rotationTrace(sectionMatrices[a], sectionMatrices[b]) * invS2);
         withUniformFix(fix, invS == 1.0f, [&](auto fixTag, auto unitTag) {
           blendRunUniformT<decltype(fixTag)::value, decltype(unitTag)::value>(
-              sectionMatrices[a], sectionMatrices[b], invS, f, p, n, &positions[o], &normals[o], run.count);
+              sectionMatrices[a], sectionMatrices[b], invS, f, p, n, outPos + o, outNrm + o, run.count);
         });
       } else if (run.third != a) {
         const uint32_t c = run.third;
@@ -1211,13 +1222,13 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
                                   : rotationBlendFix3(leastRotationTrace(normalMatrices[a], normalMatrices[b], normalMatrices[c]));
         blendRun3(sectionMatrices[a], normalMatrices[a], sectionMatrices[b], normalMatrices[b], sectionMatrices[c],
                   normalMatrices[c], fix, &blendF[run.first], &blendThirdF[run.first], &restPositions[o],
-                  &restNormals[o], &positions[o], &normals[o], run.count);
+                  inNrm + o, outPos + o, outNrm + o, run.count);
       } else if (a == b) {
-        transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], &restNormals[o],
-                     &positions[o], &normals[o], run.count);
+        transformRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, &restPositions[o], inNrm + o,
+                     outPos + o, outNrm + o, run.count);
       } else {
         blendRun(sectionMatrices[a], normalMatrices[a], renormalise[a] != 0, sectionMatrices[b], normalMatrices[b],
-                 renormalise[b] != 0, &blendF[run.first], &restPositions[o], &restNormals[o], &positions[o], &normals[o],
+                 renormalise[b] != 0, &blendF[run.first], &restPositions[o], inNrm + o, outPos + o, outNrm + o,
                  run.count);
       }
     }
@@ -1227,11 +1238,11 @@ void GcsDeformerImpl::deform(const glm::mat4* skin) {
     const Section& sec = sections[i];
     size_t o = size_t(sec.first) * 3;
     if (uniform)
-      transformRunUniform(sectionMatrices[i], invS, &restPositions[o], &restNormals[o], &positions[o], &normals[o],
+      transformRunUniform(sectionMatrices[i], invS, &restPositions[o], inNrm + o, outPos + o, outNrm + o,
                           sec.count);
     else
-      transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], &restNormals[o],
-                   &positions[o], &normals[o], sec.count);
+      transformRun(sectionMatrices[i], normalMatrices[i], renormalise[i] != 0, &restPositions[o], inNrm + o,
+                   outPos + o, outNrm + o, sec.count);
   }
 }
 

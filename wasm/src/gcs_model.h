@@ -128,6 +128,7 @@ class GcsDeformerImpl final : public Deformer {
   void sectionTransformsWeights(const glm::mat4* skin, const ScaleState& scale);
   void sectionTransformsWeightsUniform(const glm::mat4* skin, float s);
   void sectionTransformsPaper(const glm::mat4* skin, const ScaleState& scale);
+  void transformVertices(const float* inNrm, float* outPos, float* outNrm);
   void turnAboutCentre(const glm::mat4* skin, const Section& sec, glm::mat4& position) const;
 };
 

@@ -37,7 +37,10 @@ uint64_t skinningPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
 }
 uint64_t classicPeakBytes(uint64_t v, uint64_t i, uint64_t parts, uint64_t contours, uint64_t rays) {
   const uint64_t points = parts * (contours + 2) * (rays + 1);
-  return (v * 300 + i * 48 + points * 100) * 3 / 2 + 65536;  // i: welded edges (16 bytes × 3 per triangle) and loop edges
+  // i: welded edges (16 bytes × 3 per triangle) and loop edges; each part's gathered triangles with
+  // their slabs (a triangle in up to 6 parts' lists, ~60 bytes each); points: rings, and the ray
+  // casts each part keeps across rounds and rebuilds.
+  return (v * 300 + i * 170 + points * 150) * 3 / 2 + 65536;
 }
 
 }  // namespace gcs

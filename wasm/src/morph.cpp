@@ -1,4 +1,5 @@
-// Morph targets on the rest mesh (deformer.h): base + Σ influence · delta, before skinning.
+// What the deformers do to the rest mesh besides skinning (deformer.h): morph targets (base +
+// Σ influence · delta, before skinning) and the tangents' handedness (carried after).
 #include <cmath>
 #include "deformer.h"
 
@@ -32,6 +33,13 @@ void Deformer::applyMorphs() {
     }
   }
   morphApplied = morphInfluences;
+}
+
+void Deformer::packTangents() {
+  const float* in = turnedTangents.data();
+  float* out = tangents.data();
+  for (uint32_t v = 0; v < vertexCount; ++v)
+    out[4 * v] = in[3 * v], out[4 * v + 1] = in[3 * v + 1], out[4 * v + 2] = in[3 * v + 2], out[4 * v + 3] = tangentSigns[v];
 }
 
 }  // namespace gcs

@@ -46,8 +46,18 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind) {
 }
 
 void SkinningDeformer::deform(const glm::mat4* skin) {
-  const uint32_t n = vertexCount;
   const ScaleState scale = decomposeAll(skin, jointCount, poses.data());
+  skinVertices(skin, scale, restNormals.data(), positions.data(), normals.data());
+  if (!tangents.empty()) {
+    // Tangents turn like normals: the same skinning of the rest tangents (positions discarded).
+    skinVertices(skin, scale, restTangents.data(), tangentPassPositions.data(), turnedTangents.data());
+    packTangents();
+  }
+}
+
+void SkinningDeformer::skinVertices(const glm::mat4* skin, const ScaleState& scale, const float* inNrm, float* outPos,
+                                    float* outNrm) const {
+  const uint32_t n = vertexCount;
   const bool eight = !joints1.empty();
   if (kind_ == GCS_KIND_LBS) {
     for (uint32_t v = 0; v < n; ++v) {
@@ -60,7 +70,7 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
         for (int i = 0; i < 4; ++i)
           if (weights1[v][i] > 0.0f) m += weights1[v][i] * skin[joints1[v][i]];
       const float* p = &restPositions[3 * size_t(v)];
-      const float* q = &restNormals[3 * size_t(v)];
+      const float* q = inNrm + 3 * size_t(v);
       glm::vec3 rp(m * glm::vec4(p[0], p[1], p[2], 1.0f));
       glm::vec3 rest(q[0], q[1], q[2]);
       // As three.js does: the normal by the blended matrix, then unit length. Where the blend has
@@ -69,13 +79,12 @@ void SkinningDeformer::deform(const glm::mat4* skin) {
       float len2 = glm::dot(rn, rn);
       if (len2 > 1e-24f && len2 < 1e24f) rn *= 1.0f / std::sqrt(len2);
       else rn = unitOr(rn, poses[j[0]].rotation * rest);
-      for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
+      for (int c = 0; c < 3; ++c) outPos[3 * size_t(v) + c] = rp[c], outNrm[3 * size_t(v) + c] = rn[c];
     }
     return;
   }
   dqsVertices(poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
-              eight ? weights1.data() : nullptr, restPositions.data(), restNormals.data(), positions.data(),
-              normals.data(), n);
+              eight ? weights1.data() : nullptr, restPositions.data(), inNrm, outPos, outNrm, n);
 }
 
 // Dual quaternions (Kavan et al. 2007) for the rigid part of each S_j; its scale blended linearly

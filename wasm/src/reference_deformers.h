@@ -25,6 +25,10 @@ class SkinningDeformer final : public Deformer {
   std::vector<JointPose> poses;
 
  private:
+  // Every vertex under one frame: positions from the rest positions, `inNrm` (the rest normals, or
+  // the rest tangents) turned into `outNrm`.
+  void skinVertices(const glm::mat4* skin, const ScaleState& scale, const float* inNrm, float* outPos,
+                    float* outNrm) const;
   GcsDeformerKind kind_;
 };
 

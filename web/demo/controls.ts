@@ -52,8 +52,10 @@ export function initControls(menu: MenuEntry[], characterActions: CharacterActio
   modelController = m.add(params, 'model', textOptions(modelMenu(null))) as unknown as OptionsCtl;
   modelController.name('character').onChange(onModelMenu);
   m.add(buttons, 'loadFile').name('load file… (.glb / .gltf)');
-  // The attribution line of the character on screen, under the menu.
+  // The attribution line of the character on screen, under the menu; then how to load your own
+  // (here, not at the GUI's end: the GUI is taller than a 720 px window).
   childrenOf(m).appendChild(dom.credit);
+  childrenOf(m).appendChild(dom.hint);
 
   const g = gui.addFolder('GCS model (left)');
   const criterion = g.add(params, 'criterion', CRITERION_MENU).onChange(() => { state.pendingGcs = true; updatePaperOnlyControls(); }) as unknown as Ctl;
@@ -95,12 +97,12 @@ export function initControls(menu: MenuEntry[], characterActions: CharacterActio
   v.add({ open: () => { location.search = `?joint&model=${state.current?.key === 'file' ? 'human' : state.current?.key ?? 'human'}`; } }, 'open')
     .name('joint close-up (knees, elbows) ↗');
   addRendererSwitch(v, rendererKind());
-  childrenOf(gui).appendChild(dom.hint);
 
-  // FPS at the end of the GUI, under the hint (the GUI is tall: anything fixed beside it ends up under it).
+  // FPS at the top of the GUI (the GUI is tall: at its end it fell below a 720 px window; fixed beside it, under it).
   state.stats = new Stats();
-  state.stats.dom.style.cssText = 'position:relative;margin:0 8px 10px;opacity:0.85;cursor:pointer';
-  childrenOf(gui).appendChild(state.stats.dom);
+  state.stats.dom.id = 'stats';
+  state.stats.dom.style.cssText = 'position:relative;margin:6px 8px;opacity:0.85;cursor:pointer';
+  childrenOf(gui).prepend(state.stats.dom);
 
   window.addEventListener('keydown', (e) => {
     if ((e.target as HTMLElement).tagName === 'INPUT') return;

@@ -14,6 +14,7 @@ import { buildClassic, buildGcs, classicSummary, scheduleCostMeasure } from './m
 import { clearMessage, DemoError, describeError, hideStatus, shownMessage, showMessage, showStatus, yieldToPage } from './page.js';
 import { dom, LAYER, params, query, queryNumber, state, type Character } from './state.js';
 import { frameCharacter } from './views.js';
+import { countInfluences } from './influences.js';
 
 /** A character shipped with the demo (public/, licences in public/LICENSES.md). */
 export interface Shipped {
@@ -187,6 +188,7 @@ async function install(name: string, object: THREE.Object3D, clips: THREE.Animat
     const next: Character = {
       name, key, credit, holder, sources, gcs: gcsSkins, classic: classicSkins, classicError, rigidParts: [], trunkParts: [],
       mixer, clips, action: null, skeletonHelper, sourceVertices: vertices, sourceTriangles: triangles, rigidMeshes,
+      influences: countInfluences(sources),
     };
     classicSummary(next);
     for (const s of next.gcs) { s.mesh.castShadow = true; gcsColours(s); }

@@ -8,6 +8,7 @@ import { escapeHtml as esc } from './gui-text.js';
 import { viewRects } from './layout.js';
 import { rendererLabel } from './renderer.js';
 import { dom, state, type ViewKind } from './state.js';
+import type { InfluenceCount } from './influences.js';
 
 export interface Readouts {
   character: string;
@@ -15,12 +16,13 @@ export interface Readouts {
   gcs: { ms: number; warmingUp: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
   classic: { ms: number; warmingUp: boolean; vertices: number; triangles: number; contours: number; detailLoss: { rms: number; max: number } } | null;
   lbs: { vertices: number; triangles: number } | null;
+  influences: InfluenceCount | null;
 }
-let lastReadouts: Readouts = { character: '', gcs: null, classic: null, lbs: null };
+let lastReadouts: Readouts = { character: '', gcs: null, classic: null, lbs: null, influences: null };
 
 export function collectReadouts(): Readouts {
   const ch = state.current;
-  if (!ch) return { character: '', gcs: null, classic: null, lbs: null };
+  if (!ch) return { character: '', gcs: null, classic: null, lbs: null, influences: null };
   const tri = (s: SkinDeformer) => (s.mesh.geometry.index?.count ?? 0) / 3;
   let gcsInfo: Readouts['gcs'] = null;
   let classicInfo: Readouts['classic'] = null;
@@ -57,7 +59,7 @@ export function collectReadouts(): Readouts {
     /* a deformer mid-rebuild: keep the last numbers */
     return lastReadouts;
   }
-  return { character: ch.name, gcs: gcsInfo, classic: classicInfo, lbs: { vertices: ch.sourceVertices, triangles: ch.sourceTriangles } };
+  return { character: ch.name, gcs: gcsInfo, classic: classicInfo, lbs: { vertices: ch.sourceVertices, triangles: ch.sourceTriangles }, influences: ch.influences };
 }
 
 /** "deform 0.21 ms / frame", or "deform measuring…" until the figure stands. */
@@ -86,11 +88,16 @@ export function updateReadouts(): void {
   if (r.gcs) rows.gcs.push(`<span class="criterion">${renderer} · ${backendOf(state.current?.gcs)} backend</span>`);
   if (r.classic) rows.classic.push(`<span class="criterion">${renderer} · ${backendOf(state.current?.classic)} backend</span>`);
   if (r.lbs) rows.lbs.push(`skinned on the GPU by three.js · ${n(r.lbs.vertices)} vertices · ${n(r.lbs.triangles)} triangles`);
+  // three's skinning reads four influences: say what it drops (the other views use all eight).
+  if (r.lbs && r.influences?.overFour)
+    rows.lbs.push(`<span class="warn">drops influences 5–${r.influences.most} of <b>${n(r.influences.overFour)}</b> vertices: three.js skins with 4</span>`);
+  const influences = r.influences ? ` · up to <b>${r.influences.most}</b> influences per vertex` +
+    (r.influences.overFour ? ` (<b>${n(r.influences.overFour)}</b> vertices over 4)` : '') : '';
   const clip = state.current?.action ? state.current.action.getClip().name : '';
   let html = '';
   viewRects().forEach((v, i) => {
     const lines = rows[v.kind].slice();
-    if (i === 0 && r.character) lines.unshift(`<b>${esc(r.character)}</b>${clip ? ` · ${esc(clip)}` : ''}`);
+    if (i === 0 && r.character) lines.unshift(`<b>${esc(r.character)}</b>${clip ? ` · ${esc(clip)}` : ''}${influences}`);
     if (lines.length)
       html += `<div class="readout" data-view="${v.kind}" style="left:${v.x + 10}px;max-width:${v.width - 20}px">` +
         lines.map((l) => `<div class="row">${l}</div>`).join('') + '</div>';

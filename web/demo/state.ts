@@ -8,6 +8,7 @@ import { CRITERIA, MAX_SECTIONS, MIN_SECTIONS, type ClassicReason, type Criterio
 import { SkinDeformer } from '../lib/three.js';
 import type { DemoRenderer } from './renderer.js';
 import { FrameCost } from './cost.js';
+import type { InfluenceCount } from './influences.js';
 
 export type ViewKind = 'gcs' | 'classic' | 'lbs';
 
@@ -39,6 +40,8 @@ export interface Character {
   skeletonHelper: THREE.SkeletonHelper;
   sourceVertices: number;
   sourceTriangles: number;
+  /** Influences per vertex of the source skins (the LBS view, three's skinning, takes four). */
+  influences: InfluenceCount;
   /** Meshes under the character that are not skinned: drawn in every view, moved by three.js. */
   rigidMeshes: number;
 }

@@ -449,6 +449,10 @@ export class Deformer {
   private morphPtr = 0;
   private morphCount = 0;
   private morphView: Float32Array = new Float32Array(0);
+  private tangentsPtr = 0;
+  /** keepPreviousPositions: the two arrays positions alternate between, as views (made once). */
+  private swapped: { ptr: number; view: Float32Array }[] | null = null;
+  private tangentsView: Float32Array | null = null;
 
   /** @internal */
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
@@ -477,9 +481,36 @@ export class Deformer {
   /** Deformed positions (vertexCount × 3): a view on wasm memory, re-created after growth. */
   get positions(): Float32Array {
     this.live();
+    if (this.swapped) return this.swappedView(this.gcs.core.gcs_deformer_positions(this.handle));
     if (this.positionsView.buffer !== this.gcs.memory.buffer)
       this.positionsView = this.gcs.viewF32(this.positionsPtr, this.vertexCount * 3);
     return this.positionsView;
+  }
+
+  /**
+   * Velocity: keep the previous frame's positions (`previousPositions`). The core then writes each
+   * frame into the array that held the frame before last and swaps the two, so `positions` and
+   * `previousPositions` alternate between two views made once (no copy, no allocation per frame):
+   * read both after every `deform`. `false` frees the second array.
+   */
+  keepPreviousPositions(keep: boolean): void {
+    const h = this.live();
+    if (!this.gcs.core.gcs_deformer_keep_previous_positions(h, keep ? 1 : 0)) this.gcs.raise('the previous positions could not be kept');
+    this.positionsPtr = this.gcs.core.gcs_deformer_positions(h);
+    this.swapped = keep ? [this.positionsPtr, this.gcs.core.gcs_deformer_previous_positions(h)].map((ptr) => ({ ptr, view: this.gcs.viewF32(ptr, this.vertexCount * 3) })) : null;
+  }
+
+  /** The positions of the deform before the last one (keepPreviousPositions), or null. */
+  get previousPositions(): Float32Array | null {
+    this.live();
+    return this.swapped ? this.swappedView(this.gcs.core.gcs_deformer_previous_positions(this.handle)) : null;
+  }
+
+  /** The view of one of the two position arrays (re-created after memory growth). */
+  private swappedView(ptr: number): Float32Array {
+    const entry = this.swapped![this.swapped![0].ptr === ptr ? 0 : 1];
+    if (entry.view.buffer !== this.gcs.memory.buffer) entry.view = this.gcs.viewF32(ptr, this.vertexCount * 3);
+    return entry.view;
   }
 
   /** Deformed unit normals (vertexCount × 3): a view on wasm memory, re-created after growth. */
@@ -488,6 +519,39 @@ export class Deformer {
     if (this.normalsView.buffer !== this.gcs.memory.buffer)
       this.normalsView = this.gcs.viewF32(this.normalsPtr, this.vertexCount * 3);
     return this.normalsView;
+  }
+
+  /**
+   * Deformed tangents (vertexCount × 4: xyz turned as the normals are, w the handedness carried), a
+   * view on wasm memory re-created after growth; null until setTangents. Written by the same
+   * `deform` call as positions and normals.
+   */
+  get tangents(): Float32Array | null {
+    this.live();
+    if (!this.tangentsPtr) return null;
+    if (this.tangentsView!.buffer !== this.gcs.memory.buffer) this.tangentsView = this.gcs.viewF32(this.tangentsPtr, this.vertexCount * 4);
+    return this.tangentsView;
+  }
+
+  /**
+   * Rest tangents for normal maps: vertexCount × 4 numbers in the RIG's vertex order (glTF TANGENT,
+   * three.js's `tangent` attribute: xyz unit, w = ±1), or null to remove them. From then on every
+   * `deform` also writes `tangents`. GCS, LBS and DQS (the classic model resamples the mesh:
+   * INVALID_ARGUMENT). Build time only: it copies.
+   */
+  setTangents(tangents: ArrayLike<number> | null): void {
+    const h = this.live();
+    const V = this.vertexCount;
+    if (tangents && tangents.length !== V * 4)
+      throw new GcsError('LENGTH_MISMATCH', `tangents has ${tangents.length} numbers; ${V * 4} (4 per vertex) are expected`);
+    const ptr = tangents ? this.gcs.copyIn(tangents, 'f32') : 0;
+    try {
+      if (!this.gcs.core.gcs_deformer_set_tangents(h, ptr, tangents ? V : 0)) this.gcs.raise('the tangents were rejected');
+    } finally {
+      if (ptr) this.gcs.core.gcs_free(ptr);
+    }
+    this.tangentsPtr = this.gcs.core.gcs_deformer_tangents(h);
+    this.tangentsView = this.tangentsPtr ? this.gcs.viewF32(this.tangentsPtr, V * 4) : null;
   }
 
   /** The output mesh's triangles (a copy: they never change). */

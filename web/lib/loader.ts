@@ -28,6 +28,10 @@ export interface CoreExports {
   gcs_deformer_deform(d: number, skin: number, jointCount: number): number;
   gcs_deformer_set_morph_targets(d: number, deltas: number, normalDeltas: number, targets: number, vertices: number): number;
   gcs_deformer_set_morph_influences(d: number, influences: number, targets: number): number;
+  gcs_deformer_set_tangents(d: number, tangents: number, vertices: number): number;
+  gcs_deformer_tangents(d: number): number;
+  gcs_deformer_keep_previous_positions(d: number, keep: number): number;
+  gcs_deformer_previous_positions(d: number): number;
   gcs_deformer_vertex_count(d: number): number;
   gcs_deformer_positions(d: number): number;
   gcs_deformer_normals(d: number): number;
@@ -103,7 +107,7 @@ export async function instantiateCore(source?: WasmSource): Promise<CoreExports>
 export const UNSIGNED_RESULTS = [
   'gcs_version', 'gcs_last_error_message', 'gcs_alloc', 'gcs_rig_create', 'gcs_rig_vertex_count', 'gcs_rig_joint_count',
   'gcs_build_gcs', 'gcs_build_lbs', 'gcs_build_dqs', 'gcs_build_classic', 'gcs_deformer_kind',
-  'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_index_count',
+  'gcs_deformer_vertex_count', 'gcs_deformer_positions', 'gcs_deformer_normals', 'gcs_deformer_tangents', 'gcs_deformer_previous_positions', 'gcs_deformer_index_count',
   'gcs_deformer_indices', 'gcs_deformer_source_vertex', 'gcs_gcs_section_of_vertex', 'gcs_gcs_section_info',
   'gcs_gcs_section_matrices', 'gcs_gcs_blend_other', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_section_influences', 'gcs_gcs_section_influence_slots', 'gcs_gcs_section_centres', 'gcs_classic_part_count', 'gcs_classic_parts', 'gcs_classic_contour_of_vertex', 'gcs_classic_source_of_vertex',
 ] as const;

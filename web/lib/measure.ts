@@ -904,3 +904,66 @@ export function classicOffSurface(input: RigInput, deformer: ClassicDeformer, fr
     })),
   };
 }
+
+/**
+ * A rig of rigid parts made from a skinned one (like Mixamo's X Bot): every vertex bound with
+ * weight 1 to its dominant joint (the first of equal largest weights). The classic model's
+ * decisions must hold on such a rig too: its skin tears at every joint instead of blending.
+ */
+export function rigidRebind(input: RigInput): RigInput {
+  const n = Math.floor(input.positions.length / 3), k = input.influences ?? 4;
+  const joints = new Uint32Array(4 * n), weights = new Float32Array(4 * n);
+  for (let v = 0; v < n; v++) {
+    let best = 0;
+    for (let i = 1; i < k; i++) if (input.weights[k * v + i] > input.weights[k * v + best]) best = i;
+    joints[4 * v] = input.joints[k * v + best];
+    weights[4 * v] = 1;
+  }
+  return { ...input, joints, weights, influences: 4 };
+}
+
+/** The shape of a classic model's zip-band triangles (the bands joining tubes to carried skin). */
+export interface BandQuality {
+  /** Band triangles: those with both a ring vertex and a carried vertex. */
+  triangles: number;
+  /** Smallest interior angle (degrees): the minimum, the 1st percentile and the median over triangles. */
+  minAngle: number;
+  minAngleP1: number;
+  minAngleMedian: number;
+  /** Triangles with an angle under 5° and under 10°. */
+  under5: number;
+  under10: number;
+  /** Aspect ratio longest edge × perimeter / (4√3 × area): 1 for an equilateral triangle; max, p99, median. */
+  aspectMax: number;
+  aspectP99: number;
+  aspectMedian: number;
+}
+
+/**
+ * Minimum angle and aspect ratio of the zip-band triangles of a classic model in its current pose
+ * (call it after a deform with identity matrices for the bind pose): long slivers shade as streaks.
+ */
+export function classicBandQuality(deformer: ClassicDeformer): BandQuality {
+  const I = deformer.indices, X = deformer.positions, ring = deformer.contourOfVertex, source = deformer.sourceOfVertex;
+  const angles: number[] = [], aspects: number[] = [];
+  const at = (v: number) => [X[3 * v], X[3 * v + 1], X[3 * v + 2]];
+  const dist = (p: number[], q: number[]) => Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+  for (let t = 0; t < I.length; t += 3) {
+    const v = [I[t], I[t + 1], I[t + 2]];
+    if (!v.some((x) => ring[x] >= 0) || !v.some((x) => source[x] >= 0)) continue;
+    const [a, b, c] = v.map(at);
+    const la = dist(b, c), lb = dist(c, a), lc = dist(a, b);
+    const s = (la + lb + lc) / 2, area = Math.sqrt(Math.max(0, s * (s - la) * (s - lb) * (s - lc)));
+    const angle = (o: number, p: number, q: number) => Math.acos(Math.min(1, Math.max(-1, (p * p + q * q - o * o) / (2 * p * q)))) * 180 / Math.PI;
+    angles.push(Math.min(angle(la, lb, lc), angle(lb, lc, la), angle(lc, la, lb)) || 0);
+    aspects.push(area > 0 ? Math.max(la, lb, lc) * 2 * s / (4 * Math.sqrt(3) * area) : Infinity);
+  }
+  const sorted = (a: number[]) => [...a].sort((x, y) => x - y);
+  const A = sorted(angles), R = sorted(aspects), n = A.length;
+  const q = (s: number[], f: number) => (n ? s[Math.min(n - 1, Math.floor(f * (n - 1)))] : 0);
+  return {
+    triangles: n, minAngle: n ? A[0] : 0, minAngleP1: q(A, 0.01), minAngleMedian: q(A, 0.5),
+    under5: A.filter((x) => x < 5).length, under10: A.filter((x) => x < 10).length,
+    aspectMax: n ? R[n - 1] : 0, aspectP99: q(R, 0.99), aspectMedian: q(R, 0.5),
+  };
+}

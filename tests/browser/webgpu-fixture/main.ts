@@ -3,7 +3,9 @@
 //   check: GPU backend (TSL) vs CPU backend, same frames, same camera; the pose differs from the rest pose;
 //   glslVsTsl: the same pose drawn by gcs-skin/three (GLSL, WebGLRenderer) and gcs-skin/webgpu (TSL, WebGPURenderer);
 //   crowd: GcsCrowd on WebGPURenderer, drawn and moving, one draw call per skin;
-//   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials.
+//   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials;
+//   velocity: a velocity MRT pass (pass + mrt({ output, velocity })) over our skin and three.js's own;
+//   normalMapped: a character with MikkTSpace tangents and a normal map, ours against three.js's skinning.
 import * as THREE from 'three/webgpu';
 import { WebGLRenderer, WebGLRenderTarget } from 'three';
 import { WebGLNodesHandler } from 'three/addons/tsl/WebGLNodesHandler.js';
@@ -11,6 +13,7 @@ import { initGcsSkin, type GcsOptions } from '../../../web/lib/index.js';
 import * as WebGL from '../../../web/lib/three.js';
 import { GcsCrowd as WebGLCrowd } from '../../../web/lib/crowd.js';
 import { bakeClip, GcsCharacter, GcsCrowd, writeSkinMatrices } from '../../../web/lib/webgpu.js';
+import { mrt, output, pass, velocity as velocityNode } from 'three/tsl';
 import type { GpuPath } from '../../../web/lib/gpu.js';
 import { load, stage as stageAt, type Loaded } from '../fixture-scene.js';
 
@@ -365,7 +368,189 @@ async function crowdOnWrongRenderer(model: string, entry: 'webgpu' | 'three'): P
   return { error, code, warnings: [...warnings] };
 }
 
-declare global {
-  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences } }
+/** The next browser frame: WebGPURenderer counts frames (frameId) by requestAnimationFrame, as velocity does. */
+const nextFrame = () => new Promise<void>((resolve) => requestAnimationFrame(() => requestAnimationFrame(() => resolve())));
+
+/** A scene drawn through a velocity MRT pass: its colour and its velocity (NDC per frame), read back as floats. */
+function velocityPass(renderer: THREE.WebGPURenderer, scene: THREE.Scene, camera: THREE.Camera) {
+  const scenePass = pass(scene, camera, { type: THREE.FloatType });
+  scenePass.setMRT(mrt({ output, velocity: velocityNode }));
+  const pipeline = new THREE.RenderPipeline(renderer);
+  pipeline.outputNode = scenePass;
+  const colourTexture = scenePass.getTexture('output'), velocityTexture = scenePass.getTexture('velocity');
+  return {
+    async draw(): Promise<{ colour: Float32Array; velocity: Float32Array }> {
+      pipeline.render();
+      const target = scenePass.renderTarget;
+      const colour = await renderer.readRenderTargetPixelsAsync(target, 0, 0, W, H, target.textures.indexOf(colourTexture)) as Float32Array;
+      const velocity = await renderer.readRenderTargetPixelsAsync(target, 0, 0, W, H, target.textures.indexOf(velocityTexture)) as Float32Array;
+      return { colour: colour.slice(), velocity: velocity.slice() };
+    },
+    dispose(): void {
+      pipeline.dispose();
+      scenePass.dispose();
+    },
+  };
 }
-window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences };
+
+export interface VelocityResult {
+  backends: string[];
+  /** share of the pixels either skin covers where the two velocities differ by more than 1 px or 10 % */
+  vsThree: number;
+  /** share of our skin's pixels that move more than 1 px (the comparison is not of two still pictures) */
+  moving: number;
+  /** the largest velocity of our skin's pixels, in pixels, walking and then paused */
+  largest: number;
+  pausedLargest: number;
+  /** three's skinning paused, for scale */
+  threePausedLargest: number;
+}
+
+/**
+ * A walking character drawn through a velocity MRT pass by our skin (`kind`: the GPU backend on a
+ * path, the CPU backend, or a one-instance crowd) and by three.js's own skinning of the same clip,
+ * two frames `dt` apart; then our skin paused (the same time drawn again).
+ */
+async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'crowd', time: number, dt: number, gcsOptions: GcsOptions = {}, clipName?: string): Promise<VelocityResult> {
+  const gcs = await gcsReady;
+  const renderer = await gpuRenderer();
+  const ours = await load(model), three = await load(model);
+  const { scene: oursScene, camera } = stage(ours.root);
+  const { scene: threeScene } = stage(three.root);
+  let character: GcsCharacter | null = null, crowd: GcsCrowd | null = null, baked: ReturnType<typeof bakeClip> | null = null;
+  const oursMixer = play(ours, clipName), threeMixer = play(three, clipName);
+  if (kind === 'crowd') {
+    let source: THREE.SkinnedMesh | null = null;
+    ours.root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+    const skinned = source! as THREE.SkinnedMesh;
+    baked = bakeClip(skinned, ours.clips.find((c) => c.name === clipName) ?? ours.clips[0], 1 / dt);
+    crowd = new GcsCrowd(gcs, skinned, 1, { gcs: gcsOptions });
+    ours.root.updateMatrixWorld(true);
+    crowd.mesh.setMatrixAt(0, skinned.matrixWorld);
+    crowd.mesh.instanceMatrix.needsUpdate = true;
+    skinned.visible = false;
+    oursScene.add(crowd.mesh);
+  } else {
+    character = new GcsCharacter(gcs, ours.root, { gcs: gcsOptions, backend: kind === 'cpu' ? 'cpu' : 'gpu', gpuPath: kind === 'cpu' ? 'auto' : kind });
+  }
+  const pose = (t: number) => {
+    threeMixer.setTime(t);
+    if (crowd) {
+      crowd.setBakedPose(0, baked!, t);
+      crowd.update();
+    } else {
+      oursMixer.setTime(t);
+      character!.update();
+    }
+  };
+  const oursPass = velocityPass(renderer, oursScene, camera), threePass = velocityPass(renderer, threeScene, camera);
+  const px = (v: Float32Array, o: number) => Math.hypot(v[o] * W / 2, v[o + 1] * H / 2); // NDC → pixels
+  pose(time);
+  await oursPass.draw();
+  await threePass.draw();
+  await nextFrame();
+  pose(time + dt);
+  const a = await oursPass.draw(), b = await threePass.draw();
+  let covered = 0, differ = 0, mine = 0, moving = 0, largest = 0;
+  for (let o = 0; o < a.colour.length; o += 4) {
+    const inA = a.colour[o + 3] > 0 && a.colour[o] + a.colour[o + 1] + a.colour[o + 2] > 0;
+    const inB = b.colour[o + 3] > 0 && b.colour[o] + b.colour[o + 1] + b.colour[o + 2] > 0;
+    if (!inA && !inB) continue;
+    covered++;
+    const va = inA ? px(a.velocity, o) : 0, vb = inB ? px(b.velocity, o) : 0;
+    const d = Math.hypot((inA ? a.velocity[o] : 0) - (inB ? b.velocity[o] : 0), (inA ? a.velocity[o + 1] : 0) - (inB ? b.velocity[o + 1] : 0)) * W / 2;
+    if (d > Math.max(1, 0.1 * Math.max(va, vb))) differ++;
+    if (inA) {
+      mine++;
+      if (va > 1) moving++;
+      largest = Math.max(largest, va);
+    }
+  }
+  await nextFrame();
+  pose(time + dt);
+  const still = await oursPass.draw(), threeStill = await threePass.draw();
+  let pausedLargest = 0, threePausedLargest = 0;
+  for (let o = 0; o < still.colour.length; o += 4) {
+    if (still.colour[o] + still.colour[o + 1] + still.colour[o + 2] > 0) pausedLargest = Math.max(pausedLargest, px(still.velocity, o));
+    if (threeStill.colour[o] + threeStill.colour[o + 1] + threeStill.colour[o + 2] > 0) threePausedLargest = Math.max(threePausedLargest, px(threeStill.velocity, o));
+  }
+  const backends = character ? character.skins.map((s) => s.backend) : ['gpu'];
+  oursPass.dispose();
+  threePass.dispose();
+  character?.dispose();
+  crowd?.dispose();
+  return { backends, vsThree: differ / Math.max(1, covered), moving: moving / Math.max(1, mine), largest, pausedLargest, threePausedLargest };
+}
+
+/** A tangent-space normal map of round bumps (8 × 8 per uv square), strong enough to light visibly. */
+function bumpMap(): THREE.DataTexture {
+  const size = 64, data = new Uint8Array(4 * size * size);
+  for (let y = 0; y < size; y++) for (let x = 0; x < size; x++) {
+    const u = (x / size) * 2 * Math.PI, v = (y / size) * 2 * Math.PI;
+    const n = new THREE.Vector3(-0.8 * Math.cos(u) * Math.sin(v), -0.8 * Math.sin(u) * Math.cos(v), 1).normalize();
+    data.set([(n.x * 0.5 + 0.5) * 255, (n.y * 0.5 + 0.5) * 255, (n.z * 0.5 + 0.5) * 255, 255], 4 * (y * size + x));
+  }
+  const texture = new THREE.DataTexture(data, size, size);
+  texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
+  texture.repeat.set(8, 8);
+  texture.needsUpdate = true;
+  return texture;
+}
+
+/** Every skinned mesh under `root` wears one normal-mapped material (textures of the file dropped). */
+function wearNormalMap(root: THREE.Object3D, normalMap: THREE.Texture | null): void {
+  const material = new THREE.MeshStandardMaterial({ color: 0xc8c0b0, roughness: 0.45, metalness: 0, normalMap });
+  root.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) (o as THREE.SkinnedMesh).material = material; });
+}
+
+export interface NormalMappedResult {
+  tangents: boolean[];
+  /** our LBS (CPU backend, tangents deformed by the core) vs three.js's skinning, same pose */
+  lbsVsThree: { image: number; covered: number };
+  /** three.js's skinning with and without the normal map: the map shows */
+  mapShows: { image: number; covered: number };
+  /** our GCS GPU backend (each path) vs our GCS CPU backend, normal-mapped */
+  gpuVsCpu: { image: number; covered: number }[];
+  coverage: number;
+}
+
+/** A character with tangents and a normal map, posed at `time`, drawn by `which` renderer. */
+async function normalMapped(model: string, which: 'webgl' | 'webgpu', time: number): Promise<NormalMappedResult> {
+  const gcs = await gcsReady;
+  const renderer = which === 'webgpu' ? await gpuRenderer() : glRenderer();
+  const Character = which === 'webgpu' ? GcsCharacter : WebGL.GcsCharacter;
+  const map = bumpMap();
+  const ours = await load(model), three = await load(model), flat = await load(model);
+  wearNormalMap(ours.root, map);
+  wearNormalMap(three.root, map);
+  wearNormalMap(flat.root, null);
+  const { scene: oursScene, camera } = stage(ours.root);
+  const { scene: threeScene } = stage(three.root);
+  const { scene: flatScene } = stage(flat.root);
+  for (const loaded of [ours, three, flat]) play(loaded).setTime(time);
+  const character = new Character(gcs, ours.root, { method: 'lbs' });
+  character.update();
+  const lbs = await draw(renderer, oursScene, camera);
+  const reference = await draw(renderer, threeScene, camera);
+  const plain = await draw(renderer, flatScene, camera);
+  const result: NormalMappedResult = {
+    tangents: character.skins.map((s) => s.deformsTangents), lbsVsThree: differing(lbs, reference), mapShows: differing(reference, plain),
+    gpuVsCpu: [], coverage: coverage(reference),
+  };
+  for (const gpuPath of ['joints', 'sections'] as const) {
+    character.rebuild('gcs', { backend: 'cpu' });
+    character.update();
+    const cpu = await draw(renderer, oursScene, camera);
+    character.rebuild('gcs', { backend: 'gpu', gpuPath });
+    character.update();
+    result.gpuVsCpu.push(differing(await draw(renderer, oursScene, camera), cpu));
+  }
+  character.dispose();
+  if (which === 'webgl') (renderer as WebGLRenderer).dispose();
+  return result;
+}
+
+declare global {
+  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences; velocity: typeof velocity; normalMapped: typeof normalMapped } }
+}
+window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences, velocity, normalMapped };

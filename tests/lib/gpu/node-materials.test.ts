@@ -118,3 +118,56 @@ describe('GcsCharacter and GcsCrowd of gcs-skin/webgpu', () => {
     }
   });
 });
+
+describe('the CPU backend of gcs-skin/webgpu: tangents and velocity from the core pass', () => {
+  /** What the mesh's onBeforeRender sees of a WebGPURenderer drawing a velocity pass (or not). */
+  const renderer = (velocity: boolean) => ({ isWebGPURenderer: true, getMRT: () => (velocity ? { has: (name: string) => name === 'velocity' } : null) });
+  const draw = (mesh: THREE.Mesh, r: unknown) =>
+    mesh.onBeforeRender(r as THREE.WebGPURenderer, new THREE.Scene(), new THREE.PerspectiveCamera(), mesh.geometry, mesh.material as THREE.Material, null as unknown as THREE.Group);
+
+  test('tangents are the deformer\'s own output (no copy); a velocity pass gives the mesh previous positions, swapped each update', () => {
+    const mesh = human.mesh.clone() as THREE.SkinnedMesh;
+    mesh.geometry = human.mesh.geometry.clone();
+    mesh.geometry.computeTangents();
+    const group = new THREE.Group();
+    group.add(mesh);
+    const character = new GcsCharacter(gcs, group);
+    try {
+      const skin = character.skins[0];
+      const g = () => skin.mesh.geometry;
+      expect(skin.deformsTangents).toBe(true);
+      expect((g().getAttribute('tangent') as THREE.BufferAttribute).array).toBe(skin.deformer.tangents);
+      // Drawn without velocity: nothing changes.
+      draw(skin.mesh, renderer(false));
+      character.update();
+      expect(skin.mesh.material).toBe(mesh.material);
+      expect(g().getAttribute('gcsPreviousPosition')).toBeUndefined();
+      const bytes = skin.bytesPerFrame;
+      // Drawn in a velocity pass: from the next update, previous positions and a node material that reads them.
+      draw(skin.mesh, renderer(true));
+      const before = skin.deformer.positions.slice();
+      mesh.skeleton.bones[3].rotation.x += 0.5; // the human's own skeleton: turned back below
+      character.update();
+      const material = skin.mesh.material as THREE.NodeMaterial;
+      expect(material.isNodeMaterial).toBe(true);
+      expect(material.positionNode).not.toBeNull();
+      const previous = g().getAttribute('gcsPreviousPosition') as THREE.BufferAttribute;
+      expect(previous.array).toBe(skin.deformer.previousPositions);
+      expect(Array.from(previous.array)).toEqual(Array.from(before));
+      expect((g().getAttribute('position') as THREE.BufferAttribute).array).toBe(skin.deformer.positions);
+      expect(skin.bytesPerFrame).toBe(bytes + before.byteLength);
+      const current = skin.deformer.positions;
+      character.update(); // the same pose: previous = current, the arrays swapped, not copied
+      expect(previous.array).toBe(current);
+      expect(Array.from(previous.array)).toEqual(Array.from(skin.deformer.positions));
+      // A rebuild keeps velocity on.
+      character.rebuild('lbs');
+      character.update();
+      expect((skin.mesh.material as THREE.NodeMaterial).isNodeMaterial).toBe(true);
+      expect((g().getAttribute('gcsPreviousPosition') as THREE.BufferAttribute).array).toBe(skin.deformer.previousPositions);
+    } finally {
+      mesh.skeleton.bones[3].rotation.x -= 0.5;
+      character.dispose();
+    }
+  });
+});

@@ -30,6 +30,14 @@ export interface GpuMaterialKit {
    * null when it can. Checked at each draw: the renderer is known only then.
    */
   mismatch(renderer: unknown, material: THREE.Material): string | null;
+  /** Whether `renderer` is drawing a pass that writes velocity (motion vectors) now. */
+  drawsVelocity(renderer: unknown): boolean;
+  /**
+   * CPU backend, velocity: a clone of `source` that hands the renderer each vertex's previous
+   * position from the geometry's PREVIOUS_POSITION_ATTRIBUTE, or null where this kit or the
+   * material cannot (the GLSL kit; custom shaders; node materials with their own position node).
+   */
+  velocityMaterial(source: THREE.Material): THREE.Material | null;
 }
 
 /** Frees the materials of a GPU build. */

@@ -35,6 +35,12 @@ export const BLEND_ATTRIBUTE = 'gcsBlend';
  */
 export const BLEND_THIRD_ATTRIBUTE = 'gcsBlendThird';
 
+/**
+ * CPU backend on WebGPURenderer, velocity: each vertex's position the frame before (the deformer's
+ * previous positions), read by the TSL kit's velocity material.
+ */
+export const PREVIOUS_POSITION_ATTRIBUTE = 'gcsPreviousPosition';
+
 /** The CPU's test for "the scale part K is a positive uniform scale": every entry within this × s of s·I. */
 export const UNIFORM_SCALE_TOLERANCE = 1e-4;
 /** Below this a largest entry counts as zero (a collapsed scale): the normal keeps its rotation. */

@@ -7,7 +7,7 @@
 import * as THREE from 'three/webgpu';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
 import type { GpuSections } from './sections.js';
-import { gcsPositionNode } from './tsl.js';
+import { gcsPositionNode, previousPositionNode } from './tsl.js';
 
 /** Built-in material type → its node material (the ones WebGPURenderer converts). */
 const NODE_MATERIALS: Record<string, new () => THREE.NodeMaterial> = {
@@ -89,5 +89,17 @@ export const tslKit: GpuMaterialKit = {
     if (r?.isWebGLRenderer && material.onBeforeRender === THREE.Material.prototype.onBeforeRender)
       return "a WebGLRenderer without a nodes handler draws this mesh, and it cannot run node materials: draw with WebGPURenderer (three/webgpu), call renderer.setNodesHandler(new WebGLNodesHandler()) (three/addons/tsl/WebGLNodesHandler.js), or import GcsCharacter / GcsCrowd from 'gcs-skin/three' for WebGLRenderer";
     return null;
+  },
+  drawsVelocity(renderer: unknown): boolean {
+    const r = renderer as { isWebGPURenderer?: boolean; getMRT?(): { has(name: string): boolean } | null };
+    return r?.isWebGPURenderer === true && r.getMRT?.()?.has('velocity') === true;
+  },
+  velocityMaterial(source: THREE.Material): THREE.Material | null {
+    if (nodeMaterialSupport(source)) return null;
+    const material = toNodeMaterial(source);
+    material.positionNode = previousPositionNode();
+    material.name = source.name;
+    material.userData.gcsSource = source;
+    return material;
   },
 };

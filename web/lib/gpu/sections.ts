@@ -44,6 +44,8 @@ export class GpuSections {
   readonly tableSlots: TableSlots;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
+  /** Velocity: the per-frame texels as the previous frame drew them (see previousTexture). */
+  private previous: { texture: THREE.DataTexture; drawn: Float32Array; frameId: number } | null = null;
 
   constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath) {
     if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
@@ -77,9 +79,39 @@ export class GpuSections {
     return this.transforms.skins;
   }
 
-  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16). */
+  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16), twice while velocity is drawn. */
   get bytesPerUpdate(): number {
-    return this.transforms.width * this.transforms.height * 16;
+    return this.transforms.width * this.transforms.height * 16 * (this.previous ? 2 : 1);
+  }
+
+  /**
+   * Velocity (motion vectors): a texture of the per-frame texels as they were drawn the frame
+   * before, as three.js keeps its skeletons' previous bone matrices. Made on first use (a shader
+   * that needs previous positions), then kept by advanceFrame; until a frame has passed it holds
+   * this frame's texels (no motion).
+   */
+  previousTexture(): THREE.DataTexture {
+    if (!this.previous) {
+      const t = this.transforms;
+      this.previous = { texture: floatTexture(Float32Array.from(t.texels), t.width, t.height), drawn: Float32Array.from(t.texels), frameId: -1 };
+    }
+    return this.previous.texture;
+  }
+
+  /**
+   * Once per rendered frame (three.js's frameId), before the draw: the previous texture shows what
+   * the last frame drew and the texels drawn now are kept for the next. One copy, no allocation.
+   */
+  advanceFrame(frameId: number): void {
+    const p = this.previous;
+    if (!p || p.frameId === frameId) return;
+    p.frameId = frameId;
+    const image = p.texture.image as { data: Float32Array };
+    const drawn = p.drawn;
+    p.drawn = image.data;
+    image.data = drawn;
+    p.drawn.set(this.transforms.texels);
+    p.texture.needsUpdate = true;
   }
 
   /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
@@ -93,6 +125,7 @@ export class GpuSections {
 
   dispose(): void {
     this.texture.dispose();
+    this.previous?.texture.dispose();
     this.table?.dispose();
     this.transforms.dispose();
   }

@@ -1,235 +1,332 @@
 /**
- * The GCS vertex stage in TSL, for WebGPURenderer (real WebGPU and its WebGL2 fallback): the same
- * maths as the GLSL chunk (glsl.ts), from the same layout constants (layout.ts), written as node
- * graphs. `gcsPositionNode` is a node material's `positionNode`: it returns the deformed position
- * and turns `normalLocal` (and `tangentLocal` where the geometry has tangents) on the way, where
- * three.js's own skinning does (nodes/accessors/Skinning.js) — after the morph targets, so morphs
- * apply first as on the CPU. Matrices are kept as column triples built at graph time, so the
- * generated shader reads like the GLSL one.
+ * The GCS vertex stage in TSL, for WebGPURenderer (real WebGPU and its WebGL2 fallback), written as
+ * three.js writes its own skinning (nodes/accessors/Skinning.js): the maths in small functions with
+ * a layout (`Fn(...).setLayout(...)`, compiled once as shader functions), texel reads in plain
+ * accessors, `If` where the GLSL chunk (glsl.ts) branches, both from the same constants
+ * (layout.ts). `gcsPositionNode` is a node material's `positionNode`: it returns the deformed
+ * position and turns `normalLocal` (and `tangentLocal` where the geometry has tangents) on the way
+ * — after the morph targets, so morphs apply first, as on the CPU.
+ *
+ * The laid-out functions take values only: a shader function is built once per renderer and
+ * reused by every material, so it must not name a texture or uniform of one skin.
  */
-import * as THREE from 'three';
-import * as TSL from 'three/tsl';
-import type { Node } from 'three/webgpu';
+import {
+  abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, mat4, max, min, normalGeometry, normalLocal,
+  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
+  uniform, vec3, vec4,
+} from 'three/tsl';
+import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import type { GpuSections } from './sections.js';
 
-// TSL's node types nest too deeply for these graphs (ints meeting floats, swizzles of sizes):
-// nodes are untyped here, and the browser tests check what the graphs compute.
-// eslint-disable-next-line @typescript-eslint/no-explicit-any
-type N = any;
-const {
-  abs, attribute, cross, dot, float, Fn, instanceIndex, int, ivec2, length, max, min, normalGeometry, normalLocal, pow,
-  positionGeometry, positionLocal, referenceAttribute, select, tangentGeometry, tangentLocal, texture, textureSize,
-  transformNormal, uniform, vec3, vec4,
-} = TSL as N;
-/** A 3×3 matrix as its columns. */
-type M3 = [N, N, N];
+type Bool = Node<'bool'>;
+type Float = Node<'float'>;
+type Int = Node<'int'>;
+type Vec3 = Node<'vec3'>;
+type Vec4 = Node<'vec4'>;
+type Mat3 = Node<'mat3'>;
+type Mat4 = Node<'mat4'>;
 
-const mulMV = (m: M3, v: N): N => m[0].mul(v.x).add(m[1].mul(v.y)).add(m[2].mul(v.z));
-const mulMM = (a: M3, b: M3): M3 => [mulMV(a, b[0]), mulMV(a, b[1]), mulMV(a, b[2])];
-const transpose = (m: M3): M3 => [vec3(m[0].x, m[1].x, m[2].x), vec3(m[0].y, m[1].y, m[2].y), vec3(m[0].z, m[1].z, m[2].z)];
-const scale = (m: M3, s: N): M3 => [m[0].mul(s), m[1].mul(s), m[2].mul(s)];
-const add = (a: M3, b: M3): M3 => [a[0].add(b[0]), a[1].add(b[1]), a[2].add(b[2])];
-/** a + f·(b − a) + g·(c − a), column by column (a lattice cell's three nodes; g = 0 and c = a: a lerp). */
-const blend3 = (a: M3, b: M3, c: M3, f: N, g: N): M3 => [0, 1, 2].map((i) => a[i].add(b[i].sub(a[i]).mul(f)).add(c[i].sub(a[i]).mul(g))) as M3;
-const trace = (a: M3, b: M3): N => dot(a[0], b[0]).add(dot(a[1], b[1])).add(dot(a[2], b[2]));
-const pick = (c: N, a: M3, b: M3): M3 => [select(c, a[0], b[0]), select(c, a[1], b[1]), select(c, a[2], b[2])];
-const toVar = (m: M3): M3 => [m[0].toVar(), m[1].toVar(), m[2].toVar()];
-const largest = (m: M3): N => { const e = max(max(abs(m[0]), abs(m[1])), abs(m[2])); return max(max(e.x, e.y), e.z); };
-const ZERO: () => M3 = () => [vec3(0), vec3(0), vec3(0)];
+/** Column c of a matrix (its `[c]`: the typings index arrays, not matrices). */
+const column = <T extends Mat3 | Mat4>(m: T, c: number): T extends Mat3 ? Vec3 : Vec4 =>
+  (m as unknown as { element(i: number): T extends Mat3 ? Vec3 : Vec4 }).element(c);
+
+/** The largest absolute entry of a 3×3 matrix. */
+function largest(m: Mat3): Float {
+  const e = max(max(abs(column(m, 0)), abs(column(m, 1))), abs(column(m, 2)));
+  return max(max(e.x, e.y), e.z);
+}
+
+// ------------------------------------------------------------ shader functions (values in, value out)
+
+/** The rotation matrix of quaternion q (x, y, z, w) scaled by k2 = 2 / |q|² (2 for a unit quaternion). */
+const gcsRotation = Fn(([q, k2]: [Vec4, Float]) => {
+  const xx = q.x.mul(q.x), yy = q.y.mul(q.y), zz = q.z.mul(q.z), xy = q.x.mul(q.y), xz = q.x.mul(q.z), yz = q.y.mul(q.z);
+  const wx = q.w.mul(q.x), wy = q.w.mul(q.y), wz = q.w.mul(q.z);
+  return mat3(
+    vec3(float(1).sub(k2.mul(yy.add(zz))), k2.mul(xy.add(wz)), k2.mul(xz.sub(wy))),
+    vec3(k2.mul(xy.sub(wz)), float(1).sub(k2.mul(xx.add(zz))), k2.mul(yz.add(wx))),
+    vec3(k2.mul(xz.add(wy)), k2.mul(yz.sub(wx)), float(1).sub(k2.mul(xx.add(yy)))),
+  );
+}).setLayout({ name: 'gcsRotation', type: 'mat3', inputs: [{ name: 'q', type: 'vec4' }, { name: 'k2', type: 'float' }] });
+
+/** The CPU's test: k is a positive uniform scale, every entry within UNIFORM_SCALE_TOLERANCE × s of s·I. */
+const gcsUniformScale = Fn(([k]: [Mat3]) => {
+  const s = column(k, 0).x.add(column(k, 1).y).add(column(k, 2).z).div(3).toVar();
+  const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
+  return s.greaterThan(0).and(deviation.lessThanEqual(s.mul(UNIFORM_SCALE_TOLERANCE)));
+}).setLayout({ name: 'gcsUniformScale', type: 'bool', inputs: [{ name: 'k', type: 'mat3' }] });
+
+/**
+ * The CPU's normalMatrix: r when k is a positive uniform scale, else r · cof(k) scaled to entries
+ * ≤ 1 (k divided by its largest entry first, so ×1e20 scales do not overflow); r alone when k has
+ * collapsed.
+ */
+const gcsNormalMatrix = Fn(([r, k, uniformScale]: [Mat3, Mat3, Bool]) => {
+  const n = r.toVar();
+  If(uniformScale.not(), () => {
+    const kbig = largest(k).toVar();
+    If(kbig.greaterThan(COLLAPSED), () => {
+      const a = k.mul(float(1).div(kbig)).toVar();
+      const a0 = column(a, 0), a1 = column(a, 1), a2 = column(a, 2);
+      const cof = mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1)).toVar();
+      const big = largest(cof).toVar();
+      If(big.greaterThan(COLLAPSED), () => {
+        n.assign(r.mul(cof.mul(float(1).div(big))));
+      });
+    });
+  });
+  return n;
+}).setLayout({ name: 'gcsNormalMatrix', type: 'mat3', inputs: [{ name: 'r', type: 'mat3' }, { name: 'k', type: 'mat3' }, { name: 'uniformScale', type: 'bool' }] });
+
+/** Σ of the entrywise products of two matrices: 1 + 2 cos θ for rotations θ apart. */
+const gcsTrace = Fn(([a, b]: [Mat3, Mat3]) =>
+  dot(column(a, 0), column(b, 0)).add(dot(column(a, 1), column(b, 1))).add(dot(column(a, 2), column(b, 2))),
+).setLayout({ name: 'gcsTrace', type: 'float', inputs: [{ name: 'a', type: 'mat3' }, { name: 'b', type: 'mat3' }] });
+
+/**
+ * A section's blended pose, in a joint's texel layout: columns 0–2 the rows of [M | t], column 3
+ * the blended rotation quaternion (not normalised). The dual-quaternion blend of `slots` joint
+ * poses at their weights (a joint past the last has weight 0: it adds nothing), each joint's scale
+ * part K_j = R_jᵀ S_j blended linearly and applied first: M = R·K, the CPU's blendPoses. With a
+ * centre of rotation p (`centre`, w = 1; w = 0: none) it turns about p, moved where LBS moves it:
+ * t = Σ w_i (S_i p + t_i − p) − (M p − p).
+ */
+function sectionBlendFunction(slots: TableSlots) {
+  const lanes = ['x', 'y', 'z', 'w'] as const;
+  const inputs = [
+    ...Array.from({ length: slots }, (_, c) => ({ name: `p${c}`, type: 'mat4' })),
+    ...Array.from({ length: slots / 4 }, (_, g) => ({ name: `w${g}`, type: 'vec4' })),
+    { name: 'centre', type: 'vec4' },
+  ];
+  return Fn((args: Node[]) => {
+    const all = [...args]; // TSL hands the parameters as an iterable proxy
+    const poses = all.slice(0, slots) as Mat4[], weights = all.slice(slots, slots + slots / 4) as Vec4[];
+    const centre = all[slots + slots / 4] as Vec4;
+    const pivot = column(poses[0], 3);
+    const br = vec4(0).toVar(), bd = vec4(0).toVar();
+    const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
+    const moved = vec3(0).toVar();
+    for (let c = 0; c < slots; c++) {
+      const p = poses[c], w = weights[c >> 2][lanes[c & 3]];
+      const r0 = column(p, 0), r1 = column(p, 1), r2 = column(p, 2), q = column(p, 3);
+      const s = mat3(r0.xyz, r1.xyz, r2.xyz).transpose(), t = vec3(r0.w, r1.w, r2.w);
+      const d = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
+      const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
+      br.addAssign(q.mul(sw));
+      bd.addAssign(d.mul(sw));
+      k.addAssign(gcsRotation(q, float(2)).transpose().mul(s).mul(w));
+      moved.addAssign(s.mul(centre.xyz).add(t).sub(centre.xyz).mul(w));
+    }
+    const inv2 = float(1).div(dot(br, br)).toVar();
+    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
+    const m = gcsRotation(br, inv2.mul(2)).mul(k).toVar();
+    If(centre.w.greaterThan(0.5), () => {
+      t.assign(moved.sub(m.mul(centre.xyz).sub(centre.xyz)));
+    });
+    const rows = m.transpose().toVar();
+    return mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), br);
+  }).setLayout({ name: `gcsSectionBlend${slots}`, type: 'mat4', inputs });
+}
+const gcsSectionBlend = { 4: sectionBlendFunction(4), 8: sectionBlendFunction(8) } as const;
+
+/**
+ * A normal or tangent as the CPU turns it (joint-level path): blended (smooth) normals are left as
+ * they are when both sides are rotations less than 2.8° apart, get the cubic length fix when less
+ * than 35° apart, else are normalised (a vanished one keeps its rest direction); unblended ones
+ * are normalised only when the scale asks for it.
+ */
+const gcsTurnJoint = Fn(([v, n, near, almostEqual, normalise]: [Vec3, Mat3, Bool, Bool, Bool]) => {
+  const x = n.mul(v).toVar();
+  const out = x.toVar();
+  If(almostEqual, () => {
+    out.assign(x);
+  }).ElseIf(near, () => {
+    const e = dot(x, x).sub(1);
+    out.assign(x.mul(float(1).add(e.mul(float(LENGTH_FIX[0]).add(e.mul(LENGTH_FIX[1]))))));
+  }).ElseIf(normalise, () => {
+    const l = length(x);
+    out.assign(select(l.greaterThan(0), x.div(l), v));
+  });
+  return out;
+}).setLayout({
+  name: 'gcsTurnJoint', type: 'vec3',
+  inputs: [{ name: 'v', type: 'vec3' }, { name: 'n', type: 'mat3' }, { name: 'near', type: 'bool' }, { name: 'almostEqual', type: 'bool' }, { name: 'normalise', type: 'bool' }],
+});
+
+/**
+ * Rows of the cofactor matrix of a section's 3×3 part (rows r0..r2), as matrix columns, divided by
+ * its largest entry first; `unitScale` (smooth mode, which blends them) also brings them to the
+ * CPU's scale: divided by |det|^(2/3), which turns cof(s·R) back into R.
+ */
+const gcsNormalRows = Fn(([r0, r1, r2, unitScale]: [Vec4, Vec4, Vec4, Bool]) => {
+  const big = largest(mat3(r0.xyz, r1.xyz, r2.xyz)).toVar();
+  const k = select(big.greaterThan(0), float(1).div(big), float(1));
+  const a = r0.xyz.mul(k).toVar(), b = r1.xyz.mul(k).toVar(), c = r2.xyz.mul(k).toVar();
+  const n = mat3(cross(b, c), cross(c, a), cross(a, b)).toVar();
+  If(unitScale, () => {
+    const det = abs(dot(a, column(n, 0))).toVar();
+    If(det.greaterThan(COLLAPSED), () => n.assign(n.mul(float(1).div(pow(det, 2 / 3)))));
+  });
+  return n;
+}).setLayout({
+  name: 'gcsNormalRows', type: 'mat3',
+  inputs: [{ name: 'r0', type: 'vec4' }, { name: 'r1', type: 'vec4' }, { name: 'r2', type: 'vec4' }, { name: 'unitScale', type: 'bool' }],
+});
+
+/** A normal or tangent turned by cofactor rows (section-level path), normalised; a vanished one keeps its rest direction. */
+const gcsTurn = Fn(([v, rows]: [Vec3, Mat3]) => {
+  const x = rows.transpose().mul(v).toVar();
+  const l = length(x);
+  return select(l.greaterThan(0), x.div(l), v);
+}).setLayout({ name: 'gcsTurn', type: 'vec3', inputs: [{ name: 'v', type: 'vec3' }, { name: 'rows', type: 'mat3' }] });
+
+// ------------------------------------------------------------ accessors (texel reads, per skin)
 
 /** Texel i of a float texture read with integer coordinates (row-major, the texture's width). */
-function texel(tex: N, i: N): N {
-  const w = int(textureSize(tex).x);
+function texel(tex: TextureNode, i: Int): Vec4 {
+  const w = int((textureSize(tex) as unknown as Node<'ivec2'>).x);
   const y = i.div(w);
   return tex.load(ivec2(i.sub(y.mul(w)), y));
 }
 
-/** The rotation matrix of quaternion q (x, y, z, w) scaled by k2 = 2 / |q|² (2 for a unit quaternion). */
-function rotation(q: N, k2: N): M3 {
-  const xx = q.x.mul(q.x), yy = q.y.mul(q.y), zz = q.z.mul(q.z), xy = q.x.mul(q.y), xz = q.x.mul(q.z), yz = q.y.mul(q.z);
-  const wx = q.w.mul(q.x), wy = q.w.mul(q.y), wz = q.w.mul(q.z);
-  const one = float(1);
-  return [
-    vec3(one.sub(k2.mul(yy.add(zz))), k2.mul(xy.add(wz)), k2.mul(xz.sub(wy))),
-    vec3(k2.mul(xy.sub(wz)), one.sub(k2.mul(xx.add(zz))), k2.mul(yz.add(wx))),
-    vec3(k2.mul(xz.add(wy)), k2.mul(yz.sub(wx)), one.sub(k2.mul(xx.add(yy)))),
-  ];
-}
+/** How one vertex moves: its position, and a function turning its normal (or tangent). */
+interface VertexTransform { position(p: Vec3): Vec3; turn(v: Vec3): Vec3 }
 
-/**
- * The CPU's normalMatrix: r when k is a positive uniform scale, else r · cof(k) scaled to entries
- * ≤ 1; r alone when k has collapsed. Also whether the normal is renormalised (1) or not (0).
- */
-function normalMatrix(r: M3, k: M3): { n: M3; renorm: N } {
-  const s = k[0].x.add(k[1].y).add(k[2].z).div(3).toVar();
-  let uniformScale: N = s.greaterThan(0);
-  const limit = s.mul(UNIFORM_SCALE_TOLERANCE);
-  for (let c = 0; c < 3; c++) for (let i = 0; i < 3; i++) {
-    const entry = k[c][['x', 'y', 'z'][i]];
-    uniformScale = uniformScale.and(abs(c === i ? entry.sub(s) : entry).lessThanEqual(limit));
-  }
-  uniformScale = uniformScale.toVar();
-  const kbig = largest(k).toVar();
-  const a = scale(k, float(1).div(kbig));
-  const cof = toVar([cross(a[1], a[2]), cross(a[2], a[0]), cross(a[0], a[1])]);
-  const big = largest(cof).toVar();
-  const scaled = mulMM(r, scale(cof, float(1).div(big)));
-  const keep = uniformScale.or(kbig.greaterThan(COLLAPSED).not()).or(big.greaterThan(COLLAPSED).not());
-  return { n: toVar(pick(keep, r, scaled)), renorm: select(uniformScale, float(0), float(1)) };
+/** The joint-level path's inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
+interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
+
+/** Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion. */
+function jointPose(inputs: JointInputs, j: Int): Mat4 {
+  const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
+  return mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
 }
 
 /** One section's transform x ↦ M x + T, its normal matrix N and whether normals renormalise. */
-interface SectionBlend { m: M3; t: N; n: M3; renorm: N }
-
-/** The joint-level path's inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
-interface JointInputs { joints: N; table: N; slots: TableSlots; first: N }
-
-/** Joint j's pose: S_j (columns), its translation and rotation quaternion. */
-function joint(inputs: JointInputs, j: N): { s: M3; t: N; q: N } {
-  const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
-  const r0 = texel(inputs.joints, i).toVar(), r1 = texel(inputs.joints, i.add(1)).toVar(), r2 = texel(inputs.joints, i.add(2)).toVar();
-  const q = texel(inputs.joints, i.add(3)).toVar();
-  return { s: transpose([r0.xyz, r1.xyz, r2.xyz]), t: vec3(r0.w, r1.w, r2.w), q };
-}
+interface Section { m: Mat3; t: Vec3; n: Mat3; renorm: Bool }
 
 /**
- * Section s blended from its joints (the GLSL's gcsSectionBlend): a rigid core is S_j; otherwise
- * the dual-quaternion blend at its weights, K_j = R_jᵀ S_j blended linearly and applied first.
- * Joints past the last (−1) get weight 0, which adds nothing: the GLSL's early break.
+ * Section s (the GLSL's gcsSectionBlend): a rigid core moves with its joint; otherwise its joints'
+ * poses blended (gcsSectionBlend). Its normal matrix from the pose's rotation R and scale part K = Rᵀ M.
  */
-function sectionBlend(inputs: JointInputs, s: N): SectionBlend {
-  // Per 4 slots, a texel of joints then one of weights (slots 4..7: the third and fourth texels).
-  const row = s.mul(tableTexelsPerSection(inputs.slots)).toVar();
-  const jointTexels: N[] = [], weightTexels: N[] = [];
+function section(inputs: JointInputs, s: Int): Section {
+  // Per 4 slots, a texel of joints (−1 past the last) then one of weights; last, the centre.
+  const texels = tableTexelsPerSection(inputs.slots);
+  const row = s.mul(texels).toVar();
+  const joints: Vec4[] = [], weights: Vec4[] = [];
   for (let g = 0; g < inputs.slots / 4; g++) {
-    jointTexels.push(texel(inputs.table, row.add(2 * g)).toVar());
-    weightTexels.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
+    joints.push(texel(inputs.table, row.add(2 * g)).toVar());
+    weights.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
   }
-  const joints = jointTexels[0], weights = weightTexels[0];
   const lanes = ['x', 'y', 'z', 'w'] as const;
-  const j0 = joint(inputs, int(joints.x));
-  const rigidRotation = rotation(j0.q, float(2));
-  const rigidNormal = normalMatrix(rigidRotation, mulMM(transpose(rigidRotation), j0.s));
-
-  const pivot = j0.q;
-  let br: N = vec4(0), bd: N = vec4(0);
-  let k: M3 = ZERO();
-  // The centre of rotation p (w = 1; w = 0: none) and Σ w_i (S_i p − p), where LBS moves it.
-  const centre = texel(inputs.table, row.add(tableTexelsPerSection(inputs.slots) - 1)).toVar();
-  let moved: N = vec3(0);
-  for (let c = 0; c < inputs.slots; c++) {
-    const id = jointTexels[c >> 2][lanes[c & 3]];
-    const { s: S, t, q } = c === 0 ? j0 : joint(inputs, max(int(id), int(0)));
-    const d = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
-    const w = c === 0 ? weights.x : select(id.lessThan(0), float(0), weightTexels[c >> 2][lanes[c & 3]]);
-    const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
-    br = br.add(q.mul(sw));
-    bd = bd.add(d.mul(sw));
-    k = add(k, scale(mulMM(transpose(rotation(q, float(2))), S), w));
-    moved = moved.add(mulMV(S, centre.xyz).add(t).sub(centre.xyz).mul(w));
-  }
-  br = br.toVar();
-  bd = bd.toVar();
-  k = toVar(k);
-  const inv2 = float(1).div(dot(br, br)).toVar();
-  const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2));
-  const rot = toVar(rotation(br, inv2.mul(2)));
-  const blended = normalMatrix(rot, k);
-  const rigid = joints.y.lessThan(0);
-  const m = toVar(mulMM(rot, k));
-  // With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
-  const aboutCentre = moved.sub(mulMV(m, centre.xyz).sub(centre.xyz));
-  return {
-    m: toVar(pick(rigid, j0.s, m)),
-    t: select(rigid, j0.t, select(centre.w.greaterThan(0.5), aboutCentre, t)).toVar(),
-    n: toVar(pick(rigid, rigidNormal.n, blended.n)),
-    renorm: select(rigid, rigidNormal.renorm, blended.renorm).toVar(),
-  };
+  const pose = jointPose(inputs, int(joints[0].x)).toVar();
+  If(joints[0].y.greaterThanEqual(0), () => {
+    const poses: Mat4[] = [pose];
+    for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(joints[c >> 2][lanes[c & 3]], 0))));
+    // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
+    const used = weights.map((w, g) => step(vec4(0), joints[g]).mul(w));
+    const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
+    pose.assign(gcsSectionBlend[inputs.slots](...poses, ...used, centre));
+  });
+  const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
+  const m = mat3(r0.xyz, r1.xyz, r2.xyz).transpose().toVar();
+  const rotation = gcsRotation(q, float(2).div(dot(q, q))).toVar();
+  const k = rotation.transpose().mul(m).toVar();
+  const uniformScale = gcsUniformScale(k).toVar();
+  return { m, t: vec3(r0.w, r1.w, r2.w).toVar(), n: gcsNormalMatrix(rotation, k, uniformScale).toVar(), renorm: uniformScale.not().toVar() };
 }
 
-/** How one vertex moves: its position, and a function turning its normal (or tangent). */
-interface VertexTransform { position(p: N): N; turn(v: N): N }
-
-/** The joint-level path per vertex (the GLSL's JOINT_BASE and gcsTurnJoint). */
+/** The joint-level path per vertex (the GLSL's JOINT_BASE): the third section only where there is one. */
 function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
-  let m: M3, t: N, n: M3, near: N, almostEqual: N, normalise: N;
-  if (smooth) {
-    const blend = attribute(BLEND_ATTRIBUTE, 'vec3'), third = attribute(BLEND_THIRD_ATTRIBUTE, 'vec2');
-    const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar(), sc = int(third.x.add(0.5)).toVar();
-    // A third section (a three-joint lattice cell) is blended in by g; without one, c is a and g is 0.
-    const a = sectionBlend(inputs, sa), b = sectionBlend(inputs, sb), c = sectionBlend(inputs, sc);
-    const f = blend.z, g = third.y;
-    const same = sa.equal(sb), three = sc.notEqual(sa);
-    const traceAB = trace(a.n, b.n).toVar();
-    const least = min(traceAB, min(trace(a.n, c.n), trace(b.n, c.n)));
-    const rotations = a.renorm.lessThan(0.5).and(b.renorm.lessThan(0.5)).and(three.not().or(c.renorm.lessThan(0.5)));
-    m = toVar(pick(same, a.m, blend3(a.m, b.m, c.m, f, g)));
-    t = select(same, a.t, a.t.add(b.t.sub(a.t).mul(f)).add(c.t.sub(a.t).mul(g))).toVar();
-    n = toVar(pick(same, a.n, blend3(a.n, b.n, c.n, f, g)));
-    near = same.not().and(rotations).and(select(three, least.greaterThan(NEAR_TRACE3), traceAB.greaterThan(NEAR_TRACE))).toVar();
-    almostEqual = near.and(select(three, least.greaterThan(ALMOST_EQUAL_TRACE3), traceAB.greaterThan(ALMOST_EQUAL_TRACE))).toVar();
-    normalise = same.not().or(a.renorm.greaterThan(0.5)).toVar();
-  } else {
-    const a = sectionBlend(inputs, int(attribute(SECTION_ATTRIBUTE, 'float').add(0.5)));
-    ({ m, t, n } = a);
-    near = null;
-    almostEqual = null;
-    normalise = a.renorm.greaterThan(0.5);
+  if (!smooth) {
+    const a = section(inputs, int(attribute<'float'>(SECTION_ATTRIBUTE, 'float').add(0.5)));
+    return { position: (p) => a.m.mul(p).add(a.t), turn: (v) => gcsTurnJoint(v, a.n, bool(false), bool(false), a.renorm) };
   }
-  return {
-    position: (p) => mulMV(m, p).add(t),
-    turn: (v) => {
-      const x = mulMV(n, v).toVar();
-      const e = dot(x, x).sub(1);
-      const l = length(x);
-      const normalised = select(l.greaterThan(0), x.div(l), v);
-      const plain = select(normalise, normalised, x);
-      if (!near) return plain;
-      const fixed = select(near, x.mul(float(1).add(e.mul(e.mul(LENGTH_FIX[1]).add(LENGTH_FIX[0])))), plain);
-      return select(almostEqual, x, fixed);
-    },
-  };
+  const blend = attribute<'vec3'>(BLEND_ATTRIBUTE, 'vec3'), third = attribute<'vec2'>(BLEND_THIRD_ATTRIBUTE, 'vec2');
+  const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar(), sc = int(third.x.add(0.5)).toVar();
+  const a = section(inputs, sa);
+  const m = a.m.toVar(), t = a.t.toVar(), n = a.n.toVar();
+  const near = bool(false).toVar(), almostEqual = bool(false).toVar(), normalise = a.renorm.toVar();
+  If(sb.notEqual(sa), () => {
+    const b = section(inputs, sb);
+    const f = blend.z;
+    const trace = gcsTrace(a.n, b.n).toVar();
+    m.assign(a.m.add(b.m.sub(a.m).mul(f)));
+    t.assign(a.t.add(b.t.sub(a.t).mul(f)));
+    n.assign(a.n.add(b.n.sub(a.n).mul(f)));
+    If(sc.notEqual(sa), () => {
+      // A three-joint lattice cell: + g·(C − A); the least pairwise trace decides the fix.
+      const c = section(inputs, sc);
+      const g = third.y;
+      m.addAssign(c.m.sub(a.m).mul(g));
+      t.addAssign(c.t.sub(a.t).mul(g));
+      n.addAssign(c.n.sub(a.n).mul(g));
+      trace.assign(min(trace, min(gcsTrace(a.n, c.n), gcsTrace(b.n, c.n))));
+      near.assign(a.renorm.or(b.renorm).or(c.renorm).not().and(trace.greaterThan(NEAR_TRACE3)));
+      almostEqual.assign(near.and(trace.greaterThan(ALMOST_EQUAL_TRACE3)));
+    }).Else(() => {
+      near.assign(a.renorm.or(b.renorm).not().and(trace.greaterThan(NEAR_TRACE)));
+      almostEqual.assign(near.and(trace.greaterThan(ALMOST_EQUAL_TRACE)));
+    });
+    normalise.assign(true);
+  });
+  return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnJoint(v, n, near, almostEqual, normalise) };
 }
 
-/** The section-level path per vertex (the GLSL's BASE, gcsNormalRows, gcsTurn). */
-function sectionVertex(sections: N, first: N, smooth: boolean): VertexTransform {
-  const rows = (section: N): [N, N, N] => {
-    const i = first.add(section.mul(GPU_TEXELS_PER_SECTION)).toVar();
+/** The section-level path per vertex (the GLSL's BASE): rows of each section's affine 3×4, blended. */
+function sectionVertex(sections: TextureNode, first: Int, smooth: boolean): VertexTransform {
+  const rows = (s: Int): [Vec4, Vec4, Vec4] => {
+    const i = first.add(s.mul(GPU_TEXELS_PER_SECTION)).toVar();
     return [texel(sections, i).toVar(), texel(sections, i.add(1)).toVar(), texel(sections, i.add(2)).toVar()];
   };
-  // Rows of the cofactor matrix, scaled first so no entry overflows; smooth: brought to the CPU's scale.
-  const normalRows = (r: [N, N, N], unitScale: boolean): M3 => {
-    const big = largest([r[0].xyz, r[1].xyz, r[2].xyz]).toVar();
-    const k = select(big.greaterThan(0), float(1).div(big), float(1));
-    const a = r[0].xyz.mul(k), b = r[1].xyz.mul(k), c = r[2].xyz.mul(k);
-    const n: M3 = toVar([cross(b, c), cross(c, a), cross(a, b)]);
-    if (!unitScale) return n;
-    const det = abs(dot(a, n[0])).toVar();
-    return toVar(scale(n, select(det.greaterThan(COLLAPSED), float(1).div(pow(det, 2 / 3)), float(1))));
-  };
-  let r: [N, N, N], n: M3;
+  let r: [Vec4, Vec4, Vec4], n: Mat3;
   if (smooth) {
-    const blend = attribute(BLEND_ATTRIBUTE, 'vec3'), third = attribute(BLEND_THIRD_ATTRIBUTE, 'vec2');
-    const a = rows(int(blend.x.add(0.5))), b = rows(int(blend.y.add(0.5))), c = rows(int(third.x.add(0.5)));
-    const f = blend.z, g = third.y;
-    r = [0, 1, 2].map((i) => a[i].add(b[i].sub(a[i]).mul(f)).add(c[i].sub(a[i]).mul(g))) as [N, N, N];
-    n = toVar(blend3(normalRows(a, true), normalRows(b, true), normalRows(c, true), f, g));
+    const blend = attribute<'vec3'>(BLEND_ATTRIBUTE, 'vec3'), third = attribute<'vec2'>(BLEND_THIRD_ATTRIBUTE, 'vec2');
+    const sa = int(blend.x.add(0.5)).toVar(), sc = int(third.x.add(0.5)).toVar();
+    const a = rows(sa), b = rows(int(blend.y.add(0.5)));
+    const f = blend.z;
+    const lerp = (i: number): Vec4 => a[i].add(b[i].sub(a[i]).mul(f)).toVar();
+    r = [lerp(0), lerp(1), lerp(2)];
+    const na = gcsNormalRows(a[0], a[1], a[2], bool(true)).toVar();
+    n = na.add(gcsNormalRows(b[0], b[1], b[2], bool(true)).sub(na).mul(f)).toVar();
+    If(sc.notEqual(sa), () => {
+      // A three-joint lattice cell: + g·(C − A).
+      const c = rows(sc), g = third.y;
+      for (let i = 0; i < 3; i++) r[i].addAssign(c[i].sub(a[i]).mul(g));
+      n.addAssign(gcsNormalRows(c[0], c[1], c[2], bool(true)).sub(na).mul(g));
+    });
   } else {
-    r = rows(int(attribute(SECTION_ATTRIBUTE, 'float').add(0.5)));
-    n = normalRows(r, false);
+    r = rows(int(attribute<'float'>(SECTION_ATTRIBUTE, 'float').add(0.5)));
+    n = gcsNormalRows(r[0], r[1], r[2], bool(false)).toVar();
   }
   return {
     position: (p) => { const h = vec4(p, 1); return vec3(dot(r[0], h), dot(r[1], h), dot(r[2], h)); },
-    turn: (v) => {
-      const x = vec3(dot(n[0], v), dot(n[1], v), dot(n[2], v)).toVar();
-      const l = length(x);
-      return select(l.greaterThan(0), x.div(l), v);
-    },
+    turn: (v) => gcsTurn(v, n),
   };
+}
+
+/** Whether this build writes velocity (three.js asks for previous positions then). */
+const needsPreviousData = (builder: NodeBuilder): boolean => (builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData();
+
+/**
+ * The CPU backend's `positionNode` on WebGPURenderer: the deformed position as it is (wasm wrote
+ * it), and, in a velocity pass, `positionPrevious` from the deformer's previous positions.
+ */
+export function previousPositionNode(): Node<'vec3'> {
+  return Fn((builder: NodeBuilder) => {
+    if (needsPreviousData(builder)) positionPrevious.assign(attribute<'vec3'>(PREVIOUS_POSITION_ATTRIBUTE, 'vec3'));
+    return positionLocal;
+  })();
+}
+
+/** How each vertex moves under one per-frame texture (joint poses or section transforms). */
+function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int): VertexTransform {
+  return sections.path === 'joints'
+    ? jointVertex({ joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first }, sections.smooth)
+    : sectionVertex(perFrame, first, sections.smooth);
 }
 
 /**
@@ -238,27 +335,35 @@ function sectionVertex(sections: N, first: N, smooth: boolean): VertexTransform 
  * (three.js morphs before positionNode). Crowd (`instanced`): three.js has already placed the
  * instance by then, so it starts from the bind-pose attributes and places the instance itself
  * with the mesh's own `instanceMatrix` (each instance's pose at `instanceIndex`).
+ *
+ * Velocity (a render pass whose MRT has `velocity`): `positionPrevious` gets the same vertex under
+ * the previous frame's texels (GpuSections.previousTexture), as three.js's skinning does with its
+ * previous bone matrices; a crowd places it with the current instance matrix.
  */
-export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node {
+export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node<'vec3'> {
   const perFrame = texture(sections.texture);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);
   const strideNode = uniform(stride.value, 'int').onObjectUpdate(() => stride.value);
-  return Fn((builder: N) => {
+  return Fn((builder: NodeBuilder) => {
+    const has = (name: string) => builder.geometry?.getAttribute(name) !== undefined;
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
-    const vertex = sections.path === 'joints'
-      ? jointVertex({ joints: perFrame, table: texture(sections.table as THREE.DataTexture), slots: sections.tableSlots, first }, sections.smooth)
-      : sectionVertex(perFrame, first, sections.smooth);
-    const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') : null;
-    if (builder.hasGeometryAttribute('normal')) {
+    const vertex = vertexTransform(sections, perFrame, first);
+    const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
+    const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
+    if (needsPreviousData(builder)) {
+      OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
+      const previous = vertexTransform(sections, texture(sections.previousTexture()), first);
+      positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
+    }
+    if (has('normal')) {
       const n = vertex.turn(instanced ? normalGeometry : normalLocal);
       normalLocal.assign(placement ? transformNormal(n, placement) : n);
     }
-    if (builder.hasGeometryAttribute('tangent')) {
+    if (has('tangent')) {
       const t = vertex.turn(instanced ? tangentGeometry.xyz : tangentLocal);
       tangentLocal.assign(placement ? placement.mul(vec4(t, 0)).xyz : t);
     }
-    const p = vertex.position(instanced ? positionGeometry : positionLocal);
-    return placement ? placement.mul(vec4(p, 1)).xyz : p;
+    return place(vertex.position(instanced ? positionGeometry : positionLocal));
   })();
 }

@@ -74,4 +74,7 @@ export const glslKit: GpuMaterialKit = {
     if (r?.isWebGPURenderer) return "WebGPURenderer draws this mesh, and it never runs the GLSL patch of gcs-skin/three's GPU backend: import GcsCharacter / GcsCrowd from 'gcs-skin/webgpu' for GCS on the GPU there";
     return null;
   },
+  // WebGLRenderer has no velocity pass; gcs-skin/webgpu's kit hands WebGPURenderer's the previous positions.
+  drawsVelocity: () => false,
+  velocityMaterial: () => null,
 };

@@ -18,8 +18,6 @@ export interface PendingBuild {
   gcs: GcsOptions;
   classic: ClassicOptions;
   deformer: Deformer;
-  /** Deforms the tangents (as its normals), or null. */
-  tangentDeformer: Deformer | null;
   geometry: THREE.BufferGeometry;
   /** Per morph target, the largest delta length; null without morphs. */
   maxDelta: Float32Array | null;
@@ -44,10 +42,8 @@ export interface GpuBuild {
 export interface BuildSource {
   readonly source: THREE.SkinnedMesh;
   readonly rig: Rig;
-  /** The rig fed the tangents as its normals, or null. */
-  readonly tangentRig: Rig | null;
-  /** tangent w per source vertex (handedness), or null. */
-  readonly tangentW: Float32Array | null;
+  /** The source's tangents (xyz, w) in its vertex order, handed to each CPU build's deformer; null without or 'drop'. */
+  readonly tangents: Float32Array | null;
   /** The options of the current build (what `options` of prepareBuild do not change). */
   readonly options: SkinDeformerOptions;
   /** The material drawn by the CPU backend. */
@@ -74,7 +70,6 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
   const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
     : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
   const deformer = build(from.rig);
-  let tangentDeformer: Deformer | null = null;
   let gpu: GpuBuild | null = null;
   try {
     const sourceVertex = deformer.sourceVertex;
@@ -82,23 +77,15 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
     if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
     if (onGpu) {
       gpu = prepareGpu(from, deformer as GcsDeformer, gpuPath === 'auto' ? undefined : gpuPath);
-      const geometry = makeGeometry(from, deformer, sourceVertex, null, gpu);
-      return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
+      const geometry = makeGeometry(from, deformer, sourceVertex, gpu);
+      return { method, gcs: gcsOptions, classic: classicOptions, deformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
     }
-    if (from.tangentRig && sourceVertex) {
-      tangentDeformer = build(from.tangentRig);
-      // Same positions and weights, so the same vertex order; checked, not assumed.
-      const order = tangentDeformer.sourceVertex;
-      if (!order || order.length !== sourceVertex.length || order.some((v, i) => v !== sourceVertex[i])) {
-        tangentDeformer.dispose();
-        tangentDeformer = null;
-      }
-    }
-    const geometry = makeGeometry(from, deformer, sourceVertex, tangentDeformer, null);
-    return { method, gcs: gcsOptions, classic: classicOptions, deformer, tangentDeformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend, gpuPath };
+    // The same deform call turns them (the classic model resamples and takes none).
+    if (from.tangents && sourceVertex) deformer.setTangents(from.tangents);
+    const geometry = makeGeometry(from, deformer, sourceVertex, null);
+    return { method, gcs: gcsOptions, classic: classicOptions, deformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend, gpuPath };
   } catch (e) {
     if (gpu) disposeGpu(gpu);
-    tangentDeformer?.dispose();
     deformer.dispose();
     throw e;
   }
@@ -107,7 +94,6 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
 /** Frees a prepared build that will not be shown. */
 export function discardBuild(next: PendingBuild): void {
   if (next.gpu) disposeGpu(next.gpu);
-  next.tangentDeformer?.dispose();
   next.deformer.dispose();
   next.geometry.dispose();
 }
@@ -142,7 +128,7 @@ function prepareGpu(from: BuildSource, deformer: GcsDeformer, path?: GpuPath): G
 }
 
 /** The output geometry of a build: the deformer's buffers (CPU) or the bind pose with section data (GPU), and the source's other attributes. */
-function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint32Array | null, tangentDeformer: Deformer | null, gpu: GpuBuild | null): THREE.BufferGeometry {
+function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint32Array | null, gpu: GpuBuild | null): THREE.BufferGeometry {
   const src = from.source.geometry;
   const indices = deformer.indices;
   let geometry: THREE.BufferGeometry;
@@ -157,11 +143,9 @@ function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint3
     if (sourceVertex) {
       for (const [name, attr] of Object.entries(src.attributes))
         if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
-      if (tangentDeformer && from.tangentW) {
-        const w = new Float32Array(4 * sourceVertex.length);
-        for (let o = 0; o < sourceVertex.length; o++) w[4 * o + 3] = from.tangentW[sourceVertex[o]];
-        geometry.setAttribute('tangent', new THREE.BufferAttribute(w, 4).setUsage(THREE.DynamicDrawUsage));
-      }
+      // The deformer's own tangent output (xyz turned, w carried), drawn in place like positions.
+      const tangents = deformer.tangents;
+      if (tangents) geometry.setAttribute('tangent', new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage));
     } else if (deformer instanceof ClassicDeformer) {
       // Resampled: the source's uv, colours and custom attributes from the closest source point.
       deformer.deform(identitySkin(from.rig.jointCount));

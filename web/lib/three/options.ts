@@ -25,8 +25,8 @@ export interface SkinDeformerOptions {
   inPlace?: boolean;
   /**
    * When the source geometry has a `tangent` attribute: 'deform' (default) turns the tangents
-   * with the skin (a second deformer of the same kind, fed the tangents as its normals: one more
-   * deform and a copy per frame); 'drop' leaves them out, and three.js derives the tangent frame
+   * with the skin (the deformer's own pass: one deform call writes positions, normals and
+   * tangents; the GPU backend turns them in the shader); 'drop' leaves them out, and three.js derives the tangent frame
    * of normal maps from the deformed positions and uvs (screen-space derivatives). Carrying the
    * bind-pose tangents unchanged would tilt normal maps wherever the skin bends, so that is not
    * offered. Ignored by the classic model.

@@ -4,7 +4,7 @@ import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { CLASSIC_LIMITS, type Deformer, type DeformerKind, type GcsSkin, type Rig } from '../index.js';
 import type { GpuMaterialKit } from '../gpu/kit.js';
-import type { GpuPath } from '../gpu/layout.js';
+import { PREVIOUS_POSITION_ATTRIBUTE, type GpuPath } from '../gpu/layout.js';
 import type { GpuSections } from '../gpu/sections.js';
 import { glslKit } from '../gpu/webgl-materials.js';
 import { boneBounds, boundsFromBones, boundsOfPositions, type BoneBalls } from './bounds.js';
@@ -51,11 +51,14 @@ export class SkinDeformer {
   private readonly sourceLayers: number;
   /** In place, parentless source: the mesh is its child at identity. */
   private readonly childOfSource: boolean;
-  private tangentRig: Rig | null = null;
-  private tangentDeformer: Deformer | null = null;
-  /** tangent w per source vertex (handedness), copied beside the deformed xyz. */
-  private tangentW: Float32Array | null = null;
-  private tangentOut: Float32Array | null = null;
+  /** The source's tangents (xyz, w per source vertex) that CPU builds hand their deformer; null without or 'drop'. */
+  private readonly tangents: Float32Array | null = null;
+  /**
+   * CPU backend, velocity: set when the renderer drew a velocity pass (kit.drawsVelocity); from the
+   * next update() the deformer keeps its previous positions and the mesh wears the kit's velocity
+   * material. 'unsupported': the kit or a material cannot (drawn as before, no velocity).
+   */
+  private velocity: 'off' | 'wanted' | 'unsupported' | { material: THREE.Material | THREE.Material[] } = 'off';
   /** Per morph target, the largest delta length (null: no morphs this build). */
   private maxDelta: Float32Array | null = null;
   // Bounds from the bones: per joint j that carries skin, its bind position b_j (mesh space) and
@@ -91,24 +94,13 @@ export class SkinDeformer {
     this.method = options.method ?? 'gcs';
     this.inPlace = options.inPlace === true;
     this.rig = gcs.createRig(input);
-    try {
-      const tangent = source.geometry.getAttribute('tangent');
-      if (tangent && tangent.itemSize >= 3 && options.tangents !== 'drop') {
-        const n = tangent.count;
-        const xyz = new Float32Array(3 * n);
-        const w = new Float32Array(n);
-        for (let i = 0; i < n; i++) {
-          xyz[3 * i] = tangent.getX(i);
-          xyz[3 * i + 1] = tangent.getY(i);
-          xyz[3 * i + 2] = tangent.getZ(i);
-          w[i] = tangent.itemSize > 3 ? (tangent.getW(i) < 0 ? -1 : 1) : 1;
-        }
-        this.tangentRig = gcs.createRig({ ...input, normals: xyz });
-        this.tangentW = w;
-      }
-    } catch (e) {
-      this.rig.dispose();
-      throw e;
+    const tangent = source.geometry.getAttribute('tangent');
+    if (tangent && tangent.itemSize >= 3 && options.tangents !== 'drop') {
+      const n = tangent.count, t = new Float32Array(4 * n);
+      // Build time only: getX/getY… read interleaved and normalised attributes alike.
+      for (let i = 0; i < n; i++)
+        t.set([tangent.getX(i), tangent.getY(i), tangent.getZ(i), tangent.itemSize > 3 && tangent.getW(i) < 0 ? -1 : 1], 4 * i);
+      this.tangents = t;
     }
     this.skin = new Float32Array(this.rig.jointCount * 16);
     ({ pivots: this.pivots, own: this.ownBalls, near: this.nearBalls } = boneBounds(input, this.rig.jointCount));
@@ -122,6 +114,7 @@ export class SkinDeformer {
     mesh.exactBounds = () => this.exactBounds();
     mesh.onBeforeRender = (renderer, _scene, _camera, geometry, material) => {
       if (this.gpu) this.checkRenderer(renderer, geometry, material);
+      else if (this.velocity === 'off' && this.kit.drawsVelocity(renderer)) this.velocity = 'wanted';
     };
     mesh.name = source.name;
     mesh.castShadow = source.castShadow;
@@ -138,7 +131,6 @@ export class SkinDeformer {
     try {
       this.commit(this.prepare(this.method, options));
     } catch (e) {
-      this.tangentRig?.dispose();
       this.rig.dispose();
       throw e;
     }
@@ -169,7 +161,7 @@ export class SkinDeformer {
   /** @internal Builds the next deformer and its geometry without showing them. */
   prepare(method: DeformerKind, options: RebuildOptions = {}): PendingBuild {
     return prepareBuild({
-      source: this.source, rig: this.rig, tangentRig: this.tangentRig, tangentW: this.tangentW, options: this.options,
+      source: this.source, rig: this.rig, tangents: this.tangents, options: this.options,
       baseMaterial: this.baseMaterial, kit: this.kit, mesh: this.mesh, box: this.box, sphere: this.sphere,
     }, method, options);
   }
@@ -192,9 +184,9 @@ export class SkinDeformer {
   /** @internal Shows a prepared build; the previous deformer and geometry are freed (the geometry at the next update() when `duringDraw`). */
   commit(next: PendingBuild, duringDraw = false): void {
     this.deformer?.dispose();
-    this.tangentDeformer?.dispose();
     if (this.gpu) disposeGpu(this.gpu);
     this.gpu = next.gpu;
+    this.stopVelocity(); // a CPU build starts it again at its first update()
     this.note = next.note;
     if (next.note && !this.warned.has(next.note)) {
       this.warned.add(next.note);
@@ -212,8 +204,6 @@ export class SkinDeformer {
     mesh.morphTargetInfluences = gpuMorphs ? this.source.morphTargetInfluences : undefined;
     mesh.morphTargetDictionary = gpuMorphs ? this.source.morphTargetDictionary : undefined;
     this.deformer = next.deformer;
-    this.tangentDeformer = next.tangentDeformer;
-    this.tangentOut = next.tangentDeformer ? (next.geometry.getAttribute('tangent') as THREE.BufferAttribute).array as Float32Array : null;
     this.maxDelta = next.maxDelta;
     const paper = next.method === 'gcs' && (next.gcs.criterion === 'y' || next.gcs.criterion === 'axial');
     this.balls = paper || next.method === 'classic' ? this.nearBalls : this.ownBalls;
@@ -275,21 +265,11 @@ export class SkinDeformer {
       gpu.sections.update(); // section transforms only; the texture is uploaded at the next render
       this.cpuFresh = false;
     } else {
-      deformer.deform(skin);
+      if (this.velocity === 'wanted') this.startVelocity();
+      deformer.deform(skin); // positions, normals and tangents; the last positions become the previous
     }
     boundsFromBones(skin, this.pivots, this.balls, this.ballFactor, grow, this.box, this.sphere, this.tmp, this.point);
     this.exactFresh = false;
-    const tangents = this.tangentDeformer;
-    if (tangents) {
-      tangents.deform(skin);
-      const t = tangents.normals, out = this.tangentOut!;
-      for (let o = 0, n = tangents.vertexCount; o < n; o++) {
-        out[4 * o] = t[3 * o];
-        out[4 * o + 1] = t[3 * o + 1];
-        out[4 * o + 2] = t[3 * o + 2];
-      }
-      (mesh.geometry.getAttribute('tangent') as THREE.BufferAttribute).needsUpdate = true;
-    }
     if (this.inPlace && !this.childOfSource) {
       mesh.position.copy(source.position);
       mesh.quaternion.copy(source.quaternion);
@@ -325,17 +305,40 @@ export class SkinDeformer {
     return true;
   }
 
-  /** Points the attributes at live views (memory growth detaches old ones) and flags the upload. */
+  /**
+   * Points the attributes at the deformer's live views (memory growth detaches old ones; with
+   * velocity, positions and previous positions swap arrays every frame) and flags the upload.
+   */
   private syncAttributes(): void {
-    const geometry = this.mesh.geometry;
-    const position = geometry.getAttribute('position') as THREE.BufferAttribute;
-    const normal = geometry.getAttribute('normal') as THREE.BufferAttribute;
-    const positions = this.deformer.positions;
-    if (position.array !== positions) position.array = positions;
-    const normals = this.deformer.normals;
-    if (normal.array !== normals) normal.array = normals;
-    position.needsUpdate = true;
-    normal.needsUpdate = true;
+    const geometry = this.mesh.geometry, deformer = this.deformer;
+    sync(geometry.getAttribute('position'), deformer.positions);
+    sync(geometry.getAttribute('normal'), deformer.normals);
+    sync(geometry.getAttribute('tangent'), deformer.tangents);
+    sync(geometry.getAttribute(PREVIOUS_POSITION_ATTRIBUTE), deformer.previousPositions);
+  }
+
+  /** CPU backend, the first frame after a velocity pass: previous positions kept and handed to the renderer. */
+  private startVelocity(): void {
+    const base = Array.isArray(this.baseMaterial) ? this.baseMaterial : [this.baseMaterial];
+    const materials = base.map((m) => this.kit.velocityMaterial(m));
+    if (materials.some((m) => m === null)) {
+      for (const m of materials) m?.dispose();
+      this.velocity = 'unsupported'; // a custom shader, a node material with its own position node
+      return;
+    }
+    this.deformer.keepPreviousPositions(true);
+    this.mesh.geometry.setAttribute(PREVIOUS_POSITION_ATTRIBUTE, new THREE.BufferAttribute(this.deformer.previousPositions!, 3).setUsage(THREE.DynamicDrawUsage));
+    const material = Array.isArray(this.baseMaterial) ? materials as THREE.Material[] : materials[0]!;
+    this.mesh.material = material;
+    this.velocity = { material };
+  }
+
+  /** Back to no velocity (a new build; dispose): the velocity materials freed; once wanted, tried again with the next build. */
+  private stopVelocity(): void {
+    const v = this.velocity;
+    if (v === 'off' || v === 'wanted') return;
+    if (v !== 'unsupported') for (const m of Array.isArray(v.material) ? v.material : [v.material]) m.dispose();
+    this.velocity = 'wanted';
   }
 
   get currentMethod(): DeformerKind {
@@ -366,16 +369,16 @@ export class SkinDeformer {
   get bytesPerFrame(): number {
     if (this.gpu) return this.gpu.sections.bytesPerUpdate;
     let bytes = 0;
-    for (const name of ['position', 'normal', 'tangent']) {
+    for (const name of ['position', 'normal', 'tangent', PREVIOUS_POSITION_ATTRIBUTE]) {
       const a = this.mesh.geometry.getAttribute(name) as THREE.BufferAttribute | undefined;
       if (a && a.usage === THREE.DynamicDrawUsage) bytes += a.array.byteLength;
     }
     return bytes;
   }
 
-  /** True when tangents are deformed this build (the source has them and the method keeps vertices). */
+  /** True when tangents are deformed this build (the source has them and the method keeps vertices: by the core pass, or the GPU backend's shader). */
   get deformsTangents(): boolean {
-    return this.tangentDeformer !== null;
+    return this.gpu ? this.mesh.geometry.getAttribute('tangent') !== undefined : this.deformer.tangents !== null;
   }
 
   private live(): void {
@@ -391,13 +394,11 @@ export class SkinDeformer {
     if (this.isDisposed) return;
     this.isDisposed = true;
     this.deformer?.dispose();
-    this.tangentDeformer?.dispose();
-    this.tangentDeformer = null;
+    this.stopVelocity();
     if (this.gpu) disposeGpu(this.gpu);
     this.gpu = null;
     const mesh = this.mesh as DeformedMesh;
     mesh.raycastGeometry = null;
-    this.tangentRig?.dispose();
     this.rig.dispose();
     this.mesh.removeFromParent();
     this.mesh.geometry.dispose();
@@ -408,4 +409,12 @@ export class SkinDeformer {
   get disposed(): boolean {
     return this.isDisposed;
   }
+}
+
+/** Points a dynamic attribute at `array` (a live wasm view) and flags its upload. */
+function sync(attribute: THREE.BufferAttribute | THREE.InterleavedBufferAttribute | undefined, array: Float32Array | null): void {
+  const a = attribute as THREE.BufferAttribute | undefined;
+  if (!a || !array) return;
+  if (a.array !== array) a.array = array;
+  a.needsUpdate = true;
 }

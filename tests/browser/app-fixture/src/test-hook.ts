@@ -1,7 +1,8 @@
 // Drives the README's example for tests/browser/app.test.ts, which writes src/main.ts from
 // README.md itself: `import { installTestHook } from './test-hook';`, the README's block as it
 // stands, then `installTestHook({ renderer, scene, camera, gltf, mixer, character });`.
-// (src/reference.ts is the same block without its gcs-skin lines: three.js's own skinning.)
+// (src/reference.ts is the same block without its gcs-skin lines: three.js's own skinning;
+// src/webgpu.ts the README's WebGPURenderer block between the same two lines.)
 // The test serves its characters as the README's 'character.glb' and compares pictures, so:
 // - at import, before the README's code runs, requestAnimationFrame is wrapped to count frames and
 //   to hold the loop after a frame (screenshots do not compete with rendering on software WebGL),
@@ -33,7 +34,8 @@ window.requestAnimationFrame = (callback) => requestFrame((time) => {
 THREE.Timer.prototype.getDelta = () => 0;
 
 export interface Example {
-  renderer: THREE.WebGLRenderer;
+  /** WebGLRenderer, or WebGPURenderer (three/webgpu: its context is WebGL2's on the WebGL2 backend) */
+  renderer: { getContext(): unknown };
   scene: THREE.Scene;
   camera: THREE.PerspectiveCamera;
   gltf: GLTF;
@@ -56,7 +58,8 @@ export function installTestHook({ renderer, scene, camera, gltf, mixer, characte
   };
   play(params.get('clip'));
 
-  const gl = renderer.getContext();
+  const context = renderer.getContext();
+  const gl = context instanceof WebGL2RenderingContext || context instanceof WebGLRenderingContext ? context : null;
   const skinned = () => {
     const found: THREE.SkinnedMesh[] = [];
     gltf.scene.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) found.push(o as THREE.SkinnedMesh); });
@@ -69,6 +72,7 @@ export function installTestHook({ renderer, scene, camera, gltf, mixer, characte
     skinnedMeshes: () => skinned().length,
     deformedMeshes: () => live()?.meshes.length ?? 0,
     method: () => live()?.method ?? 'three',
+    backend: () => live()?.backend ?? 'three',
     textured: () => skinned().some((m) => !!(m.material as THREE.MeshStandardMaterial).map),
     play: (name: string) => play(name),
     rebuild: (m: DeformerKind) => character?.rebuild(m),
@@ -88,8 +92,8 @@ export function installTestHook({ renderer, scene, camera, gltf, mixer, characte
       held = null;
       if (callback) window.requestAnimationFrame(callback);
     },
-    /** gl.getError() since the last call (errors stay flagged until read). */
-    glError: () => gl.getError(),
+    /** gl.getError() since the last call (errors stay flagged until read); 0 on real WebGPU. */
+    glError: () => gl?.getError() ?? 0,
   };
   (window as unknown as { __app: typeof hook }).__app = hook;
   document.title = 'ready';

@@ -1,0 +1,137 @@
+// The classic cross-section model in the characters' own motion: every clip of our human and of
+// every shared character (../shared/models), and each of them rebound as a rig of rigid parts (every
+// vertex 100 % on its dominant joint, like Mixamo's X Bot), stays on the skin it replaces (per clip:
+// off-surface p99 ≤ 1 %, max ≤ 2.5 % of the height). The build's outputs are pinned by a digest
+// taken before the build was split into steps and made faster (tests/lib/classic-golden.json):
+// the same triangles, reports and deformed vertices, bit for bit.
+import { beforeAll, describe, expect, test } from 'vitest';
+import { createHash } from 'node:crypto';
+import { readFileSync, writeFileSync } from 'node:fs';
+import { basename, dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import type * as THREE from 'three';
+import { initGcsSkin, type GcsSkin, type ClassicDeformer, type RigInput } from '../../web/lib/index.js';
+import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
+import { createHuman } from '../../web/lib/human/index.js';
+import { characterHeight, sampleClip } from '../../packages/cli/src/gltf-node.js';
+import { classicBandQuality, classicOffSurface, identitySkin, rigidRebind } from '../../web/lib/measure.js';
+import { loadGlb, sharedModels } from '../helpers/models.js';
+
+let gcs: GcsSkin;
+beforeAll(async () => {
+  gcs = await initGcsSkin();
+});
+
+const FRAMES_PER_CLIP = 12;
+const GOLDEN = join(dirname(fileURLToPath(import.meta.url)), 'classic-golden.json');
+
+interface Character { name: string; meshes: THREE.SkinnedMesh[]; clips: THREE.AnimationClip[] }
+
+/** Our human, then the shared characters (only `only`, if given). */
+async function characters(only?: string): Promise<Character[]> {
+  const human = createHuman();
+  const out: Character[] = [{ name: 'human', meshes: [human.mesh], clips: human.clips }];
+  for (const file of sharedModels().files) {
+    if (only && basename(file, '.glb') !== only) continue;
+    const model = await loadGlb(file);
+    out.push({ name: basename(file, '.glb'), meshes: model.skinnedMeshes, clips: model.clips });
+  }
+  return out;
+}
+
+/** The meshes of a character as rig inputs: as they are, and rebound rigidly. */
+function variants(ch: Character): { label: string; mesh: THREE.SkinnedMesh; index: number; input: RigInput }[] {
+  return ch.meshes.flatMap((mesh, index) => {
+    const input = rigInputFromSkinnedMesh(mesh);
+    const name = `${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}`;
+    return [{ label: name, mesh, index, input }, { label: `${name} (rigid)`, mesh, index, input: rigidRebind(input) }];
+  });
+}
+
+/** A digest of everything a classic build gives: triangles, report, maps, and the deformed output over frames. */
+function digest(d: ClassicDeformer, frames: Float32Array[]): string {
+  const h = createHash('sha256');
+  const bytes = (a: ArrayLike<number> & { buffer: ArrayBufferLike; byteOffset: number; byteLength: number }) =>
+    h.update(new Uint8Array(a.buffer, a.byteOffset, a.byteLength));
+  bytes(d.indices);
+  bytes(Int32Array.from(d.parts.flatMap((p) => [p.joint, p.resampled ? 1 : 0, p.firstVertex, p.vertexCount])));
+  h.update(d.parts.map((p) => p.reason).join());
+  bytes(d.contourOfVertex);
+  bytes(d.sourceOfVertex);
+  for (const skin of [identitySkin(d.jointCount), ...frames]) {
+    d.deform(skin);
+    bytes(d.positions);
+    bytes(d.normals);
+  }
+  bytes(Float32Array.of(d.detailLoss.rms, d.detailLoss.max));
+  return h.digest('hex');
+}
+
+describe('classic cross-sections: the same outputs as before the build was split into steps', () => {
+  test('human, shared characters and their rigid rebinds: triangles, reports and deformed vertices bit for bit (4 frames per clip)', async () => {
+    const found: Record<string, string> = {};
+    for (const ch of await characters())
+      for (const v of variants(ch)) {
+        const rig = gcs.createRig(v.input);
+        const d = rig.buildClassic();
+        found[v.label] = digest(d, ch.clips.flatMap((clip) => sampleClip(v.mesh, clip, 4)));
+        d.dispose();
+        rig.dispose();
+      }
+    if (process.env.GCS_WRITE_CLASSIC_GOLDEN) writeFileSync(GOLDEN, `${JSON.stringify(found, null, 2)}\n`);
+    const golden = JSON.parse(readFileSync(GOLDEN, 'utf8')) as Record<string, string>;
+    const compared = Object.keys(found).filter((k) => k in golden);
+    console.log(`classic golden: ${compared.length} of ${Object.keys(found).length} builds compared`);
+    expect(compared.length).toBeGreaterThanOrEqual(2); // at least the human and its rigid rebind
+    for (const k of compared) expect(found[k], k).toBe(golden[k]);
+  });
+});
+
+// One test per character (the measure is the costly part): a build that resamples nothing is
+// checked on a few frames per clip (its carried skin is DQS of its own weights).
+const onSkin = sharedModels().files.map((f) => basename(f, '.glb'));
+describe('classic cross-sections stay on the skin in every clip (distance to the DQS-posed source surface)', () => {
+  for (const name of ['human', ...onSkin])
+    test(`${name}, as it is and rebound rigidly, every clip (${FRAMES_PER_CLIP} frames): p99 ≤ 1 %, max ≤ 2.5 % of the height`, async () => {
+      const ch = name === 'human' ? (await characters())[0] : (await characters(name))[1];
+      const rows: string[] = [];
+      const heights = characterHeight(ch.meshes);
+      for (const v of variants(ch)) {
+        const rig = gcs.createRig(v.input);
+        const d = rig.buildClassic();
+        const resampled = d.parts.filter((p) => p.resampled).length;
+        const carriedOff = d.parts.filter((p) => p.reason === 'off-surface').length;
+        for (const clip of ch.clips) {
+          const frames = sampleClip(v.mesh, clip, resampled ? FRAMES_PER_CLIP : 3);
+          const r = classicOffSurface(v.input, d, frames, { height: heights.meshUnits[v.index] });
+          rows.push(`${v.label} / ${clip.name || 'clip'}: p99 ${r.p99.toFixed(3)} %, max ${r.max.toFixed(3)} % (${resampled} parts resampled, ${carriedOff} carried off-surface)`);
+          expect(r.p99, `${v.label} / ${clip.name}`).toBeLessThanOrEqual(1);
+          expect(r.max, `${v.label} / ${clip.name}`).toBeLessThanOrEqual(2.5);
+          // Carried skin moves by DQS of its own weights: it lies on the surface (float rounding only).
+          for (const p of r.parts) if (!p.resampled) expect(p.max).toBeLessThan(1e-3);
+        }
+        d.dispose();
+        rig.dispose();
+      }
+      console.log(`classic off-surface per clip:\n  ${rows.join('\n  ')}`);
+    }, 180_000);
+});
+
+describe('classic cross-sections: the zip bands between tubes and carried skin', () => {
+  test('band triangles measured at the bind pose (minimum angle, aspect ratio; printed)', async () => {
+    for (const ch of await characters())
+      for (const mesh of ch.meshes) {
+        const rig = gcs.createRig(rigInputFromSkinnedMesh(mesh));
+        const d = rig.buildClassic();
+        d.deform(identitySkin(d.jointCount));
+        const q = classicBandQuality(d);
+        console.log(`classic bands ${ch.name} / ${mesh.name}: ${q.triangles} triangles, min angle ${q.minAngle.toFixed(2)}° (p1 ${q.minAngleP1.toFixed(2)}°, median ${q.minAngleMedian.toFixed(1)}°), under 5° ${q.under5}, aspect max ${q.aspectMax.toFixed(1)} (p99 ${q.aspectP99.toFixed(1)}, median ${q.aspectMedian.toFixed(2)})`);
+        // A band joins every edge of its ring and its loop: where something is resampled and
+        // meets carried skin there are band triangles, each a real triangle.
+        if (d.parts.some((p) => p.resampled) && d.parts.some((p) => !p.resampled)) expect(q.triangles).toBeGreaterThan(0);
+        if (q.triangles) expect(q.minAngle).toBeGreaterThan(0);
+        d.dispose();
+        rig.dispose();
+      }
+  });
+});
