@@ -1,7 +1,7 @@
 // The demo's rough edges a newcomer met (issue 20), in headless Chromium:
 // - crowd mode frames every character left of the opaque control column, not under it;
-// - the deform-time readouts say "warming up" until their figure is steady, and then it stays put
-//   (a smoothed average showed start-up figures for many seconds);
+// - the deform-time readouts say "measuring…" until measured (within 3 s of a build), and then the
+//   figure stays put (a smoothed average showed start-up figures for many seconds);
 // - ?paused=1 opens on the clip's first frame, not the rest pose.
 // (The note beside the criterion menu under the paper's criteria: demo.test.ts, with the criteria.)
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
@@ -63,26 +63,38 @@ describe.skipIf(!!reason)('the demo as a newcomer meets it (headless Chromium)',
     }
   }, 300000);
 
-  test('the deform-time readouts say "warming up" until steady, then show a figure that stays put; a rebuild starts over', async () => {
+  test('the deform-time readouts say "measuring…" until measured, stand within 3 s of a rebuild, then stay put', async () => {
     const { page, errors } = await open('');
     try {
-      const first = await gcsReadout(page);
-      expect(first.warmingUp, 'the first readout, right after the page is ready').toBe(true);
-      await expect(page.locator('.readout[data-view=gcs]').innerText()).resolves.toMatch(/deform warming up… · [\d,]+ vertices/);
-      await page.waitForFunction(() => !(window.__demo.readouts() as { gcs: GcsReadout }).gcs.warmingUp, null, { timeout: 120000, polling: 250 });
+      await page.waitForFunction(() => !(window.__demo.readouts() as { gcs: GcsReadout }).gcs.warmingUp, null, { timeout: 60000, polling: 100 });
       await expect(page.locator('.readout[data-view=gcs]').innerText()).resolves.toMatch(/deform [\d.]+ ms \/ frame · [\d,]+ vertices/);
-      // Steady: the figures over the next seconds agree (a smoothed average of the start-up
-      // frames fell more than fourfold here over its first ten seconds).
+      // Stays put: measured once per build (as the bench measures), not a running average.
       const figures: number[] = [];
-      for (let i = 0; i < 4; i++) {
+      for (let i = 0; i < 3; i++) {
         figures.push((await gcsReadout(page)).ms);
         await page.waitForTimeout(1000);
       }
-      console.log(`steady GCS deform readouts: ${figures.map((f) => f.toFixed(3)).join(', ')} ms`);
-      expect(Math.max(...figures) / Math.min(...figures)).toBeLessThan(2);
-      // A rebuild: new figures, warming up again.
-      await page.evaluate(() => window.__demo.setSections(8));
-      await page.waitForFunction(() => window.__demo.sectionsPerPart() === 8 && (window.__demo.readouts() as { gcs: GcsReadout }).gcs.warmingUp, null, { timeout: 30000 });
+      console.log(`GCS deform readouts over 3 s: ${figures.map((f) => f.toFixed(3)).join(', ')} ms`);
+      expect(new Set(figures).size).toBe(1);
+      // A rebuild: "measuring…" at once, a figure again within 3 s (timed in the page).
+      const { measuringAtOnce, ms, frames } = await page.evaluate(async () => {
+        type R = { gcs: { warmingUp: boolean } };
+        const t0 = performance.now(), f0 = window.__demo.frame();
+        window.__demo.setSections(8);
+        let measuringAtOnce = false;
+        for (;;) {
+          await new Promise((r) => requestAnimationFrame(r));
+          const r = window.__demo.readouts() as R;
+          if (window.__demo.sectionsPerPart() === 8 && r.gcs.warmingUp) measuringAtOnce = true;
+          if (measuringAtOnce && !r.gcs.warmingUp) break;
+          if (performance.now() - t0 > 30000) break;
+        }
+        return { measuringAtOnce, ms: performance.now() - t0, frames: window.__demo.frame() - f0 };
+      });
+      console.log(`after a rebuild: figures again in ${ms.toFixed(0)} ms (${frames} frames)`);
+      expect(measuringAtOnce).toBe(true);
+      expect(ms).toBeLessThanOrEqual(3000);
+      await expect(page.locator('.readout[data-view=gcs]').innerText()).resolves.toMatch(/deform [\d.]+ ms \/ frame/);
       expect(errors).toEqual([]);
     } finally {
       await page.close();

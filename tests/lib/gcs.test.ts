@@ -363,3 +363,40 @@ describe('GCS weights criterion (default)', () => {
     rig.dispose();
   });
 });
+
+describe('a mesh that uses a few joints of a larger skeleton', () => {
+  test('joints no vertex uses change nothing, not even through a non-uniform scale (they are not decomposed)', () => {
+    // The tube's joints 0 and 1 become 1 and 2 under an unused root (0); the tip (3) is unused too.
+    const tube = makeTube();
+    const { input } = tube;
+    const joints = input.joints.map((j, i) => (input.weights[i] > 0 ? j + 1 : 0));
+    const ibm = new Float32Array(64);
+    ibm.set(new THREE.Matrix4().elements, 0);
+    ibm.set(input.inverseBindMatrices, 16);
+    const rig = gcs.createRig({ ...input, joints, parents: new Int32Array([-1, 0, 1, 2]), inverseBindMatrices: ibm });
+    const plainRig = gcs.createRig(input);
+    const bend = rotationAbout(tube.joint, Z, Math.PI / 3);
+    const wild = new THREE.Matrix4().makeRotationX(0.7).scale(new THREE.Vector3(2, 0.5, 3)).setPosition(5, -2, 1);
+    const skin = (unused: THREE.Matrix4) => {
+      const s = new Float32Array(64);
+      s.set(unused.elements, 0);
+      s.set(tubeSkin(bend).subarray(0, 32), 16);
+      s.set(unused.elements, 48);
+      return s;
+    };
+    for (const options of [{}, { smooth: false }]) {
+      const d = rig.buildGcs(options), reference = plainRig.buildGcs(options);
+      d.deform(skin(new THREE.Matrix4()));
+      const positions = d.positions.slice(), normals = d.normals.slice();
+      d.deform(skin(wild));
+      expect(d.positions).toEqual(positions);
+      expect(d.normals).toEqual(normals);
+      reference.deform(tubeSkin(bend));
+      expect(maxAbsDiff(d.positions, reference.positions)).toBeLessThan(1e-6);
+      d.dispose();
+      reference.dispose();
+    }
+    rig.dispose();
+    plainRig.dispose();
+  });
+});

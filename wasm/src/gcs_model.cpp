@@ -159,6 +159,13 @@ void finishModel(GcsDeformerImpl& m) {
       }
   }
   m.poses.resize(m.jointCount);
+  std::vector<uint8_t> used(m.jointCount, m.settings.criterion == GCS_CRITERION_WEIGHTS ? 0 : 1);
+  for (const Section& sec : m.sections)
+    if (sec.rigid) used[sec.part] = 1;
+  for (const Influence& in : m.influences) used[in.joint] = 1;
+  m.usedJoints.clear();
+  for (uint32_t j = 0; j < m.jointCount; ++j)
+    if (used[j]) m.usedJoints.push_back(j);
   m.lastSkin.assign(m.jointCount, glm::mat4(1.0f));
   m.sectionMatrices.assign(S, glm::mat4(1.0f));
   m.normalMatrices.assign(S, glm::mat4(1.0f));
@@ -1151,7 +1158,7 @@ uint32_t GcsDeformerImpl::countAdjusted() const {
 
 void GcsDeformerImpl::computeSections(const glm::mat4* skin) {
   const uint32_t J = jointCount;
-  const ScaleState scale = decomposeAll(skin, J, poses.data());
+  const ScaleState scale = decomposeJoints(skin, usedJoints.data(), uint32_t(usedJoints.size()), poses.data());
   frameScale = scale;
   if (settings.criterion == GCS_CRITERION_WEIGHTS) sectionTransformsWeights(skin, scale);
   else sectionTransformsPaper(skin, scale);

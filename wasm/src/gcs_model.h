@@ -103,6 +103,9 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<Motion> motions;          // D_j per part joint
   std::vector<glm::quat> swings, twists;
   std::vector<JointPose> poses;         // S_j split into rotation, translation and scale
+  // The joints whose poses a frame needs (weights criterion: those the sections blend or carry;
+  // others: every joint). A mesh of a shared skeleton (a robot's hand) uses a few of its joints.
+  std::vector<uint32_t> usedJoints;
   std::vector<glm::mat4> sectionMatrices;   // position transform of each section
   std::vector<glm::mat4> normalMatrices;    // normal transform of each section (3×3 in a mat4)
   std::vector<uint8_t> renormalise;         // normals of the section need renormalising

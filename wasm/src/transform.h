@@ -29,6 +29,18 @@ inline float quatAngle(const glm::quat& q) {
   return 2.0f * std::acos(w);
 }
 
+// The largest |entry| of a 3×3 of finite entries. A comparison, not std::fmax: wasm has no
+// instruction with fmax's NaN rule, so each fmax is a libc call (a skin matrix takes 9 per frame).
+inline float largestAbs(const glm::mat3& m) {
+  float big = 0.0f;
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 3; ++i) {
+      const float a = std::fabs(m[c][i]);
+      big = a > big ? a : big;
+    }
+  return big;
+}
+
 // Rotation part of an affine matrix as a unit quaternion, robust to any scale in the matrix:
 // a uniform scale (Mixamo's ×100), a non-uniform one, a mirror, or a collapse to zero. Columns
 // are normalised (after dividing by the largest entry, so tiny scales do not underflow); when they
@@ -36,9 +48,7 @@ inline float quatAngle(const glm::quat& q) {
 // columns; when every column has collapsed the rotation is the identity.
 inline glm::quat rotationOf(const glm::mat4& m) {
   glm::mat3 r(m);
-  float big = 0.0f;
-  for (int c = 0; c < 3; ++c)
-    for (int i = 0; i < 3; ++i) big = std::fmax(big, std::fabs(r[c][i]));
+  const float big = largestAbs(r);
   if (!(big > 1e-30f)) return glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   r /= big;
   float len[3];
@@ -115,56 +125,58 @@ inline bool isUniformScale(const glm::mat3& k) {
 // The matrix that carries normals for the affine map x ↦ R·K·x + t: R when K is a positive
 // uniform scale (then unit normals stay unit); otherwise R·cof(K) divided by its largest entry, so
 // the caller must renormalise (`renormalise` is set); R alone when K has collapsed entirely.
-inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, bool& renormalise) {
-  glm::mat3 r = glm::mat3_cast(rotation);
+inline glm::mat3 normalMatrix(const glm::mat3& r, const glm::mat3& k, bool& renormalise) {
   if (isUniformScale(k)) {
     renormalise = false;
     return r;
   }
   // Scale k to entries ≤ 1 first: the cofactor multiplies entries pairwise (×1e20 would overflow).
-  float kbig = 0.0f;
-  for (int col = 0; col < 3; ++col)
-    for (int i = 0; i < 3; ++i) kbig = std::fmax(kbig, std::fabs(k[col][i]));
+  const float kbig = largestAbs(k);
   renormalise = true;
-  if (!(kbig > 1e-30f)) return glm::mat3_cast(rotation);
+  if (!(kbig > 1e-30f)) return r;
   glm::mat3 c = cofactor(k / kbig);
-  float big = 0.0f;
-  for (int col = 0; col < 3; ++col)
-    for (int i = 0; i < 3; ++i) big = std::fmax(big, std::fabs(c[col][i]));
-  renormalise = true;
+  const float big = largestAbs(c);
   if (!(big > 1e-30f)) return r;  // every direction collapsed: keep the rotated rest normal
   return r * (c / big);
+}
+
+inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, bool& renormalise) {
+  return normalMatrix(glm::mat3_cast(rotation), k, renormalise);
 }
 
 inline void decompose(const glm::mat4& s, JointPose& out) {
   out.rotation = rotationOf(s);
   out.translation = glm::vec3(s[3]);
-  out.scale = glm::transpose(glm::mat3_cast(out.rotation)) * glm::mat3(s);
-  glm::quat r = out.rotation;
+  const glm::mat3 rm = glm::mat3_cast(out.rotation);
+  out.scale = glm::transpose(rm) * glm::mat3(s);
+  const glm::quat r = out.rotation;
   glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
   out.real = glm::vec4(r.x, r.y, r.z, r.w);
   out.dual = glm::vec4(d.x, d.y, d.z, d.w);
-  out.normal = glm::mat4(normalMatrix(r, out.scale, out.renormalise));
+  out.normal = glm::mat4(normalMatrix(rm, out.scale, out.renormalise));
   out.normal[3][3] = 0.0f;
 }
 
-// Decomposes every skin matrix of a frame and tells what their scales have in common. `uniform`
-// holds when every K_j is s·I up to a relative 1e-5 (float rounding of Rᵀ·S makes exact equality
-// rare on animated rigs), all with the same s; s is then exact when K_0 is exactly uniform (the
-// bind pose: 1).
-inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose* poses) {
+// Decomposes the skin matrices of the joints jointAt(0 … count−1) and tells what their scales have
+// in common. `uniform` holds when every K_j is s·I up to a relative 1e-5 (float rounding of Rᵀ·S
+// makes exact equality rare on animated rigs), all with the same s; s is then exact when the first
+// joint's K is exactly uniform (the bind pose: 1).
+template <class JointAt>
+inline ScaleState decomposeEach(const glm::mat4* skin, uint32_t count, JointAt jointAt, JointPose* poses) {
   ScaleState st;
-  for (uint32_t j = 0; j < count; ++j) {
-    decompose(skin[j], poses[j]);
-    if (st.same && j > 0 && poses[j].scale != poses[0].scale) st.same = false;
-  }
   if (count == 0) return st;
-  const glm::mat3& k0 = poses[0].scale;
+  const uint32_t first = jointAt(0);
+  for (uint32_t k = 0; k < count; ++k) {
+    const uint32_t j = jointAt(k);
+    decompose(skin[j], poses[j]);
+    if (st.same && k > 0 && poses[j].scale != poses[first].scale) st.same = false;
+  }
+  const glm::mat3& k0 = poses[first].scale;
   const float s0 = (k0[0][0] + k0[1][1] + k0[2][2]) / 3.0f;
   st.uniform = s0 > 0.0f;
   const float tol = 1e-5f * s0;
-  for (uint32_t j = 0; j < count && st.uniform; ++j) {
-    const glm::mat3& k = poses[j].scale;
+  for (uint32_t n = 0; n < count && st.uniform; ++n) {
+    const glm::mat3& k = poses[jointAt(n)].scale;
     for (int c = 0; c < 3 && st.uniform; ++c)
       for (int i = 0; i < 3; ++i)
         if (std::fabs(k[c][i] - (c == i ? s0 : 0.0f)) > tol) {
@@ -175,6 +187,16 @@ inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose*
   st.s = st.uniform ? s0 : 1.0f;
   if (st.uniform && k0[0][0] == k0[1][1] && k0[1][1] == k0[2][2]) st.s = k0[0][0];
   return st;
+}
+
+// Every joint 0 … count−1 (decomposeEach).
+inline ScaleState decomposeAll(const glm::mat4* skin, uint32_t count, JointPose* poses) {
+  return decomposeEach(skin, count, [](uint32_t k) { return k; }, poses);
+}
+
+// Only the listed joints (a mesh's own, on a skeleton shared by several meshes: decomposeEach).
+inline ScaleState decomposeJoints(const glm::mat4* skin, const uint32_t* joints, uint32_t count, JointPose* poses) {
+  return decomposeEach(skin, count, [joints](uint32_t k) { return joints[k]; }, poses);
 }
 
 // True when every scale is the same s·I with s in [1e-6, 1e6]: the fast uniform path (normal

@@ -1,5 +1,6 @@
 // The frame loop (renderer.setAnimationLoop): pending rebuilds, the mixer, every deformer's
-// update() timed for the readouts, the views drawn, the readouts refreshed four times a second.
+// update(), the views drawn, a slice of the cost measurement (cost.ts), the readouts refreshed
+// four times a second.
 import type * as THREE from 'three';
 import { rebuildPending } from './models.js';
 import { describeError, showMessage } from './page.js';
@@ -42,19 +43,21 @@ export function animate(): void {
       let root: THREE.Object3D | undefined = ch.gcs[0]?.source ?? ch.classic[0]?.source;
       while (root?.parent) root = root.parent;
       root?.updateMatrixWorld();
-      let t0 = performance.now();
       for (const s of ch.gcs) s.update(noWorldUpdate);
-      state.timing.gcs.add(performance.now() - t0);
-      if (ch.classic.length) {
-        t0 = performance.now();
-        for (const s of ch.classic) s.update(noWorldUpdate);
-        state.timing.classic.add(performance.now() - t0);
-      }
+      for (const s of ch.classic) s.update(noWorldUpdate);
     } catch (e) {
       showMessage(`deform: ${describeError(e)}`);
     }
   }
   render();
+  // After the picture: the cost measurement deforms the live models with recorded poses, and the
+  // next frame's update() writes the picture again before it is drawn.
+  try {
+    state.frameCost.afterFrame();
+  } catch (e) {
+    state.frameCost.stop();
+    showMessage(`cost / frame: ${describeError(e)}`);
+  }
   state.stats.update();
   state.frameCount++;
   if (now - lastReadout > 250) {

@@ -1,52 +1,203 @@
-// What the GCS settings cost on this machine: the deform time of the current model beside the
-// plain (stepped) one at the same section count, measured in the page (not a constant that could
-// go stale), so the readout can say what smooth blending and the section count cost.
-import type { GcsOptions } from '../lib/index.js';
-import { identitySkin } from '../lib/measure.js';
-import type { SkinDeformer } from '../lib/three.js';
+// What each view's model costs per frame on this machine, measured as `npm run bench` measures it:
+// timeInterleaved (gcs-skin/measure) over live poses recorded after each (re)build, the models
+// timed in turn (the GCS on screen, a stepped one of the same sections for comparison, the classic
+// model), so that whatever else the machine does lands on all alike. Done in short slices after
+// frames (the page keeps drawing), the figures stand a few frames after a build and then stay:
+// no figure that drifts with the page's own load, none that inverts by chance (InversionGuard).
+import type { GcsDeformer, GcsOptions } from '../lib/index.js';
+import { median, timeInterleaved } from '../lib/measure.js';
+import { writeSkinMatrices, type SkinDeformer } from '../lib/three.js';
 
-export interface SettingCost {
-  /** ms per frame of the current GCS model, summed over the skins. */
-  current: number;
-  /** ms per frame of the plain (smooth: false) model at the same sections; NaN under the paper's criteria. */
-  plain: number;
+/** Live poses recorded after a build (frames of the clip as it plays), at most. */
+const RECORDED_FRAMES = 4;
+/** Slices of timing, one after each frame, and how long each may run. */
+const SLICES = 8;
+const SLICE_MS = 10;
+/**
+ * On a slow page (a few frames a second) the figures must still stand within 3 s of the build:
+ * recording stops after this long with the poses it has, and past LATE_MS the remaining slices all
+ * run after one frame (a frame that slow hides 80 ms more).
+ */
+const RECORD_MS = 300;
+const LATE_MS = 800;
+/** A timed sample lasts at least this: a browser's clock moves in 0.1 ms steps (timeInterleaved's repeat). */
+const SAMPLE_MS = 1;
+
+export interface FrameCostFigures {
+  /** ms per frame of the GCS model on screen (every skinned mesh), NaN until measured. */
+  gcs: number;
+  /** ms per frame of the stepped (smooth: false) GCS at the same sections; NaN under the paper's criteria. */
+  stepped: number;
+  /** ms per frame of the classic model; NaN until measured or without one. */
+  classic: number;
 }
 
-/** ms per call of each function: rounds of each taken in turn (so both see the same noise: the
- *  page renders on the same cores), each round long enough for the browser's coarse clock; medians. */
-function timeInTurn(fns: readonly (() => void)[]): number[] {
-  const rounds: number[][] = fns.map(() => []);
-  // Warm up first: V8 runs new wasm code in its baseline tier until the code is hot, and the
-  // model not on screen has not run yet.
-  for (const fn of fns) for (const t0 = performance.now(); performance.now() - t0 < 30;) fn();
-  for (let r = 0; r < 7; r++)
-    fns.forEach((fn, k) => {
-      let n = 0;
-      const t0 = performance.now();
-      let t = t0;
-      while (t - t0 < 3 || n < 4) { fn(); n++; t = performance.now(); }
-      rounds[k].push((t - t0) / n);
-    });
-  return rounds.map((x) => x.sort((a, b) => a - b)[x.length >> 1]);
-}
+const NONE: FrameCostFigures = { gcs: NaN, stepped: NaN, classic: NaN };
 
-/** Times the skins' current GCS models and plain ones built for the comparison (then disposed), in the bind pose. */
-export function measureSettingCost(skins: readonly SkinDeformer[], options: GcsOptions): SettingCost {
-  let current = 0, plain = 0;
-  const byWeights = (options.criterion ?? 'weights') === 'weights';
-  for (const s of skins) {
-    const identity = identitySkin(s.deformer.jointCount);
-    // Scratch models: timing the live one would leave the bind pose on screen.
-    const same = s.rig.buildGcs(options);
-    const stepped = byWeights ? s.rig.buildGcs({ ...options, smooth: false }) : null;
-    try {
-      const [a, b] = timeInTurn([() => same.deform(identity), ...(stepped ? [() => stepped.deform(identity)] : [])]);
-      current += a;
-      plain += stepped ? b : NaN;
-    } finally {
-      same.dispose();
-      stepped?.dispose();
+/**
+ * Whether a measurement may be shown: stepped GCS does less work per vertex than smooth, so a
+ * measurement that finds it slower is noise until it is found so `confirm` times in a row.
+ */
+export class InversionGuard {
+  private run = 0;
+  constructor(readonly confirm = 3) {}
+  /** True when (smooth, stepped) may be shown; false: measure again. */
+  accept(smooth: number, stepped: number): boolean {
+    if (!(stepped > smooth)) {
+      this.run = 0;
+      return true;
     }
+    return ++this.run >= this.confirm;
   }
-  return { current, plain };
+  reset(): void {
+    this.run = 0;
+  }
+}
+
+/** What FrameCost measures: the views' skins (one per source mesh), and how the GCS was built. */
+export interface CostModels {
+  gcs: readonly SkinDeformer[];
+  classic: readonly SkinDeformer[];
+  /** The GCS settings on screen: a stepped twin is built when they are smooth under the weights criterion. */
+  options: GcsOptions;
+}
+
+type Phase = 'idle' | 'recording' | 'measuring' | 'done';
+
+/** The per-frame cost figures of the models on screen, measured after each build (see the file's head). */
+export class FrameCost {
+  private phase: Phase = 'idle';
+  private models: CostModels | null = null;
+  private sources: SkinDeformer['source'][] = [];
+  /** poses[f][k]: skin matrices of source k at recorded frame f. */
+  private poses: Float32Array[][] = [];
+  private stepped: GcsDeformer[] = [];
+  private steps: ((frame: number) => void)[] = [];
+  private repeat: number[] = [];
+  private slices: number[][] = [];
+  private shown: FrameCostFigures = NONE;
+  private readonly guard = new InversionGuard();
+  private listener: (figures: FrameCostFigures) => void = () => {};
+  /** Frames since the last restart (for tests: how soon the figures stand). */
+  framesSinceBuild = 0;
+  private builtAt = 0;
+
+  constructor(
+    private readonly writePose: (source: SkinDeformer['source'], out: Float32Array) => void = (s, out) => writeSkinMatrices(s, out),
+    private readonly now: () => number = () => performance.now(),
+  ) {}
+
+  /** Calls `listener` whenever the figures change. */
+  onChange(listener: (figures: FrameCostFigures) => void): void {
+    this.listener = listener;
+  }
+
+  figures(): FrameCostFigures {
+    return this.shown;
+  }
+
+  /** True once the figures for the models on screen stand. */
+  get settled(): boolean {
+    return this.phase === 'done';
+  }
+
+  /** A model was (re)built: its figures start over. */
+  restart(models: CostModels): void {
+    this.dropScratch();
+    this.models = models;
+    this.sources = [...new Set([...models.gcs, ...models.classic].map((s) => s.source))];
+    this.poses = [];
+    this.slices = [];
+    this.guard.reset();
+    this.framesSinceBuild = 0;
+    this.builtAt = this.now();
+    this.phase = 'recording';
+    this.publish(NONE);
+  }
+
+  /** Stops measuring and frees the scratch models (the character is gone). */
+  stop(): void {
+    this.dropScratch();
+    this.models = null;
+    this.phase = 'idle';
+    this.publish(NONE);
+  }
+
+  /** After each frame's update(): records a pose, or runs one slice of timing. */
+  afterFrame(): void {
+    if (this.phase === 'idle' || this.phase === 'done' || !this.models) return;
+    this.framesSinceBuild++;
+    if (this.phase === 'recording') {
+      this.poses.push(this.sources.map((src) => {
+        const out = new Float32Array(src.skeleton.bones.length * 16);
+        this.writePose(src, out);
+        return out;
+      }));
+      if (this.poses.length < RECORDED_FRAMES && this.now() - this.builtAt < RECORD_MS) return;
+      this.prepare();
+      if (this.now() - this.builtAt < LATE_MS) return;
+    }
+    do this.slice();
+    while (this.phase === 'measuring' && this.now() - this.builtAt >= LATE_MS);
+  }
+
+  /** The steps to time in turn (each deforms every mesh of one model) and their repeat counts. */
+  private prepare(): void {
+    const m = this.models!;
+    const poseOf = (s: SkinDeformer) => this.sources.indexOf(s.source);
+    const step = (deformers: { deform(skin: Float32Array): void }[], sourceIndex: number[]) => (f: number) => {
+      const pose = this.poses[f];
+      for (let i = 0; i < deformers.length; i++) deformers[i].deform(pose[sourceIndex[i]]);
+    };
+    const gcsIndex = m.gcs.map(poseOf);
+    // The live deformers: the next frame's update() writes the picture again before it is drawn.
+    this.steps = [step(m.gcs.map((s) => s.deformer), gcsIndex)];
+    const weights = (m.options.criterion ?? 'weights') === 'weights';
+    if (weights && m.options.smooth !== false) {
+      this.stepped = m.gcs.map((s) => s.rig.buildGcs({ ...m.options, smooth: false }));
+      this.steps.push(step(this.stepped, gcsIndex));
+    }
+    if (m.classic.length) this.steps.push(step(m.classic.map((s) => s.deformer), m.classic.map(poseOf)));
+    // Calibration (also the warm-up: the stepped twin's code path has not run yet): ms per call.
+    this.repeat = this.steps.map((s) => {
+      const t0 = performance.now();
+      for (let f = 0; f < this.poses.length; f++) s(f);
+      const perCall = (performance.now() - t0) / this.poses.length;
+      return Math.max(1, Math.min(200, Math.ceil(SAMPLE_MS / Math.max(perCall, 0.002))));
+    });
+    this.slices = this.steps.map(() => []);
+    this.phase = 'measuring';
+  }
+
+  private slice(): void {
+    const t = timeInterleaved(this.poses.length, this.steps, { minSamples: 1, minMs: 0, maxMs: SLICE_MS, warmup: 0, repeat: this.repeat });
+    t.forEach((x, k) => this.slices[k].push(x.medianMs));
+    if (this.slices[0].length < SLICES) return;
+    const m = this.models!;
+    const ms = this.slices.map((s) => median(s));
+    const hasStepped = this.stepped.length > 0;
+    const figures: FrameCostFigures = {
+      gcs: ms[0],
+      stepped: hasStepped ? ms[1] : (m.options.criterion ?? 'weights') === 'weights' ? ms[0] : NaN,
+      classic: m.classic.length ? ms[hasStepped ? 2 : 1] : NaN,
+    };
+    if (hasStepped && !this.guard.accept(figures.gcs, figures.stepped)) {
+      this.slices = this.steps.map(() => []); // measure again before showing an inversion
+      return;
+    }
+    this.dropScratch();
+    this.phase = 'done';
+    this.publish(figures);
+  }
+
+  private dropScratch(): void {
+    for (const d of this.stepped) d.dispose();
+    this.stepped = [];
+    this.steps = [];
+  }
+
+  private publish(figures: FrameCostFigures): void {
+    this.shown = figures;
+    this.listener(figures);
+  }
 }

@@ -5,7 +5,7 @@ import type * as THREE from 'three';
 import type { ClassicDeformer, ClassicOptions, ClassicReason, GcsOptions } from '../lib/index.js';
 import type { SkinDeformer } from '../lib/three.js';
 import { classicColours, gcsColours } from './colours.js';
-import { measureSettingCost, type SettingCost } from './cost.js';
+import type { FrameCostFigures } from './cost.js';
 import { updateLabels } from './labels.js';
 import { describeError, showMessage } from './page.js';
 import { updateReadouts } from './readouts.js';
@@ -26,7 +26,6 @@ export function buildGcs(source: THREE.SkinnedMesh): SkinDeformer {
   const skin = new state.Skin(state.gcs, source, { method: 'gcs', gcs: gcsOptions(), material: source.material });
   skin.mesh.layers.set(LAYER.gcs);
   state.builtCriterion = params.criterion;
-  state.timing.gcs.reset();
   return skin;
 }
 
@@ -34,7 +33,6 @@ export function buildGcs(source: THREE.SkinnedMesh): SkinDeformer {
 export function buildClassic(sources: THREE.SkinnedMesh[]): { skins: SkinDeformer[]; error: string | null } {
   const skins: SkinDeformer[] = [];
   state.classicBuilds++;
-  state.timing.classic.reset();
   try {
     for (const src of sources) {
       const skin = new state.Skin(state.gcs, src, { method: 'classic', classic: classicOptions(), material: src.material });
@@ -73,7 +71,6 @@ export function rebuildPending(ch: Character): void {
 function rebuildGcs(ch: Character): void {
   state.pendingGcs = false;
   state.gcsBuilds++;
-  state.timing.gcs.reset();
   try {
     for (const s of ch.gcs) {
       s.rebuild('gcs', { gcs: gcsOptions() });
@@ -92,7 +89,6 @@ function rebuildClassic(ch: Character): void {
   state.pendingClassic = false;
   if (ch.classic.length) {
     state.classicBuilds++;
-    state.timing.classic.reset();
     try {
       for (const s of ch.classic) {
         s.rebuild('classic', { classic: classicOptions() });
@@ -111,6 +107,7 @@ function rebuildClassic(ch: Character): void {
   classicSummary(ch);
   updateLabels();
   updateReadouts();
+  scheduleCostMeasure(ch);
 }
 
 export function setBulge(): void {
@@ -122,32 +119,29 @@ export function setBulge(): void {
   }
 }
 
-// What the settings cost, measured once the sliders rest (a drag rebuilds every frame); shown in the
-// GCS folder, beside the controls that set it (controls.ts listens).
-let settingCost: SettingCost | null = null;
-let costTimer = 0;
+// What the settings cost (cost.ts): measured after every build, shown in the GCS folder beside the
+// controls that set it (controls.ts listens) and in the views' readouts.
 let costListener: (text: string) => void = () => {};
 
 /** Calls `listener` with the cost line's text whenever it changes. */
 export function onCostChange(listener: (text: string) => void): void {
   costListener = listener;
-  costListener(costText());
+  costListener(costText(state.frameCost.figures()));
 }
 
+state.frameCost.onChange((figures) => {
+  costListener(costText(figures));
+  updateReadouts();
+});
+
+/** Starts the cost measurement over for the models `ch` shows now. */
 export function scheduleCostMeasure(ch: Character): void {
-  settingCost = null;
-  costListener(costText());
-  clearTimeout(costTimer);
-  costTimer = window.setTimeout(() => {
-    if (ch !== state.current) return;
-    try { settingCost = measureSettingCost(ch.gcs, gcsOptions()); } catch { settingCost = null; }
-    costListener(costText());
-  }, 400);
+  state.frameCost.restart({ gcs: ch.gcs, classic: ch.classic, options: gcsOptions() });
 }
 
-function costText(): string {
+function costText(figures: FrameCostFigures): string {
   const f = (v: number) => (v < 10 ? v.toFixed(2) : v.toFixed(1));
-  return !settingCost ? 'measuring…'
-    : Number.isNaN(settingCost.plain) ? `${f(settingCost.current)} ms`
-    : `${f(settingCost.current)} ms · stepped ${f(settingCost.plain)}`;
+  return Number.isNaN(figures.gcs) ? 'measuring…'
+    : Number.isNaN(figures.stepped) ? `${f(figures.gcs)} ms`
+    : `${f(figures.gcs)} ms · stepped ${f(figures.stepped)}`;
 }

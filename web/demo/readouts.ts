@@ -1,5 +1,5 @@
-// The readouts under each view: deform time per frame (a steady median: "warming up…" until there
-// is one), sizes, sections or contours, the criterion and why, the renderer and backend.
+// The readouts under each view: deform time per frame (measured after each build as the bench
+// measures it, cost.ts: "measuring…" until then), sizes, sections or contours, the criterion and why, the renderer and backend.
 import type { ClassicDeformer, Criterion, GcsDeformer } from '../lib/index.js';
 import type { SkinDeformer } from '../lib/three.js';
 import { rigidVertices } from './colours.js';
@@ -12,7 +12,7 @@ import type { InfluenceCount } from './influences.js';
 
 export interface Readouts {
   character: string;
-  /** ms: NaN while warmingUp (the first frames after a build, or the figure still falling). */
+  /** ms: NaN while warmingUp (measuring, a few frames after each build). */
   gcs: { ms: number; warmingUp: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
   classic: { ms: number; warmingUp: boolean; vertices: number; triangles: number; contours: number; detailLoss: { rms: number; max: number } } | null;
   lbs: { vertices: number; triangles: number } | null;
@@ -35,7 +35,8 @@ export function collectReadouts(): Readouts {
       sections += d.sectionCount;
       adjusted += d.adjustedShare * d.sectionCount;
     }
-    const gcsMs = state.timing.gcs.value();
+    const cost = state.frameCost.figures();
+    const gcsMs = cost.gcs;
     gcsInfo = {
       ms: gcsMs, warmingUp: Number.isNaN(gcsMs), sections, adjustedShare: sections ? adjusted / sections : 0, criterion: state.builtCriterion,
       rigidShare: vertices ? rigid / vertices : 0, vertices, triangles: ch.gcs.reduce((n, s) => n + tri(s), 0),
@@ -47,7 +48,7 @@ export function collectReadouts(): Readouts {
         const w = s.deformer.vertexCount;
         rms2 += loss.rms * loss.rms * w; n += w; max = Math.max(max, loss.max);
       }
-      const classicMs = state.timing.classic.value();
+      const classicMs = cost.classic;
       classicInfo = {
         ms: classicMs, warmingUp: Number.isNaN(classicMs), vertices: ch.classic.reduce((k, s) => k + s.deformer.vertexCount, 0),
         triangles: ch.classic.reduce((k, s) => k + tri(s), 0), contours: ch.classic.reduce((k, s) => k + s.deformer.sectionCount, 0),
@@ -61,8 +62,8 @@ export function collectReadouts(): Readouts {
   return { character: ch.name, gcs: gcsInfo, classic: classicInfo, lbs: { vertices: ch.sourceVertices, triangles: ch.sourceTriangles }, influences: ch.influences };
 }
 
-/** "deform 0.21 ms / frame", or "deform warming up…" while there is no steady figure. */
-const deformTime = (ms: number) => (Number.isNaN(ms) ? 'deform <b>warming up…</b>' : `deform <b>${ms < 10 ? ms.toFixed(2) : ms.toFixed(1)} ms</b> / frame`);
+/** "deform 0.21 ms / frame", or "deform measuring…" until the figure stands. */
+const deformTime = (ms: number) => (Number.isNaN(ms) ? 'deform <b>measuring…</b>' : `deform <b>${ms < 10 ? ms.toFixed(2) : ms.toFixed(1)} ms</b> / frame`);
 
 export function updateReadouts(): void {
   const r = (lastReadouts = collectReadouts());

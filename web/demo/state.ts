@@ -7,7 +7,7 @@ import type Stats from 'three/addons/libs/stats.module.js';
 import { CRITERIA, MAX_SECTIONS, MIN_SECTIONS, type ClassicReason, type Criterion, type GcsSkin } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import type { DemoRenderer } from './renderer.js';
-import { SteadyFigure } from './steady-figure.js';
+import { FrameCost } from './cost.js';
 import type { InfluenceCount } from './influences.js';
 
 export type ViewKind = 'gcs' | 'classic' | 'lbs';
@@ -112,8 +112,8 @@ export interface DemoState {
   builtCriterion: Criterion;
   /** Pixels the picture is moved down in every view so that the character's centre sits between labels and readouts. */
   viewShift: number;
-  /** ms per frame of each model's update(), steady figures only (reset when a model is built). */
-  timing: { gcs: SteadyFigure; classic: SteadyFigure };
+  /** ms per frame of each model, measured after each build as the bench measures it (cost.ts). */
+  frameCost: FrameCost;
 }
 
 // Set by init() before anything reads them (the renderer, scene, camera and core come first).
@@ -137,7 +137,7 @@ export const state: DemoState = {
   classicBuilds: 0,
   builtCriterion: params.criterion,
   viewShift: 0,
-  timing: { gcs: new SteadyFigure(), classic: new SteadyFigure() },
+  frameCost: new FrameCost(),
 };
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;

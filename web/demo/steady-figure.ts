@@ -1,8 +1,10 @@
-// Per-frame figures (ms, bytes) as a newcomer should read them. The first frames after a build run
-// cold code and upload whole buffers, and a smoothed average keeps them for many frames (tens of
-// seconds at a few frames a second); this keeps a window of recent frames instead, drops the
-// first frames after each reset, and reports the window's figure only once it has stopped falling
-// (its older and newer halves agree). Until then value() is NaN: the page says "warming up".
+// Per-frame figures (ms, bytes) as a newcomer should read them (the crowd page). The first frames
+// after a build run cold code and upload whole buffers, and a smoothed average keeps them for many
+// frames (tens of seconds at a few frames a second); this keeps a window of recent frames instead,
+// drops the first frames after each reset, and reports the window's figure once it has stopped
+// falling (its older and newer halves agree), or once `deadlineMs` have passed since the reset,
+// whatever the frame rate: then from the frames it has (at least 4), and agreed() says whether the
+// halves agree. Until then value() is NaN: the page says "warming up".
 // The figure is the mean of the window's middle half: spikes (a garbage collection) drop out, and
 // the browser's coarse clock (0.1 ms steps) averages out where a median would round it.
 export class SteadyFigure {
@@ -15,23 +17,45 @@ export class SteadyFigure {
   private stored = 0;
   private next = 0;
   private settled = false;
+  private halvesAgree = false;
+  private since: number;
 
   /**
    * @param windowSize frames in the window (a multiple of 4)
    * @param dropped first frames after a reset that never count
    * @param tolerance how far apart the halves' figures may be, as a share of the larger
+   * @param deadlineMs after this long since the reset the figure is shown whether or not it agrees
+   * @param now the clock (ms)
    */
-  constructor(readonly windowSize = 32, readonly dropped = 10, readonly tolerance = 0.2) {
+  constructor(readonly windowSize = 32, readonly dropped = 10, readonly tolerance = 0.2, readonly deadlineMs = 3000,
+    private readonly now: () => number = () => performance.now()) {
     this.ring = new Float64Array(windowSize);
     this.older = new Float64Array(windowSize >> 1);
     this.newer = new Float64Array(windowSize >> 1);
     this.whole = new Float64Array(windowSize);
+    this.since = now();
   }
 
   /** Starts over (a model was built: its figures are new). */
   reset(): void {
     this.seen = this.stored = this.next = 0;
-    this.settled = false;
+    this.settled = this.halvesAgree = false;
+    this.since = this.now();
+  }
+
+  /** Frames counted since the reset (the dropped ones not included). */
+  get frames(): number {
+    return this.stored;
+  }
+
+  /** True once the deadline has passed (a figure still missing then lacks frames). */
+  get overdue(): boolean {
+    return this.now() - this.since >= this.deadlineMs;
+  }
+
+  /** Whether the figure shown had stopped changing (its halves agreed), or was shown at the deadline. */
+  agreed(): boolean {
+    return this.halvesAgree;
   }
 
   add(value: number): void {
@@ -41,23 +65,25 @@ export class SteadyFigure {
     this.stored = Math.min(this.stored + 1, this.windowSize);
   }
 
-  /** The window's figure once steady, else NaN. */
+  /** The window's figure once steady (or at the deadline), else NaN. */
   value(): number {
-    if (this.stored < this.windowSize) return NaN;
-    const n = this.windowSize, half = n >> 1;
+    const late = this.now() - this.since >= this.deadlineMs;
+    if (this.stored < (late ? 4 : this.windowSize)) return NaN;
+    const n = this.stored & ~1, half = n >> 1;
+    const whole = this.whole.subarray(0, n), older = this.older.subarray(0, half), newer = this.newer.subarray(0, half);
     for (let i = 0; i < n; i++) {
-      const v = this.ring[(this.next + i) % n]; // oldest first
-      this.whole[i] = v;
-      if (i < half) this.older[i] = v;
-      else this.newer[i - half] = v;
+      const v = this.ring[(this.next - n + i + this.windowSize) % this.windowSize]; // oldest first
+      whole[i] = v;
+      if (i < half) older[i] = v;
+      else newer[i - half] = v;
     }
     if (!this.settled) {
-      const a = middleMean(this.older), b = middleMean(this.newer);
-      // A machine too noisy to ever agree still gets its figure after a while.
-      this.settled = Math.abs(a - b) <= this.tolerance * Math.max(a, b) || this.seen > this.dropped + 6 * n;
+      const a = middleMean(older), b = middleMean(newer);
+      this.halvesAgree = Math.abs(a - b) <= this.tolerance * Math.max(a, b);
+      this.settled = this.halvesAgree || late;
       if (!this.settled) return NaN;
     }
-    return middleMean(this.whole);
+    return middleMean(whole);
   }
 }
 

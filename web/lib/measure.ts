@@ -29,13 +29,38 @@ export function median(values: ArrayLike<number>): number {
   return percentile(values, 50);
 }
 
-/** The p-th percentile (0..100, nearest rank on the sorted values); NaN for no values. */
+/**
+ * The p-th percentile (0..100, nearest rank on the sorted values, NaN sorting last); NaN for no
+ * values. By selection, not a sort: the fidelity probe takes it over a million distances.
+ */
 export function percentile(values: ArrayLike<number>, p: number): number {
   const n = values.length;
   if (!n) return NaN;
-  const sorted = Float64Array.from(values as ArrayLike<number>).sort();
   const rank = Math.min(n - 1, Math.max(0, Math.ceil((p / 100) * n) - 1));
-  return sorted[rank];
+  const a = new Float64Array(n);
+  let m = 0;
+  for (let i = 0; i < n; i++) if (!Number.isNaN(values[i])) a[m++] = values[i];
+  return rank < m ? select(a, m, rank) : NaN;
+}
+
+/** The k-th smallest of a[0 … n−1] (no NaN), partly reordering a (Hoare's quickselect, median-of-three pivots). */
+function select(a: Float64Array, n: number, k: number): number {
+  let lo = 0, hi = n - 1;
+  while (hi > lo) {
+    const mid = (lo + hi) >> 1;
+    const x = a[lo], y = a[mid], z = a[hi];
+    const pivot = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+    let i = lo, j = hi;
+    while (i <= j) {
+      while (a[i] < pivot) i++;
+      while (a[j] > pivot) j--;
+      if (i <= j) { const t = a[i]; a[i] = a[j]; a[j] = t; i++; j--; }
+    }
+    if (k <= j) hi = j;
+    else if (k >= i) lo = i;
+    else return a[k];
+  }
+  return a[k];
 }
 
 // ------------------------------------------------------------------------------------ timing
@@ -49,6 +74,12 @@ export interface TimingOptions {
   maxMs?: number;
   /** Frames run before timing (default: one pass over the frames). */
   warmup?: number;
+  /**
+   * timeInterleaved: calls per timed sample, one number for every step or one per step (default
+   * 1); a sample's time is divided by it. For a coarse clock (a browser's 0.1 ms steps) a sample
+   * must last many clock steps: calls of 0.05 ms are timed 20 at a time, not one by one.
+   */
+  repeat?: number | readonly number[];
 }
 
 export interface Timing {
@@ -81,25 +112,32 @@ export function timeFrames(frameCount: number, step: (frame: number) => void, op
 }
 
 /**
- * Times several steps in turn, one call each per round, so that whatever else the machine does
- * lands on all of them alike: their ratios hold on a shared, noisy host where timings taken one
- * after the other do not. Each step cycles over `frameCount` frames. Returns one Timing per step.
+ * Times several steps in turn, one call each per round (or `repeat` calls), so that whatever else
+ * the machine does lands on all of them alike: their ratios hold on a shared, noisy host where
+ * timings taken one after the other do not. Each step cycles over `frameCount` frames, every step
+ * on the same frames in a round. Returns one Timing per step (ms per call).
  */
 export function timeInterleaved(frameCount: number, steps: ((frame: number) => void)[], options: TimingOptions = {}): Timing[] {
   const minSamples = options.minSamples ?? 200;
   const minMs = options.minMs ?? 150;
   const maxMs = options.maxMs ?? 3000;
   const warmup = options.warmup ?? frameCount;
+  const repeat = steps.map((_, k) => {
+    const r = typeof options.repeat === 'number' ? options.repeat : options.repeat?.[k] ?? 1;
+    return Number.isInteger(r) && r >= 1 ? r : 1;
+  });
   for (let i = 0; i < warmup; i++) for (const step of steps) step(i % frameCount);
   const samples: number[][] = steps.map(() => []);
+  const stride = Math.max(...repeat);
   const start = performance.now();
-  for (let i = 0; ; i++) {
+  for (let first = 0; ; first += stride) {
     let t1 = 0;
     steps.forEach((step, k) => {
+      const n = repeat[k];
       const t0 = performance.now();
-      step(i % frameCount);
+      for (let r = 0; r < n; r++) step((first + r) % frameCount);
       t1 = performance.now();
-      samples[k].push(t1 - t0);
+      samples[k].push((t1 - t0) / n);
     });
     const elapsed = t1 - start;
     if ((samples[0].length >= minSamples && elapsed >= minMs) || elapsed >= maxMs) break;
@@ -382,7 +420,7 @@ export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Floa
       for (let c = 0; c < 4; c++) { real[c] += s * sj.dq[c]; dual[c] += s * sj.dq[4 + c]; }
       for (let c = 0; c < 9; c++) k[c] += w * sj.k[c];
     }
-    const len = Math.hypot(real[0], real[1], real[2], real[3]);
+    const len = Math.sqrt(real[0] * real[0] + real[1] * real[1] + real[2] * real[2] + real[3] * real[3]);
     for (let c = 0; c < 4; c++) { real[c] /= len; dual[c] /= len; }
     // t = 2 · dual · conj(real)
     const tq = quatMul(dual, [-real[0], -real[1], -real[2], real[3]]);
@@ -520,16 +558,19 @@ export class FidelityProbe {
     // its rest normal, its rest edge lengths.
     const triJoint = new Int32Array(triCount).fill(-1);
     const restNormal = new Float64Array(3 * triCount);
-    const restEdge = new Float64Array(3 * triCount);
+    const restEdge = new Float64Array(3 * triCount); // squared
     for (let t = 0; t < triCount; t++) {
       const a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
       triJoint[t] = source ? triangleJoint(this.input, source[a], source[b], source[c]) : jointOf[a];
       faceNormal(rest, a, b, c, restNormal, 3 * t);
-      restEdge[3 * t] = dist(rest, a, b); restEdge[3 * t + 1] = dist(rest, b, c); restEdge[3 * t + 2] = dist(rest, c, a);
+      restEdge[3 * t] = dist2(rest, a, b); restEdge[3 * t + 1] = dist2(rest, b, c); restEdge[3 * t + 2] = dist2(rest, c, a);
     }
     const edges = interiorEdges(rest, indices);
     const restCos = dihedralCosines(restNormal, edges);
+    const bands = creaseBands(restCos);
     const posedNormal = new Float64Array(3 * triCount);
+    const J = this.input.parents.length;
+    const scales = new Float64Array(J);
     const scale = 100 / this.height;
     let rigidError = 0, flipped = 0, creases = 0, stretched = 0, normalOff = 0, nonFinite = 0, gap = 0;
     const dqsDistances = source ? new Float32Array(nOut * this.frames.length) : null;
@@ -539,7 +580,7 @@ export class FidelityProbe {
       nonFinite += countNonFinite(pos, nrm);
       gap = Math.max(gap, seamGap(pos, pairs));
       for (let o = 0; o < nOut; o++) {
-        const l = Math.hypot(nrm[3 * o], nrm[3 * o + 1], nrm[3 * o + 2]);
+        const l = len3(nrm[3 * o], nrm[3 * o + 1], nrm[3 * o + 2]);
         const off = Math.abs(l - 1);
         if (!(off <= normalOff)) normalOff = Number.isNaN(off) ? Infinity : off;
       }
@@ -547,7 +588,7 @@ export class FidelityProbe {
         const ref = this.reference[f];
         for (let o = 0; o < nOut; o++) {
           const v = source[o];
-          const d = Math.hypot(pos[3 * o] - ref[3 * v], pos[3 * o + 1] - ref[3 * v + 1], pos[3 * o + 2] - ref[3 * v + 2]);
+          const d = len3(pos[3 * o] - ref[3 * v], pos[3 * o + 1] - ref[3 * v + 1], pos[3 * o + 2] - ref[3 * v + 2]);
           dqsDistances[f * nOut + o] = Number.isNaN(d) ? Infinity : d;
           const j = this.rigid[v];
           if (j >= 0) {
@@ -556,12 +597,13 @@ export class FidelityProbe {
             const ex = skin[m] * x + skin[m + 4] * y + skin[m + 8] * z + skin[m + 12];
             const ey = skin[m + 1] * x + skin[m + 5] * y + skin[m + 9] * z + skin[m + 13];
             const ez = skin[m + 2] * x + skin[m + 6] * y + skin[m + 10] * z + skin[m + 14];
-            const e = Math.hypot(pos[3 * o] - ex, pos[3 * o + 1] - ey, pos[3 * o + 2] - ez);
+            const e = len3(pos[3 * o] - ex, pos[3 * o + 1] - ey, pos[3 * o + 2] - ez);
             if (!(e <= rigidError)) rigidError = Number.isNaN(e) ? Infinity : e;
           }
         }
       }
       const rot = this.rotations[f];
+      for (let j = 0; j < J; j++) scales[j] = jointScale(skin, j);
       for (let t = 0; t < triCount; t++) {
         const a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
         const j = triJoint[t];
@@ -574,12 +616,13 @@ export class FidelityProbe {
           const cz = rot[r + 2] * rx + rot[r + 5] * ry + rot[r + 8] * rz;
           if (cx * posedNormal[3 * t] + cy * posedNormal[3 * t + 1] + cz * posedNormal[3 * t + 2] < 0) flipped++;
         }
-        // Stretch is relative to the triangle's own scale change: compare with the rest edge carried by S_j's scale.
-        const k = j >= 0 ? jointScale(skin, j) : 1;
-        if (dist(pos, a, b) > 2 * k * restEdge[3 * t] || dist(pos, b, c) > 2 * k * restEdge[3 * t + 1] ||
-            dist(pos, c, a) > 2 * k * restEdge[3 * t + 2]) stretched++;
+        // Stretch is relative to the triangle's own scale change: compare with the rest edge carried
+        // by S_j's scale (squared lengths: |e| > 2k|r| ⟺ |e|² > 4k²|r|²).
+        const k = j >= 0 ? scales[j] : 1, k4 = 4 * k * k;
+        if (dist2(pos, a, b) > k4 * restEdge[3 * t] || dist2(pos, b, c) > k4 * restEdge[3 * t + 1] ||
+            dist2(pos, c, a) > k4 * restEdge[3 * t + 2]) stretched++;
       }
-      creases += countCreases(posedNormal, edges, restCos);
+      creases += countCreases(posedNormal, edges, restCos, CREASE_DEGREES, bands);
     });
     return {
       frames: this.frames.length,
@@ -640,22 +683,36 @@ export function dihedralCosines(faceNormals: ArrayLike<number>, edges: { a: Uint
  * counts as a crease.
  */
 export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32Array; b: Uint32Array },
-  restCos: Float64Array, degrees = CREASE_DEGREES): number {
-  const limit = degrees * Math.PI / 180;
+  restCos: Float64Array, degrees = CREASE_DEGREES, bands = creaseBands(restCos, degrees)): number {
   let count = 0;
   for (let i = 0; i < restCos.length; i++) {
-    const c0 = restCos[i];
-    if (Number.isNaN(c0)) continue;
+    if (Number.isNaN(restCos[i])) continue;
     const c = normalCos(faceNormals, edges.a[i], edges.b[i]);
-    if (!(Math.abs(Math.acos(c) - Math.acos(c0)) <= limit)) count++;
+    if (!(c >= bands.lo[i] && c <= bands.hi[i])) count++;
   }
   return count;
+}
+
+/**
+ * Per edge, the cosines its posed dihedral may take without a crease: the angle within `degrees`
+ * of its rest angle a0 is the cosine within [cos(a0 + limit), cos(a0 − limit)] (cos falls on
+ * [0, π]), so a frame compares cosines instead of taking an acos per edge.
+ */
+export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): { lo: Float64Array; hi: Float64Array } {
+  const limit = degrees * Math.PI / 180;
+  const lo = new Float64Array(restCos.length), hi = new Float64Array(restCos.length);
+  for (let i = 0; i < restCos.length; i++) {
+    const a0 = Math.acos(restCos[i]);
+    lo[i] = Math.cos(Math.min(Math.PI, a0 + limit));
+    hi[i] = Math.cos(Math.max(0, a0 - limit));
+  }
+  return { lo, hi };
 }
 
 function normalCos(nrm: ArrayLike<number>, s: number, t: number): number {
   const ax = nrm[3 * s], ay = nrm[3 * s + 1], az = nrm[3 * s + 2];
   const bx = nrm[3 * t], by = nrm[3 * t + 1], bz = nrm[3 * t + 2];
-  const l = Math.hypot(ax, ay, az) * Math.hypot(bx, by, bz);
+  const l = len3(ax, ay, az) * len3(bx, by, bz);
   if (!(l > 0)) return NaN;
   return Math.max(-1, Math.min(1, (ax * bx + ay * by + az * bz) / l));
 }
@@ -687,15 +744,24 @@ function faceNormal(p: ArrayLike<number>, a: number, b: number, c: number, out: 
   out[o] = uy * vz - uz * vy; out[o + 1] = uz * vx - ux * vz; out[o + 2] = ux * vy - uy * vx;
 }
 
-function dist(p: ArrayLike<number>, a: number, b: number): number {
-  return Math.hypot(p[3 * a] - p[3 * b], p[3 * a + 1] - p[3 * b + 1], p[3 * a + 2] - p[3 * b + 2]);
+function dist2(p: ArrayLike<number>, a: number, b: number): number {
+  const x = p[3 * a] - p[3 * b], y = p[3 * a + 1] - p[3 * b + 1], z = p[3 * a + 2] - p[3 * b + 2];
+  return x * x + y * y + z * z;
 }
 
 /** Mean column length of joint j's skin matrix: its scale (1 for a rigid motion). */
 function jointScale(skin: ArrayLike<number>, j: number): number {
   const m = 16 * j;
-  return (Math.hypot(skin[m], skin[m + 1], skin[m + 2]) + Math.hypot(skin[m + 4], skin[m + 5], skin[m + 6]) +
-    Math.hypot(skin[m + 8], skin[m + 9], skin[m + 10])) / 3;
+  return (len3(skin[m], skin[m + 1], skin[m + 2]) + len3(skin[m + 4], skin[m + 5], skin[m + 6]) +
+    len3(skin[m + 8], skin[m + 9], skin[m + 10])) / 3;
+}
+
+/**
+ * The length of (x, y, z). Not Math.hypot: V8's is several times slower, and the probe takes
+ * millions a frame; float32 inputs squared in double neither overflow nor underflow.
+ */
+function len3(x: number, y: number, z: number): number {
+  return Math.sqrt(x * x + y * y + z * z);
 }
 
 function maxOf(a: ArrayLike<number>): number {

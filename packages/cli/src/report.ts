@@ -1,10 +1,11 @@
-// `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--json]`:
+// `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--wide] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
-// method, build ms, median ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe
-// over every sampled frame of every clip, distances in % of the character's height), and per clip
-// the frame time, and the mesh's knees and elbows bent alone (measureJoints: volume change, bulge,
-// collapse, creases, new self-intersections per method). The JSON shape is documented in
-// docs/report-json.md.
+// method, build ms, ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe over the
+// sampled frames of every clip, distances in % of the character's height), and the mesh's knees and
+// elbows bent alone (measureJoints: volume change, bulge, collapse, creases, new self-intersections
+// per method). Frame times come from one interleaved timing per clip (every method in turn:
+// timeInterleaved, as `npm run bench`), and a method's one figure is the median of its clips'.
+// Progress on stderr when it is a terminal. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
 import { setConsoleFunction } from 'three';
 import { GcsError } from '../../../web/lib/errors.js';
@@ -14,31 +15,47 @@ import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
 import { wholeNumber } from './args.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
-  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, timeFrames,
+  FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, median, timeInterleaved,
   type Fidelity, type JointsMeasure, type MethodName,
 } from '../../../web/lib/measure.js';
 
-export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--json]
+/** Fidelity frames in all (default --frames: this many spread over the clips, at least MIN_FRAMES_PER_CLIP each, at most 60). */
+export const FRAME_BUDGET = 64;
+export const MIN_FRAMES_PER_CLIP = 8;
+export const DEFAULT_TIME_MS = 1200;
+
+/** Frames sampled per clip when --frames is not given: 60 for one clip, fewer for many. */
+export function defaultFramesPerClip(clipCount: number): number {
+  return Math.max(MIN_FRAMES_PER_CLIP, Math.min(60, Math.round(FRAME_BUDGET / Math.max(1, clipCount))));
+}
+
+export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--wide] [--json]
   Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
-  method, build ms, median ms per frame and its fidelity over every sampled frame of every clip:
-  rigid error, distance from an independent DQS (p95, max), flipped and stretched triangles,
-  normals off unit length, non-finite values, seam gap (distances in % of the character's height);
-  then per clip the frame times, and the knees and elbows (found from the skeleton) each bent alone
-  to 45°, 90°, 135°: volume change, bulge, collapse, creases, new self-intersections per method.
+  method, build ms, ms per frame (the median of the clips', all methods timed in turn) and its
+  fidelity over the sampled frames of every clip: rigid error, distance from an independent DQS
+  (p95, max), flipped, creased and stretched triangles, non-finite values (distances in % of the
+  character's height); then the knees and elbows (found from the skeleton) each bent alone to 45°,
+  90°, 135°: volume change, bulge, collapse, creases, new self-intersections per method. Progress
+  goes to stderr when it is a terminal.
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
-  --frames N      frames sampled per clip (default 60)
-  --time-ms N     timing budget per clip and method, ms (default 300; fidelity is unaffected)
-  --json          machine-readable output (docs/report-json.md)
+  --frames N      frames sampled per clip (default: 60 for one clip, fewer per clip for more
+                  clips, about ${FRAME_BUDGET} in all and at least ${MIN_FRAMES_PER_CLIP} each; more frames, more time)
+  --time-ms N     timing budget per mesh, shared by its clips, ms (default ${DEFAULT_TIME_MS}; fidelity is unaffected)
+  --wide          every column, and per clip the frame times and adjusted sections
+  --json          machine-readable output (docs/report-json.md), every detail
   Reads KHR_mesh_quantization, EXT_meshopt_compression and KHR_draco_mesh_compression files.
   exit codes: 0 ok, 1 some method produced non-finite values, 2 bad arguments or unreadable file`;
 
 export interface ReportOptions {
   clip?: string;
   sections?: number;
+  /** Frames sampled per clip (default defaultFramesPerClip). */
   frames?: number;
-  /** Timing budget per clip and method, and for all frames per method (default 300 ms). */
+  /** Timing budget per mesh, shared by its clips (default DEFAULT_TIME_MS ms). */
   timeMs?: number;
+  /** Called as the report goes (which mesh, method, clip), for a progress line. */
+  onProgress?: (text: string) => void;
 }
 
 export interface MethodReport {
@@ -51,7 +68,7 @@ export interface MethodReport {
   triangles?: number;
   /** Sections (GCS) or contours (classic); absent for LBS and DQS. */
   sections?: number;
-  /** ms per deform() over all the measured frames. */
+  /** ms per deform(): the median of the clips' medians (clips[].methods, the same timing); p95Ms the clips' largest p95. */
   medianMs?: number;
   p95Ms?: number;
   /** FidelityProbe over all the measured frames; distances in % of the mesh's `height`. */
@@ -121,7 +138,8 @@ const roundOrNull = (x: number | null) => (x === null ? null : round(x));
 /** Builds the report of a file (throws ReportError for an unreadable or unskinned file). */
 export async function report(file: string, options: ReportOptions = {}, gcs?: GcsSkin): Promise<Report> {
   const sections = options.sections ?? 6;
-  const frames = options.frames ?? 60;
+  const progress = options.onProgress ?? (() => {});
+  progress(`reading ${file}`);
   let model;
   try {
     model = await loadGltfFile(file);
@@ -137,11 +155,16 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
     if (!clips.length)
       throw new ReportError(`${file} has no clip named '${options.clip}' (clips: ${model.clips.map((c) => c.name).join(', ') || 'none'})`, 'NO_CLIP');
   }
+  const frames = options.frames ?? defaultFramesPerClip(clips.length);
   gcs ??= await initGcsSkin();
   const height = characterHeight(model.skinnedMeshes);
   const meshes: MeshReport[] = [];
+  const M = model.skinnedMeshes.length;
   model.skinnedMeshes.forEach((mesh, i) => {
-    meshes.push(reportMesh(gcs!, file, mesh, clips, { sections, frames, timeMs: options.timeMs ?? 300, height: height.meshUnits[i], worldScale: height.scales[i] }));
+    const meshProgress = (text: string) => progress(`${M > 1 ? `mesh ${i + 1}/${M} ` : ''}'${printable(mesh.name)}': ${text}`);
+    meshes.push(reportMesh(gcs!, file, mesh, clips, {
+      sections, frames, timeMs: options.timeMs ?? DEFAULT_TIME_MS, height: height.meshUnits[i], worldScale: height.scales[i], progress: meshProgress,
+    }));
   });
   return {
     file, options: { sections, frames, clip: options.clip ?? null },
@@ -150,7 +173,7 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
   };
 }
 
-interface MeshSettings { sections: number; frames: number; timeMs: number; height: number; worldScale: number }
+interface MeshSettings { sections: number; frames: number; timeMs: number; height: number; worldScale: number; progress: (text: string) => void }
 
 function roundFidelity(f: Fidelity): Fidelity {
   return {
@@ -182,17 +205,21 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
   const clipFrames = clips.map((clip) => sampleClip(mesh, clip, s.frames));
   const all = clipFrames.flat();
   const frames = all.length ? all : [identitySkin(rig.jointCount)];
+  s.progress(`reference poses (${frames.length} frames)`);
   const probe = new FidelityProbe(input, frames, { height });
   const methods = {} as Record<MethodName, MethodReport>;
   const clipMethods = clips.map(() => ({}) as Partial<Record<MethodName, ClipMethodReport>>);
-  let gcsCounts: { parts: number; sections: number } | null = null;
+  const built: { method: MethodName; d: Deformer }[] = [];
+  let gcsCounts = null as { parts: number; sections: number } | null;
   try {
-    for (const method of METHODS) {
+    // Build and measure fidelity, method by method; the deformers stay for the timing below.
+    METHODS.forEach((method, k) => {
+      s.progress(`${method} (${k + 1}/${METHODS.length}): build, fidelity over ${frames.length} frames`);
       let d: Deformer | undefined;
       let r: MethodReport = { available: false };
       try {
         const t0 = performance.now();
-        d = buildMethod(rig, method, { sections: s.sections });
+        d = buildMethod(rig!, method, { sections: s.sections });
         r.buildMs = round(performance.now() - t0);
         r.vertices = d.vertexCount;
         r.triangles = d.indices.length / 3;
@@ -202,27 +229,40 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
           const loss = (d as unknown as { detailLoss: { rms: number; max: number } }).detailLoss;
           r.detailLoss = { rms: round(loss.rms), max: round(loss.max) };
         }
-        const dd = d;
-        const t = timeFrames(frames.length, (f) => dd.deform(frames[f]), { minSamples: 100, minMs: s.timeMs / 2, maxMs: s.timeMs });
-        r.medianMs = round(t.medianMs);
-        r.p95Ms = round(t.p95Ms);
-        r.fidelity = roundFidelity(probe.measure(dd));
-        clipFrames.forEach((skins, c) => {
-          let adjusted = 0;
-          if (method === 'gcs') for (const skin of skins) { dd.deform(skin); adjusted += (dd as GcsDeformer).adjustedShare; }
-          const tc = timeFrames(skins.length, (f) => dd.deform(skins[f]), { minSamples: 100, minMs: s.timeMs / 2, maxMs: s.timeMs });
-          clipMethods[c][method] = { medianMs: round(tc.medianMs), p95Ms: round(tc.p95Ms), samples: tc.samples };
-          if (method === 'gcs') clipMethods[c][method]!.adjustedShare = round(adjusted / skins.length, 3);
-        });
+        r.fidelity = roundFidelity(probe.measure(d));
         r.available = true;
+        built.push({ method, d });
       } catch (e) {
+        d?.dispose();
         if (!(e instanceof GcsError)) throw e;
         r = { available: false, error: errorInfo(e), ...(r.buildMs !== undefined ? { buildMs: r.buildMs } : {}) };
-      } finally {
-        d?.dispose();
       }
       methods[method] = r;
-    }
+    });
+    // Frame times: per clip, every method in turn (the bind pose alone when there is no clip).
+    const timed = clips.length ? clipFrames : [frames];
+    const budget = Math.max(20, s.timeMs / timed.length);
+    const perClip = timed.map((skins, c) => {
+      if (clips.length) s.progress(`timing clip '${printable(clips[c].name)}' (${c + 1}/${clips.length}), ${built.length} methods in turn`);
+      const t = timeInterleaved(skins.length, built.map(({ d }) => (f: number) => d.deform(skins[f])),
+        { minSamples: 30, minMs: budget / 2, maxMs: budget, warmup: Math.min(skins.length, 8) });
+      built.forEach(({ method, d }, k) => {
+        if (!clips.length) return;
+        const x: ClipMethodReport = { medianMs: round(t[k].medianMs), p95Ms: round(t[k].p95Ms), samples: t[k].samples };
+        if (method === 'gcs') {
+          let adjusted = 0;
+          for (const skin of skins) { d.deform(skin); adjusted += (d as GcsDeformer).adjustedShare; }
+          x.adjustedShare = round(adjusted / skins.length, 3);
+        }
+        clipMethods[c][method] = x;
+      });
+      return t;
+    });
+    built.forEach(({ method }, k) => {
+      methods[method].medianMs = round(median(perClip.map((t) => t[k].medianMs)));
+      methods[method].p95Ms = round(Math.max(...perClip.map((t) => t[k].p95Ms)));
+    });
+    s.progress('knees and elbows, each bent alone');
     const joints = roundJoints(measureJoints(rig, input, { methods: jointMethods({ sections: s.sections }), names: mesh.skeleton.bones.map((b) => b.name) }));
     return {
       name: mesh.name,
@@ -239,6 +279,7 @@ function reportMesh(gcs: GcsSkin, file: string, mesh: THREE.SkinnedMesh, clips: 
       joints,
     };
   } finally {
+    for (const { d } of built) d.dispose();
     rig.dispose();
   }
 }
@@ -294,8 +335,24 @@ function table(rows: string[][]): string {
   return rows.map((r) => r.map((cell, c) => (left(c) ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ').trimEnd()).join('\n');
 }
 
-/** The human-readable report. */
-export function formatReport(r: Report): string {
+/** `text` in lines of at most REPORT_COLUMNS, broken at spaces (a word longer than that stays whole). */
+function wrap(text: string): string[] {
+  const lines: string[] = [];
+  let line = '';
+  for (const word of text.split(' ')) {
+    if (line && line.length + 1 + word.length > REPORT_COLUMNS) { lines.push(line); line = `  ${word}`; }
+    else line = line ? `${line} ${word}` : word;
+  }
+  if (line) lines.push(line);
+  return lines;
+}
+
+/** The text report fits this many columns (its tables; --wide and JSON carry the rest). */
+export const REPORT_COLUMNS = 120;
+
+/** The human-readable report: a table per mesh that fits REPORT_COLUMNS; `wide`: every column and the clips. */
+export function formatReport(r: Report, options: { wide?: boolean } = {}): string {
+  const wide = options.wide ?? false;
   const out: string[] = [`gcs-skin report: ${printable(r.file)}`,
     `character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`];
   for (const w of r.warnings) out.push(`loader warning: ${printable(w)}`);
@@ -303,49 +360,77 @@ export function formatReport(r: Report): string {
     const c = m.counts;
     out.push('', `mesh '${shownName(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
-    out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s)` : 'bind pose only: no clip'}); ` +
+    out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s), ${r.options.frames} each` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
     out.push(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
       (c.moreThan4Influences ? ' (three.js\'s own skinning would drop their JOINTS_1/WEIGHTS_1)' : ''));
     const lbs = m.methods.lbs?.fidelity?.flipped;
     // Creases against the baselines: the more of LBS's and DQS's count over the same frames.
     const creaseBase = Math.max(m.methods.lbs?.fidelity?.creases ?? 0, m.methods.dqs?.fidelity?.creases ?? 0);
-    const rows = [['method', 'build ms', 'median ms', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'creases', 'stretched', 'normal off', 'non-finite', 'seam gap %', 'note']];
+    const header = ['method', 'build ms', 'ms/frame', 'rigid err %', 'DQS p95 %', 'DQS max %', 'flipped', 'creases', 'stretched', 'non-finite'];
+    if (wide) header.push('p95 ms', 'normal off', 'seam gap %', 'note');
+    const rows = [header];
+    const notes: string[] = [];
     for (const name of METHODS) {
       const x = m.methods[name];
-      if (!x.available || !x.fidelity) { rows.push([name, fmt(x.buildMs, 2), 'n/a', '', '', '', '', '', '', '', '', '', `${x.error!.code}: ${printable(x.error!.message)}`]); continue; }
+      if (!x.available || !x.fidelity) {
+        rows.push([name, fmt(x.buildMs, 2), 'n/a', ...header.slice(3).map(() => '')]);
+        notes.push(`${name}: ${x.error!.code}: ${printable(x.error!.message)}`);
+        continue;
+      }
       const f = x.fidelity;
-      const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : `${f.flipped} (LBS ${lbs})`;
+      const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : wide ? `${f.flipped} (LBS ${lbs})` : `${f.flipped}`;
       const creases = name === 'lbs' || name === 'dqs' || !(creaseBase > 0) ? String(f.creases)
-        : `${f.creases} (${(f.creases / creaseBase).toFixed(2)}× LBS/DQS)`;
+        : `${f.creases} (${(f.creases / creaseBase).toFixed(2)}×)`;
       const note = x.detailLoss ? `resampled: detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of its height` : '';
-      rows.push([name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, creases, String(f.stretched),
-        fmt(f.normalOffUnit, 4), String(f.nonFinite), fmt(f.seamGap, 4), note]);
+      const row = [name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, creases, String(f.stretched),
+        String(f.nonFinite)];
+      if (wide) row.push(fmt(x.p95Ms, 4), fmt(f.normalOffUnit, 4), fmt(f.seamGap, 4), note);
+      else if (note) notes.push(`${name}: ${note}`);
+      rows.push(row);
     }
     out.push(table(rows));
-    if (!m.clips.length) out.push('(no animation clips: per-clip timing needs a clip)');
-    for (const clip of m.clips) {
-      out.push('', `clip '${shownName(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
-      const rows2 = [['method', 'median ms', 'p95 ms', 'adjusted']];
-      for (const name of METHODS) {
-        const x = clip.methods[name];
-        if (!x) { rows2.push([name, 'n/a', '', '']); continue; }
-        rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
-      }
-      out.push(table(rows2));
+    out.push(`ms/frame: median of the clips' (methods timed in turn) · creases ×: vs the more of LBS/DQS · LBS flipped ${lbs ?? 'n/a'}`);
+    for (const n of notes) out.push(n);
+    if (!m.clips.length) out.push('(no animation clips: the bind pose was timed)');
+    else if (!wide) {
+      const names = m.clips.map((clip) => shownName(clip.name)).join(', ');
+      out.push(`${m.clips.length} clip(s)${names.length <= 70 ? `: ${names}` : ''} (per clip: --wide or --json)`);
     }
     const j = m.joints;
-    out.push('', `joints: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}; each bent alone from the bind pose`,
-      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone over the same at bind');
-    for (const note of j.notes) out.push(`  note: ${printable(note)}`);
-    if (j.joints.length) out.push(table(jointTableRows(j).map((row) => row.map(printable))));
+    out.push('', ...wrap(`joints, each bent alone from the bind pose: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}`),
+      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone',
+      'over the same at bind');
+    for (const note of j.notes) out.push(...wrap(`  note: ${printable(note)}`));
+    if (j.joints.length) {
+      // The joint on a row of its own above its methods: a column of joint names would not fit.
+      const [head, ...body] = jointTableRows(j).map((row) => row.map(printable));
+      const rows = [head.slice(1)];
+      for (const row of body) {
+        if (row[0]) rows.push([row[0], ...head.slice(2).map(() => '')]);
+        rows.push([`  ${row[1]}`, ...row.slice(2)]);
+      }
+      rows[0][0] = 'joint / method';
+      out.push(table(rows));
+    }
+    if (wide)
+      for (const clip of m.clips) {
+        out.push('', `clip '${shownName(clip.name)}' (${fmt(clip.duration, 2)} s, ${clip.frames} frames)`);
+        const rows2 = [['method', 'median ms', 'p95 ms', 'samples', 'adjusted']];
+        for (const name of METHODS) {
+          const x = clip.methods[name];
+          if (!x) { rows2.push([name, 'n/a', '', '', '']); continue; }
+          rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), String(x.samples), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
+        }
+        out.push(table(rows2));
+      }
   }
   return out.join('\n');
 }
 
-function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolean; options: ReportOptions } {
+function parseArgs(argv: string[]): { file?: string; json: boolean; wide: boolean; help: boolean; options: ReportOptions } {
   const options: ReportOptions = {};
-  let file: string | undefined, json = false, help = false;
+  let file: string | undefined, json = false, wide = false, help = false;
   for (let i = 0; i < argv.length; i++) {
     const a = argv[i];
     const value = () => {
@@ -355,6 +440,7 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
     };
     const integer = (min: number, max: number) => wholeNumber(a, value(), min, max);
     if (a === '--json') json = true;
+    else if (a === '--wide') wide = true;
     else if (a === '-h' || a === '--help') help = true;
     else if (a === '--clip') options.clip = value();
     else if (a === '--sections') options.sections = integer(3, 256);
@@ -364,7 +450,36 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; help: boolea
     else if (file === undefined) file = a;
     else throw new ReportError(`only one model file, got '${file}' and '${a}'`);
   }
-  return { file, json, help, options };
+  return { file, json, wide, help, options };
+}
+
+/**
+ * Whether to show progress on `stream`: only on a terminal (a pipe or a file gets the report and
+ * nothing else), not a dumb one, and not when GCS_SKIN_PROGRESS=0; GCS_SKIN_PROGRESS=1 forces it.
+ */
+export function wantsProgress(stream: { isTTY?: boolean }, env: Record<string, string | undefined>): boolean {
+  if (env.GCS_SKIN_PROGRESS === '1') return true;
+  if (env.GCS_SKIN_PROGRESS === '0') return false;
+  return stream.isTTY === true && env.TERM !== 'dumb';
+}
+
+/** One progress line on stderr, rewritten in place (cut to the terminal's width) and cleared at the end; silent when not wanted. */
+function progressLine(stream: NodeJS.WriteStream, env: Record<string, string | undefined>): { show: (text: string) => void; end: () => void } {
+  if (!wantsProgress(stream, env)) return { show: () => {}, end: () => {} };
+  let shown = false;
+  const started = performance.now();
+  return {
+    show: (text) => {
+      const line = `gcs-skin report: ${text} (${((performance.now() - started) / 1000).toFixed(0)} s)`;
+      const width = Math.max(20, (stream.columns || 80) - 1);
+      stream.write(`\r\x1b[K${line.length > width ? `${line.slice(0, width - 1)}…` : line}`);
+      shown = true;
+    },
+    end: () => {
+      if (shown) stream.write('\r\x1b[K');
+      shown = false;
+    },
+  };
 }
 
 /**
@@ -391,16 +506,20 @@ export async function run(argv: string[]): Promise<number> {
   // print: a successful run writes its report and nothing else; three's errors still reach stderr.
   setConsoleFunction((level, message, ...params) => { if (level === 'error') console.error(message, ...params); });
   let r: Report;
+  const progress = progressLine(process.stderr, process.env);
   try {
-    r = await report(args.file, args.options);
+    r = await report(args.file, { ...args.options, onProgress: progress.show });
   } catch (e) {
     if (e instanceof ReportError) {
+      progress.end();
       process.stderr.write(`gcs-skin report: ${oneLine(e.message)} [${e.code}]\n`);
       return 2;
     }
     throw e;
+  } finally {
+    progress.end();
   }
-  console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r));
+  console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r, { wide: args.wide }));
   const bad = nonFiniteMethods(r);
   if (bad.length) {
     process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${shownName(b.mesh)}' (${b.count})`).join(', ')}\n`);

@@ -154,12 +154,16 @@ function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint3
   }
   // Groups (multi-material) and the draw range count index entries: they carry over when the
   // deformer kept the triangles in order (GCS, LBS, DQS remap vertex ids only; checked here).
+  // (Checked only when there are groups, a draw range or several materials: a slider drag rebuilds
+  // every frame, and the check reads every index.)
+  const ranged = src.groups.length > 0 || src.drawRange.start !== 0 || src.drawRange.count !== Infinity || Array.isArray(from.mesh.material);
   let sameOrder = !!sourceVertex;
-  if (sourceVertex) {
+  if (sourceVertex && ranged) {
     const srcIndex = src.index;
-    for (let i = 0; i < indices.length && sameOrder; i++)
-      sameOrder = sourceVertex[indices[i]] === (srcIndex ? srcIndex.getX(i) : i);
     if (srcIndex && indices.length !== srcIndex.count) sameOrder = false;
+    const order = srcIndex?.array; // an index attribute is never interleaved
+    for (let i = 0; i < indices.length && sameOrder; i++)
+      sameOrder = sourceVertex[indices[i]] === (order ? order[i] : i);
   }
   if (sameOrder) {
     for (const g of src.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
