@@ -75,6 +75,7 @@ function expectRefusedBy(r: Outcome, file: string, code: string, mb = REFUSED_MB
   expect(line, where).toMatch(new RegExp(`^gcs-skin ${cmd}: .* \\[${code}\\]$`));
   expect(line).not.toContain(SECRET);
   expect(line).not.toMatch(/[\x00-\x1f\x7f]/);
+  expect(line.length, `${where}: ${line.length} characters`).toBeLessThanOrEqual(200);
   expectBounded(r, where, mb);
   console.log(`hostile: ${file.slice(file.startsWith(folder) ? folder.length + 1 : 0).padEnd(28)} ${code.padEnd(15)} ${String(line.length).padStart(4)} chars ${r.cpuMs.toFixed(0).padStart(5)} ms CPU ${r.ms.toFixed(0).padStart(5)} ms wall ${r.maxRssMb.toFixed(0).padStart(4)} MB`);
   return line;

@@ -77,7 +77,7 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
   } catch (e) {
     throw unreadable(e);
   }
-  if (!within(await realpath(folder), real)) throw outside("is a link leading out of the glTF's folder");
+  if (!within(await realpath(folder), real)) throw outside("links out of the folder");
   try {
     // No link followed at the last step: the path checked above is the one opened.
     const bytes = await readRegularFile(real, { maxBytes: budget.left, truncateAt: maxBytes, noFollow: true });

@@ -23,14 +23,14 @@ export function checkAnimations(ctx: ValidationContext): void {
     const a = accessors[ai];
     const dense = accessorReader(json, buffers, a), sparse = sparseReader(json, buffers, a);
     const bad = (k: number, t: number, why: string) =>
-      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${t}: ${why}`);
+      fail('BAD_DATA', where, `key ${n(k)} of ${what} (accessor ${ai}) is at time ${+t.toPrecision(6)}: ${why}`);
     if (sparse) for (let k = 0; k < sparse.count; k++) { const t = sparse.value(k, 0); if (!Number.isFinite(t)) bad(sparse.index(k), t, 'key times are finite seconds'); }
     if (!dense || sparse) return; // the order of sparse-patched times is left to the loaders
     let previous = 0;
     for (let k = 0; k < a.count; k++) {
       const t = dense(k, 0);
       if (!Number.isFinite(t)) bad(k, t, 'key times are finite seconds');
-      if (t < previous) bad(k, t, k ? `before key ${n(k - 1)} at ${previous}: key times never go back` : 'key times start at 0 or later');
+      if (t < previous) bad(k, t, k ? `before key ${n(k - 1)} at ${+previous.toPrecision(6)}: key times never go back` : 'key times start at 0 or later');
       previous = t;
     }
   };

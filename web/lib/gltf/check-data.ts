@@ -130,8 +130,8 @@ export function checkDeclaredBytes(ctx: ValidationContext): void {
   const allowed = LIMITS.expandedFloor + LIMITS.expansion * present;
   if (expanded > allowed)
     fail('TOO_LARGE', largest >= 0 ? `/accessors/${largest}` : '/bufferViews',
-      `its accessors declare ${n(expanded)} bytes${largest >= 0 ? ` (largest: accessor ${largest}, ${plural(accessors[largest].count, 'element')})` : ''}` +
-      ` from ${n(present)} bytes of data, past ${LIMITS.expandedFloor / 2 ** 20} MiB + ${LIMITS.expansion} × the data`);
+      `accessors declare ${n(expanded)} bytes${largest >= 0 ? ` (accessor ${largest}: ${plural(accessors[largest].count, 'element')})` : ''}` +
+      ` from ${n(present)} bytes of data, past ${LIMITS.expandedFloor / 2 ** 20} MiB + ${LIMITS.expansion}× that`);
 }
 
 /** Sparse indices read from the data. */

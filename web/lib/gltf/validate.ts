@@ -38,6 +38,7 @@ import { checkInstancing, checkNodeGraph, checkNodes, checkScenes, checkSkins } 
 import { GltfError } from './error.js';
 import type { BufferData, GltfJson } from './json.js';
 import { READ_EXTENSIONS } from './limits.js';
+import { shownName } from './shown-name.js';
 import { isObject, ValidationContext } from './validation-context.js';
 
 /**
@@ -76,7 +77,8 @@ function checkAsset(json: GltfJson, file: string): void {
     const unread = required.filter((x: unknown) => !READ_EXTENSIONS.includes(x as string));
     if (unread.length)
       throw new GltfError('UNSUPPORTED', file, '/extensionsRequired',
-        `${file} requires the glTF extension${unread.length > 1 ? 's' : ''} ${unread.join(', ')}, which this loader does not read` +
-        ` (it reads ${READ_EXTENSIONS.join(', ')})`);
+        // The first one named (capped and escaped: the names are the file's), the list of ours short: one line.
+        `${file} requires the glTF extension ${shownName(String(unread[0]))}${unread.length > 1 ? ` and ${unread.length - 1} more` : ''}, ` +
+        'which this loader does not read (it reads quantization, meshopt, Draco, KTX2)');
   }
 }
