@@ -161,14 +161,15 @@ inline bool decomposeSimilarity(const glm::mat4& s, JointPose& out) {
       !(glm::dot(glm::cross(a, b), c) > 0.0f))
     return false;
   const float k = std::sqrt(c2), inv = 1.0f / k;
-  const glm::quat r = glm::normalize(glm::quat_cast(glm::mat3(a * inv, b * inv, c * inv)));
+  const glm::mat3 rm(a * inv, b * inv, c * inv);
+  const glm::quat r = glm::normalize(glm::quat_cast(rm));
   out.rotation = r;
   out.translation = glm::vec3(s[3]);
   out.scale = glm::mat3(k);
   const glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
   out.real = glm::vec4(r.x, r.y, r.z, r.w);
   out.dual = glm::vec4(d.x, d.y, d.z, d.w);
-  out.normal = glm::mat4(glm::mat3_cast(r));
+  out.normal = glm::mat4(rm);  // orthonormal within 1e-6: normals stay unit
   out.normal[3][3] = 0.0f;
   out.renormalise = false;
   return true;
