@@ -503,7 +503,8 @@ if (results.sizes.length) {
 }
 
 console.log('\nReal characters beside our human (every skinned mesh, every clip), default GCS timed in turn with a memcpy of the bytes ' +
-  'it reads and writes; node pass: joint poses and node transforms (before any vertex), timed in the same run; runs: vertices that share their nodes:');
+  'it reads and writes; node pass: joint poses and node transforms (before any vertex), timed in the same run; runs: vertices that share their nodes; ' +
+  'vertex pass / memcpy: what is left after the node pass, over the memcpy (the ratio GCS / memcpy cannot fall below it):');
 console.log(fmtTable(realRigRows(results.realRigs.rows, ms)));
 for (const s of results.realRigs.skipped) console.log(`  ${s}`);
 

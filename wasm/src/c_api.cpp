@@ -139,9 +139,9 @@ int gcs_deformer_deform(GcsDeformer* deformer, const float* skinMatrices, uint32
   gcs::Deformer& d = *deformer->impl;
   if (jointCount != d.jointCount)
     return fail(GCS_ERR_LENGTH_MISMATCH, "got %u skin matrices, but the rig has %u joints", jointCount, d.jointCount);
-  for (uint32_t i = 0; i < jointCount * 16; ++i)
-    if (!std::isfinite(skinMatrices[i]))
-      return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u contains NaN or infinity", i / 16);
+  const size_t bad = gcs::firstNonFinite(skinMatrices, size_t(jointCount) * 16);
+  if (bad != size_t(jointCount) * 16)
+    return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u contains NaN or infinity", uint32_t(bad / 16));
   // glm::mat4 is 16 floats, column-major, no padding: the array can be read in place.
   static_assert(sizeof(glm::mat4) == 16 * sizeof(float), "glm::mat4 must be 16 packed floats");
   d.applyMorphs();
@@ -325,9 +325,9 @@ static bool validGpuInput(const gcs::GcsDeformerImpl& g, const float* skinMatric
   const uint64_t inFloats = uint64_t(instanceCount) * jointCount * 16;
   if (uint64_t(instanceCount) * outBytesPerInstance > 0xffffffffull || inFloats * 4 > 0xffffffffull)
     return fail(GCS_ERR_OUT_OF_RANGE, "%u instances of %u %s do not fit in 4 GiB of memory", instanceCount, units, unitName);
-  for (uint64_t i = 0; i < inFloats; ++i)
-    if (!std::isfinite(skinMatrices[i]))
-      return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u of instance %u contains NaN or infinity",
+  const uint64_t i = gcs::firstNonFinite(skinMatrices, size_t(inFloats));
+  if (i != inFloats)
+    return fail(GCS_ERR_NON_FINITE, "the skin matrix of joint %u of instance %u contains NaN or infinity",
                   uint32_t((i / 16) % jointCount), uint32_t(i / 16 / jointCount));
   return true;
 }

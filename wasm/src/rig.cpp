@@ -7,11 +7,20 @@
 
 namespace gcs {
 
-bool allFinite(const float* values, size_t count) {
+size_t firstNonFinite(const float* values, size_t count) {
+  uint32_t any = 0;  // a branch-free pass first (vectorised): skin matrices arrive every frame
+  for (size_t i = 0; i < count; ++i) {
+    uint32_t bits;
+    std::memcpy(&bits, values + i, sizeof bits);
+    any |= uint32_t((bits & 0x7f800000u) == 0x7f800000u);
+  }
+  if (!any) return count;
   for (size_t i = 0; i < count; ++i)
-    if (!std::isfinite(values[i])) return false;
-  return true;
+    if (!std::isfinite(values[i])) return i;
+  return count;
 }
+
+bool allFinite(const float* values, size_t count) { return firstNonFinite(values, count) == count; }
 
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
   if (rig.welded) {

@@ -68,6 +68,8 @@ std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& repr
 // largest), the same joint listed twice merged, the rest normalised to sum 1. Returns their count.
 uint32_t cleanWeights(const Rig& rig, uint32_t v, uint32_t* joint, float* weight);
 
+// The index of the first NaN or infinity among `count` floats; `count` when all are finite.
+size_t firstNonFinite(const float* values, size_t count);
 // Checks that `count` floats are all finite.
 bool allFinite(const float* values, size_t count);
 
