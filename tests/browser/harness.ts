@@ -129,38 +129,43 @@ export interface RegionStats {
   changed: number;
 }
 
+/** A PNG (base64) decoded inside the page: createImageBitmap + OffscreenCanvas, no npm PNG package. */
+async function decodePng(b64: string): Promise<ImageData> {
+  const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+  const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+  const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+  const ctx = canvas.getContext('2d')!;
+  ctx.drawImage(bitmap, 0, 0);
+  return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
+}
+
 /**
- * Decodes PNG screenshots inside the page (createImageBitmap + OffscreenCanvas, no npm PNG
- * package) and measures regions of them.
+ * Runs `measure` inside the page on the PNGs (base64) decoded there: the one decoder of every
+ * browser test's pixel measures. Like page.evaluate's function, `measure` sees only its arguments.
  */
+export function measurePixels<A, R>(page: Page, pngs: string[], measure: (images: ImageData[], arg: A) => R | Promise<R>, arg: A): Promise<R> {
+  // An expression (page.evaluate calls no function given as a string), its input written into it as JSON.
+  return page.evaluate<R>(`(async ({ pngs, arg }) => (${measure})(await Promise.all(pngs.map(${decodePng})), arg))(${JSON.stringify({ pngs, arg })})`);
+}
+
+/** Measures regions of a PNG screenshot (and, with `before`, what changed from that one). */
 export async function analyse(page: Page, png: Buffer, regions: Rect[], before?: Buffer): Promise<RegionStats[]> {
-  return page.evaluate(async ({ png, before, regions }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
-    };
-    const a = await decode(png);
-    const b = before ? await decode(before) : null;
-    return regions.map((r) => {
-      const colours = new Set<number>();
-      let skin = 0, changed = 0, total = 0;
-      for (let y = Math.max(0, r.y); y < Math.min(a.height, r.y + r.height); y++) {
-        for (let x = Math.max(0, r.x); x < Math.min(a.width, r.x + r.width); x++) {
-          const i = 4 * (y * a.width + x);
-          const R = a.data[i], G = a.data[i + 1], B = a.data[i + 2];
-          colours.add(((R >> 3) << 10) | ((G >> 3) << 5) | (B >> 3));
-          if (R > 110 && R - B > 40) skin++;
-          if (b && (Math.abs(R - b.data[i]) > 24 || Math.abs(G - b.data[i + 1]) > 24 || Math.abs(B - b.data[i + 2]) > 24)) changed++;
-          total++;
-        }
+  const pngs = before ? [png, before] : [png];
+  return measurePixels(page, pngs.map((p) => p.toString('base64')), ([a, b], regions) => regions.map((r) => {
+    const colours = new Set<number>();
+    let skin = 0, changed = 0, total = 0;
+    for (let y = Math.max(0, r.y); y < Math.min(a.height, r.y + r.height); y++) {
+      for (let x = Math.max(0, r.x); x < Math.min(a.width, r.x + r.width); x++) {
+        const i = 4 * (y * a.width + x);
+        const R = a.data[i], G = a.data[i + 1], B = a.data[i + 2];
+        colours.add(((R >> 3) << 10) | ((G >> 3) << 5) | (B >> 3));
+        if (R > 110 && R - B > 40) skin++;
+        if (b && (Math.abs(R - b.data[i]) > 24 || Math.abs(G - b.data[i + 1]) > 24 || Math.abs(B - b.data[i + 2]) > 24)) changed++;
+        total++;
       }
-      return { colours: colours.size, skin: skin / Math.max(1, total), changed: changed / Math.max(1, total) };
-    });
-  }, { png: png.toString('base64'), before: before?.toString('base64'), regions });
+    }
+    return { colours: colours.size, skin: skin / Math.max(1, total), changed: changed / Math.max(1, total) };
+  }), regions);
 }
 
 export { existsSync };

@@ -7,7 +7,7 @@ import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import type { BrowserContext, Page } from 'playwright-core';
-import { launchChromium, openDemoPage, ROOT, skipReason, startDemo, type DemoServer } from './harness.js';
+import { launchChromium, measurePixels, openDemoPage, ROOT, skipReason, startDemo, type DemoServer } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -32,25 +32,20 @@ const hook = (page: Page) => ({
  * `b` of the same one (or of `other`), both cut to the narrower width.
  */
 async function viewDifference(page: Page, png: Buffer, a: { x: number; width: number }, b: { x: number; width: number }, other?: Buffer): Promise<number> {
-  return page.evaluate(async ({ png, other, a, b }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx;
-    };
-    const first = await decode(png), second = other ? await decode(other) : first;
+  const pngs = other ? [png, other] : [png];
+  return measurePixels(page, pngs.map((p) => p.toString('base64')), ([first, second = first], { a, b }) => {
     // Between the labels and the readouts, clear of the dividers at the columns' edges: the picture itself.
-    const w = Math.min(a.width, b.width) - 6, h = first.canvas.height;
+    const w = Math.min(a.width, b.width) - 6, h = first.height;
     const top = Math.round(0.22 * h), bottom = Math.round(0.82 * h);
-    const A = first.getImageData(a.x + 3, top, w, bottom - top).data, B = second.getImageData(b.x + 3, top, w, bottom - top).data;
     let changed = 0;
-    for (let i = 0; i < A.length; i += 4)
-      if (Math.abs(A[i] - B[i]) > 24 || Math.abs(A[i + 1] - B[i + 1]) > 24 || Math.abs(A[i + 2] - B[i + 2]) > 24) changed++;
-    return changed / (A.length / 4);
-  }, { png: png.toString('base64'), other: other?.toString('base64'), a, b });
+    for (let y = top; y < bottom; y++)
+      for (let x = 0; x < w; x++) {
+        const i = 4 * (y * first.width + a.x + 3 + x), j = 4 * (y * second.width + b.x + 3 + x);
+        const A = first.data, B = second.data;
+        if (Math.abs(A[i] - B[j]) > 24 || Math.abs(A[i + 1] - B[j + 1]) > 24 || Math.abs(A[i + 2] - B[j + 2]) > 24) changed++;
+      }
+    return changed / (w * (bottom - top));
+  }, { a, b });
 }
 
 describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
