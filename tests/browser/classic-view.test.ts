@@ -5,17 +5,12 @@
 // - the classic view against the GCS view on a real character (Cesium Man, paused): the two
 //   silhouettes nearly coincide (a flap, a cut or a part standing off the skin shows as pixels of
 //   one and not the other), and the classic view is textured like the GCS view.
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { BrowserContext, Page } from 'playwright-core';
-import { launchChromium, measurePixels, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { describe, expect, test } from 'vitest';
+import type { Page } from 'playwright-core';
+import { demoInChromium, frames, measurePixels, skipReason, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
-
-async function frames(page: Page, n: number): Promise<void> {
-  const f = await page.evaluate(() => window.__demo.frame());
-  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
-}
 
 interface ViewFigures {
   /** Character pixels (differing from the empty scene) inside the view. */
@@ -90,22 +85,10 @@ async function measureViews(page: Page): Promise<{ views: ViewFigures[]; overlap
 }
 
 describe.skipIf(!!reason)('the demo\'s views measured on screenshots (headless Chromium)', () => {
-  let server: DemoServer;
-  let context: BrowserContext;
-
-  beforeAll(async () => {
-    [server, context] = await Promise.all([startDemo(), launchChromium()]);
-  });
-  afterAll(async () => {
-    await context?.close();
-    await server?.close();
-  });
+  const demo = demoInChromium();
 
   async function open(query: string): Promise<Page> {
-    const page = await context.newPage();
-    await page.goto(`${server.url}?${query}`);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
+    const { page } = await demo.open(`?${query}`);
     await page.evaluate(() => window.__demo.idle());
     expect(await page.evaluate(() => window.__demo.error())).toBe('');
     return page;

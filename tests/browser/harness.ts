@@ -6,6 +6,7 @@ import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import type { BrowserContext, Page } from 'playwright-core';
 import type { ViteDevServer } from 'vite';
+import { afterAll, beforeAll } from 'vitest';
 
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
 export const MODELS_DIR = resolve(ROOT, '../shared/models');
@@ -89,6 +90,33 @@ export async function openDemoPage(context: BrowserContext, server: DemoServer, 
   await page.waitForFunction(() => (window as unknown as { __demo?: unknown }).__demo !== undefined);
   await page.evaluate(() => (window as unknown as { __demo: { ready: Promise<unknown> } }).__demo.ready);
   return { page, errors };
+}
+
+/** The served demo and a headless Chromium for a describe block's tests: started before them, closed after. */
+export interface DemoInChromium {
+  server: DemoServer;
+  context: BrowserContext;
+  /** openDemoPage on this server and browser. */
+  open(query: string, options?: { dialogs?: boolean }): Promise<{ page: Page; errors: string[] }>;
+}
+
+/** Call in a describe block: the demo and Chromium start in its beforeAll and close in its afterAll. */
+export function demoInChromium(): DemoInChromium {
+  const demo = { open: (query, options) => openDemoPage(demo.context, demo.server, query, options) } as DemoInChromium;
+  beforeAll(async () => {
+    [demo.server, demo.context] = await Promise.all([startDemo(), launchChromium()]);
+  });
+  afterAll(async () => {
+    await demo.context?.close();
+    await demo.server?.close();
+  });
+  return demo;
+}
+
+/** Waits until the demo has drawn `n` more frames. */
+export async function frames(page: Page, n: number): Promise<void> {
+  const f = await page.evaluate(() => window.__demo.frame());
+  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
 }
 
 /** A fixture page (tests/browser/<folder>/index.html) served by Vite's dev server and open in Chromium. */

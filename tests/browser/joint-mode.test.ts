@@ -3,11 +3,11 @@
 // by side from one camera. Unbent, the three views are the same picture; bent, LBS's differs from
 // DQS's (its collapse at the inner side), and the readouts say so: LBS loses volume, DQS keeps it
 // and bulges more.
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import { describe, expect, test } from 'vitest';
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
-import type { BrowserContext, Page } from 'playwright-core';
-import { launchChromium, measurePixels, openDemoPage, ROOT, skipReason, startDemo, type DemoServer } from './harness.js';
+import type { Page } from 'playwright-core';
+import { demoInChromium, measurePixels, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -54,18 +54,10 @@ async function viewDifference(page: Page, png: Buffer, a: { x: number; width: nu
 }
 
 describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
-  let server: DemoServer;
-  let context: BrowserContext;
-  beforeAll(async () => {
-    [server, context] = await Promise.all([startDemo(), launchChromium()]);
-  });
-  afterAll(async () => {
-    await context?.close();
-    await server?.close();
-  });
+  const demo = demoInChromium();
 
   test('our human\'s left elbow: the same picture unbent; at 135° LBS differs from DQS, loses volume, and DQS bulges more', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?joint');
+    const { page, errors } = await demo.open('?joint');
     try {
       const j = hook(page);
       expect(await page.evaluate(() => window.__demo.error())).toBe('');
@@ -118,7 +110,7 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
   }, 300000);
 
   test('the comparison page\'s joint close-up button opens ?joint on the character on screen', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?model=cesiumman');
+    const { page, errors } = await demo.open('?model=cesiumman');
     try {
       await Promise.all([
         page.waitForURL(/[?&]joint(&|=|$)/),
@@ -135,7 +127,7 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
   }, 300000);
 
   test('CesiumMan (no bone names): two knees and two elbows found, a knee bent to 135° measured in every view', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?joint=right%20knee&model=cesiumman&bend=135');
+    const { page, errors } = await demo.open('?joint=right%20knee&model=cesiumman&bend=135');
     try {
       const j = hook(page);
       expect(await page.evaluate(() => window.__demo.error())).toBe('');
