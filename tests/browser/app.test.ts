@@ -27,14 +27,13 @@
 import { spawn, spawnSync, type ChildProcess } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
-import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
 import { packTarballs, snapshotRepository, userEnv } from '../helpers/pack.js';
 import { README_REPOSITORY, readmeBlocks } from '../helpers/readme.js';
-import { launchChromium, measurePixels, MODELS_DIR, ROOT, skipReason } from './harness.js';
+import { freePort, launchChromium, measurePixels, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -93,17 +92,6 @@ const GCS_SKIN_LINE = /gcs-skin|GcsCharacter|\bgcs\b|\bcharacter\.(update|rebuil
 
 function versionOf(pkg: string): string {
   return JSON.parse(readFileSync(join(ROOT, 'node_modules', pkg, 'package.json'), 'utf8')).version;
-}
-
-async function freePort(): Promise<number> {
-  return new Promise((resolvePort, reject) => {
-    const srv = createServer();
-    srv.once('error', reject);
-    srv.listen(0, '127.0.0.1', () => {
-      const { port } = srv.address() as { port: number };
-      srv.close(() => resolvePort(port));
-    });
-  });
 }
 
 let dir = '';

@@ -17,7 +17,8 @@ export function skipReason(): string | null {
   return existsSync(CHROMIUM) ? null : `browser tests skipped: no Chromium at ${CHROMIUM} (apt-get install chromium, or set CHROMIUM=/path)`;
 }
 
-async function freePort(): Promise<number> {
+/** A TCP port free on 127.0.0.1 now. */
+export async function freePort(): Promise<number> {
   return new Promise((resolvePort, reject) => {
     const srv = createNetServer();
     srv.once('error', reject);
@@ -145,6 +146,21 @@ export async function openFixture(folder: string, hook: string): Promise<Fixture
   await page.goto(server.resolvedUrls!.local[0]);
   await page.waitForFunction((h) => (window as unknown as Record<string, unknown>)[h] !== undefined, hook, { timeout: 120000 });
   return { page, errors, close: async () => { await context.close(); await server.close(); } };
+}
+
+/** A fixture's page for a test file's tests: opened (openFixture) in beforeAll unless `skip`, closed in afterAll. */
+export function fixtureForTests(folder: string, hook: string, skip: boolean): { page: Page; errors: string[] } {
+  const shared = { errors: [] as string[] } as { page: Page; errors: string[] };
+  let fixture: FixturePage | null = null;
+  beforeAll(async () => {
+    if (skip) return;
+    fixture = await openFixture(folder, hook);
+    ({ page: shared.page, errors: shared.errors } = fixture);
+  });
+  afterAll(async () => {
+    await fixture?.close();
+  });
+  return shared;
 }
 
 export interface Rect { x: number; y: number; width: number; height: number }
