@@ -9,7 +9,7 @@ import { createHuman } from '../dist/human/index.js';
 import { rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { errorInfo, median, timeFrames, timeInterleaved } from '../dist/measure.js';
 import { JsGcs } from './bench/js-gcs.mjs';
-import { machine, markdownTable, ms, parseArgs, table } from './bench/common.mjs';
+import { argsOrExit, machine, markdownTable, ms, table } from './bench/common.mjs';
 import { crowdBench } from './bench/crowd.mjs';
 import { loadRealRigs, realRigBench, realRigRows, RATIO_GOAL } from './bench/real-rigs.mjs';
 import { firstPicture, sliderRebuild } from './bench/builds.mjs';
@@ -20,24 +20,16 @@ const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
   if (!Number.isInteger(n) || n < 2000 || n > 2000000) throw new Error(`--sizes: '${x}' is not a vertex count from 2000 to 2000000`);
   return n;
 }));
-let args;
-try {
-  args = parseArgs(process.argv.slice(2), {
-    json: { type: 'flag', default: false },
-    markdown: { type: 'flag', default: false },
-    quick: { type: 'flag', default: false },
-    sizes: { parse: sizesArg, default: null },
-    sections: { parse: (s) => Number(s), default: 6 },
-    crowdOnly: { type: 'flag', default: false },
-    noCrowd: { type: 'flag', default: false },
-    save: { type: 'flag', default: false },
-  });
-} catch (e) {
-  console.error(`bench: ${e.message}`);
-  process.exit(2);
-}
-if (args.help) {
-  console.log(`usage: npm run bench -- [--sizes 10k,100k,1m|none] [--quick] [--json] [--markdown] [--sections N]
+const args = argsOrExit('bench', {
+  json: { type: 'flag', default: false },
+  markdown: { type: 'flag', default: false },
+  quick: { type: 'flag', default: false },
+  sizes: { parse: sizesArg, default: null },
+  sections: { parse: (s) => Number(s), default: 6 },
+  crowdOnly: { type: 'flag', default: false },
+  noCrowd: { type: 'flag', default: false },
+  save: { type: 'flag', default: false },
+}, `usage: npm run bench -- [--sizes 10k,100k,1m|none] [--quick] [--json] [--markdown] [--sections N]
   --sizes     vertex counts of the scaling table (default 10k,100k,1m; --quick: 10k)
   --quick     shorter timing, small sizes only
   --json      machine-readable results on stdout
@@ -45,8 +37,6 @@ if (args.help) {
   --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)
   --no-crowd  everything but the crowd bench
   --save      write the figures the README quotes to docs/figures.json (tests/readme-figures.test.ts checks them)`);
-  process.exit(0);
-}
 const quick = args.quick;
 const sizes = args.sizes ?? (quick ? [10000] : [10000, 100000, 1000000]);
 const sections = args.sections;

@@ -17,20 +17,11 @@ import { rigInputFromSkinnedMesh } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { characterHeight, loadGltfFile, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import { classicAtBudget, classicBandQuality, classicFigures, classicOffSurface, identitySkin, meshBorder, rigidRebind } from '../dist/measure.js';
-import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
+import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';
 
-let args;
-try {
-  args = parseArgs(process.argv.slice(2), { markdown: { type: 'flag', default: false }, noModels: { type: 'flag', default: false } });
-} catch (e) {
-  console.error(`classic: ${e.message}`);
-  process.exit(2);
-}
-if (args.help) {
-  console.log('usage: npm run classic -- [--markdown] [--no-models]');
-  process.exit(0);
-}
+const args = argsOrExit('classic', { markdown: { type: 'flag', default: false }, noModels: { type: 'flag', default: false } },
+  'usage: npm run classic -- [--markdown] [--no-models]');
 const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../shared/models');
 const gcs = await initGcsSkin();
 

@@ -1,5 +1,5 @@
 // The built demo served by `vite preview` and a headless Chromium (SwiftShader) to photograph it:
-// what scripts/screenshot-demo.mjs and scripts/screenshot-classic.mjs share.
+// what scripts/screenshot-demo.mjs, screenshot-classic.mjs and screenshot-joints.mjs share.
 import { existsSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
@@ -40,4 +40,32 @@ export async function openDemo(tool, width, height) {
       rmSync(dist, { recursive: true, force: true });
     },
   };
+}
+
+/** The value after `name` on the command line, or `fallback`. */
+export function option(name, fallback) {
+  const i = process.argv.indexOf(name);
+  return i > 0 ? process.argv[i + 1] : fallback;
+}
+
+/** Collects `page`'s errors; the function returned throws, naming `what`, once there are any. */
+export function watchErrors(page) {
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  return (what) => {
+    if (errors.length) throw new Error(`${what}: page errors: ${errors.join('; ')}`);
+  };
+}
+
+/**
+ * Opens the demo at `address` in `page` and waits for its first build (with `idle`, until its builds
+ * have settled too); throws, naming `what`, when the page shows a message.
+ */
+export async function loadDemo(page, address, what, { idle = false } = {}) {
+  await page.goto(address);
+  await page.waitForFunction(() => window.__demo !== undefined);
+  await page.evaluate(() => window.__demo.ready);
+  if (idle) await page.evaluate(() => window.__demo.idle());
+  const message = await page.evaluate(() => window.__demo.error());
+  if (message) throw new Error(`${what}: the page says: ${message}`);
 }

@@ -25,36 +25,26 @@ import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/c
 import {
   FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, restOfOutput,
 } from '../dist/measure.js';
-import { markdownTable, num, parseArgs, table } from './bench/common.mjs';
+import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
 import {
   bindCentres, dominantJoints, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
   rotateBoneWorld, signedVolume, worldPos,
 } from './bench/fidelity.mjs';
 
-let args;
-try {
-  const positive = (s, flag) => {
-    const n = Number(s);
-    if (!Number.isInteger(n) || n < 1) throw new Error(`${flag} must be a whole number ≥ 1; got '${s}'`);
-    return n;
-  };
-  args = parseArgs(process.argv.slice(2), {
-    json: { type: 'flag', default: false },
-    markdown: { type: 'flag', default: false },
-    jointsMarkdown: { type: 'flag', default: false },
-    noModels: { type: 'flag', default: false },
-    vertices: { parse: positive, default: undefined },
-    sections: { parse: positive, default: 6 },
-    frames: { parse: positive, default: 60 },
-  });
-} catch (e) {
-  console.error(`metrics: ${e.message}`);
-  process.exit(2);
-}
-if (args.help) {
-  console.log('usage: npm run metrics -- [--json] [--markdown] [--joints-markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
-  process.exit(0);
-}
+const positive = (s, flag) => {
+  const n = Number(s);
+  if (!Number.isInteger(n) || n < 1) throw new Error(`${flag} must be a whole number ≥ 1; got '${s}'`);
+  return n;
+};
+const args = argsOrExit('metrics', {
+  json: { type: 'flag', default: false },
+  markdown: { type: 'flag', default: false },
+  jointsMarkdown: { type: 'flag', default: false },
+  noModels: { type: 'flag', default: false },
+  vertices: { parse: positive, default: undefined },
+  sections: { parse: positive, default: 6 },
+  frames: { parse: positive, default: 60 },
+}, 'usage: npm run metrics -- [--json] [--markdown] [--joints-markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
 // Progress on stderr whenever stdout carries a document (JSON or the markdown table).
 const log = args.json || args.markdown || args.jointsMarkdown ? (...a) => console.error(...a) : (...a) => console.log(...a);
 const { sections, frames: framesPerClip } = args;

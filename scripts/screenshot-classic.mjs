@@ -12,20 +12,15 @@
 // web/lib/gcs-skin.wasm: the classic model before issue 21.)
 import { mkdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
-import { openDemo, root } from './demo-browser.mjs';
+import { loadDemo, openDemo, option, root, watchErrors } from './demo-browser.mjs';
 
-const arg = (name, fallback) => {
-  const i = process.argv.indexOf(name);
-  return i > 0 ? process.argv[i + 1] : fallback;
-};
-const outDir = resolve(arg('--out', join(root, 'docs')));
-const suffix = arg('--suffix', '');
+const outDir = resolve(option('--out', join(root, 'docs')));
+const suffix = option('--suffix', '');
 const { url, context, close } = await openDemo('screenshot-classic', 1200, 700);
 mkdirSync(outDir, { recursive: true });
 try {
   const page = await context.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(e.message));
+  const checkErrors = watchErrors(page);
   const shots = [
     { query: '?model=cesiumman&colour=1&paused=1', file: `classic-hips${suffix}.png`, eye: [0.75, 1.05, 1.25], target: [0, 0.78, 0] },
     { query: '?model=cesiumman&colour=1&paused=1', file: `classic-arm${suffix}.png`, eye: [1.5, 1.2, 0.9], target: [0.15, 0.95, 0] },
@@ -34,18 +29,13 @@ try {
   let loaded = '';
   for (const shot of shots) {
     if (shot.query !== loaded) {
-      await page.goto(`${url}${shot.query}`);
-      await page.waitForFunction(() => window.__demo !== undefined);
-      await page.evaluate(() => window.__demo.ready);
-      await page.evaluate(() => window.__demo.idle());
-      const message = await page.evaluate(() => window.__demo.error());
-      if (message) throw new Error(`the page says: ${message}`);
+      await loadDemo(page, `${url}${shot.query}`, shot.query, { idle: true });
       await page.evaluate(() => window.__demo.pause(0.9));
       loaded = shot.query;
     }
     await page.evaluate(([eye, target]) => window.__demo.lookAt(eye, target), [shot.eye, shot.target]);
     await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
-    if (errors.length) throw new Error(`page errors: ${errors.join('; ')}`);
+    checkErrors(shot.file);
     await page.screenshot({ path: join(outDir, shot.file) });
     console.log('wrote', join(outDir, shot.file));
   }

@@ -13,12 +13,10 @@
 // A page that shows a message (e.g. the wasm failed to load) or throws is an error: no picture.
 import { mkdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
-import { openDemo, root } from './demo-browser.mjs';
+import { loadDemo, openDemo, option, root, watchErrors } from './demo-browser.mjs';
 
-const outIndex = process.argv.indexOf('--out');
-const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
-const onlyIndex = process.argv.indexOf('--only');
-const only = onlyIndex > 0 ? process.argv[onlyIndex + 1] : null;
+const outDir = resolve(option('--out', join(root, 'docs')));
+const only = option('--only', null);
 const { url, context, close } = await openDemo('screenshot-demo', 1440, 800);
 mkdirSync(outDir, { recursive: true });
 try {
@@ -33,19 +31,13 @@ try {
   if (!shots.length) throw new Error(`--only ${only}: no such shot`);
   for (const shot of shots) {
     const page = await context.newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(url + shot.query);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
-    await page.evaluate(() => window.__demo.idle());
-    const message = await page.evaluate(() => window.__demo.error());
-    if (message) throw new Error(`${shot.file}: the page says: ${message}`);
+    const checkErrors = watchErrors(page);
+    await loadDemo(page, url + shot.query, shot.file, { idle: true });
     if (shot.crowd) {
       // Crowd mode: let every character take a few steps, then hold the pose; the readout refreshes every 10 frames.
       await page.waitForFunction(() => window.__crowd.frame() > 12, null, { timeout: 600000 });
       await page.evaluate(() => window.__crowd.pause());
-      if (errors.length) throw new Error(`${shot.file}: page errors: ${errors.join('; ')}`);
+      checkErrors(shot.file);
       await page.screenshot({ path: join(outDir, shot.file), timeout: 600000 }); // software rendering of the whole crowd
       console.log('wrote', join(outDir, shot.file));
       await page.close();
@@ -55,7 +47,7 @@ try {
     await page.waitForFunction(() => window.__demo.time() > 0.9, null, { timeout: 60000 });
     await page.evaluate(() => window.__demo.pause(0.32));
     await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
-    if (errors.length) throw new Error(`${shot.file}: page errors: ${errors.join('; ')}`);
+    checkErrors(shot.file);
     await page.screenshot({ path: join(outDir, shot.file) });
     console.log('wrote', join(outDir, shot.file));
     await page.close();

@@ -11,10 +11,9 @@
 // A page that shows a message or throws is an error: no picture.
 import { mkdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
-import { openDemo, root } from './demo-browser.mjs';
+import { loadDemo, openDemo, option, root, watchErrors } from './demo-browser.mjs';
 
-const outIndex = process.argv.indexOf('--out');
-const outDir = outIndex > 0 ? resolve(process.argv[outIndex + 1]) : join(root, 'docs');
+const outDir = resolve(option('--out', join(root, 'docs')));
 const shots = [
   { file: 'joints-elbow.png', query: '?joint=left%20elbow&bend=135' },
   { file: 'joints-elbow-centres.png', query: '?joint=left%20elbow&bend=135&centres=1' },
@@ -27,14 +26,9 @@ mkdirSync(outDir, { recursive: true });
 try {
   for (const shot of shots) {
     const page = await context.newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(url + shot.query);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
-    const message = await page.evaluate(() => window.__demo.error());
-    if (message) throw new Error(`${shot.file}: the page says: ${message}`);
-    if (errors.length) throw new Error(`${shot.file}: page errors: ${errors.join('; ')}`);
+    const checkErrors = watchErrors(page);
+    await loadDemo(page, url + shot.query, shot.file);
+    checkErrors(shot.file);
     const views = await page.evaluate(() => window.__demo.joint.views());
     const last = views[views.length - 1];
     await page.screenshot({ path: join(outDir, shot.file), clip: { x: 0, y: 0, width: last.x + last.width, height: HEIGHT } });

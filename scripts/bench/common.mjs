@@ -1,4 +1,4 @@
-// Helpers shared by scripts/bench.mjs and scripts/metrics.mjs: argument parsing, tables, machine info.
+// Helpers shared by scripts/bench.mjs, metrics.mjs and classic.mjs: argument parsing, tables, machine info.
 import { execFileSync } from 'node:child_process';
 import os from 'node:os';
 
@@ -22,6 +22,25 @@ export function parseArgs(argv, spec) {
     out[key] = s.parse ? s.parse(value, a) : value;
   }
   return out;
+}
+
+/**
+ * This process's arguments by `spec` (parseArgs) for the command-line tool `tool`: a bad one is
+ * named on stderr and exits 2; -h / --help prints `usage` and exits 0.
+ */
+export function argsOrExit(tool, spec, usage) {
+  let args;
+  try {
+    args = parseArgs(process.argv.slice(2), spec);
+  } catch (e) {
+    console.error(`${tool}: ${e.message}`);
+    process.exit(2);
+  }
+  if (args.help) {
+    console.log(usage);
+    process.exit(0);
+  }
+  return args;
 }
 
 /** A text table: first row is the header; numbers right-aligned. */

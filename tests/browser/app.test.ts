@@ -27,14 +27,13 @@
 import { spawn, spawnSync, type ChildProcess } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
-import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
 import { packTarballs, snapshotRepository, userEnv } from '../helpers/pack.js';
 import { README_REPOSITORY, readmeBlocks } from '../helpers/readme.js';
-import { launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
+import { freePort, launchChromium, measurePixels, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -93,17 +92,6 @@ const GCS_SKIN_LINE = /gcs-skin|GcsCharacter|\bgcs\b|\bcharacter\.(update|rebuil
 
 function versionOf(pkg: string): string {
   return JSON.parse(readFileSync(join(ROOT, 'node_modules', pkg, 'package.json'), 'utf8')).version;
-}
-
-async function freePort(): Promise<number> {
-  return new Promise((resolvePort, reject) => {
-    const srv = createServer();
-    srv.once('error', reject);
-    srv.listen(0, '127.0.0.1', () => {
-      const { port } = srv.address() as { port: number };
-      srv.close(() => resolvePort(port));
-    });
-  });
 }
 
 let dir = '';
@@ -442,21 +430,12 @@ async function shot(page: Page, what: { ground: boolean; character: boolean }): 
 }
 
 /**
- * Pixel measures, run in a blank page of the same browser (PNG decoding without npm packages).
+ * Pixel measures, run in a blank page of the same browser (decoded by the harness's measurePixels).
  * Silhouettes come from pictures without the ground: a pixel is the character's when it differs
  * from the background (the top-left pixel) by more than 40 in some channel.
  */
 async function measure(page: Page, kind: 'diff' | 'anydiff' | 'maxdiff' | 'iou' | 'shadow' | 'area', images: string[]): Promise<number> {
-  return page.evaluate(async ({ kind, images, threshold }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (ch) => ch.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
-    };
-    const imgs = await Promise.all(images.map(decode));
+  return measurePixels(page, images, (imgs, { kind, threshold }) => {
     const n = imgs[0].width * imgs[0].height;
     const mask = (img: ImageData) => {
       const d = img.data, out = new Uint8Array(n);
@@ -497,7 +476,7 @@ async function measure(page: Page, kind: 'diff' | 'anydiff' | 'maxdiff' | 'iou' 
       if (!m[i] && lum(empty.data, i) - lum(full.data, i) > 20) dark++;
     }
     return area ? dark / area : 0;
-  }, { kind, images, threshold: DIFF_THRESHOLD });
+  }, { kind, threshold: DIFF_THRESHOLD });
 }
 const diff = (p: Page, a: string, b: string) => measure(p, 'diff', [a, b]);
 /** For the record: share of pixels that differ at all, and the largest channel difference. */

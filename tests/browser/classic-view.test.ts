@@ -5,17 +5,12 @@
 // - the classic view against the GCS view on a real character (Cesium Man, paused): the two
 //   silhouettes nearly coincide (a flap, a cut or a part standing off the skin shows as pixels of
 //   one and not the other), and the classic view is textured like the GCS view.
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { BrowserContext, Page } from 'playwright-core';
-import { launchChromium, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { describe, expect, test } from 'vitest';
+import type { Page } from 'playwright-core';
+import { demoInChromium, frames, measurePixels, skipReason, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
-
-async function frames(page: Page, n: number): Promise<void> {
-  const f = await page.evaluate(() => window.__demo.frame());
-  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
-}
 
 interface ViewFigures {
   /** Character pixels (differing from the empty scene) inside the view. */
@@ -44,16 +39,7 @@ async function measureViews(page: Page): Promise<{ views: ViewFigures[]; overlap
   await page.evaluate(() => window.__demo.hideCharacter(false));
   await page.evaluate(() => document.querySelectorAll('style').forEach((s) => { if (s.textContent?.includes('visibility: hidden !important')) s.remove(); }));
   await frames(page, 2);
-  return page.evaluate(async ({ shot, empty, boxes }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
-    };
-    const a = await decode(shot), b = await decode(empty);
+  return measurePixels(page, [shot, empty], ([a, b], boxes) => {
     const W = a.width, H = a.height;
     type Box = { left: number; right: number; top: number; bottom: number };
     const inside = (list: Box[]) => (x: number, y: number) => list.some((r) => x >= r.left && x < r.right && y >= r.top && y < r.bottom);
@@ -95,26 +81,14 @@ async function measureViews(page: Page): Promise<{ views: ViewFigures[]; overlap
         }
       }
     return { views, overlap: { xor, union, colour: colour / Math.max(1, both) }, height: H };
-  }, { shot, empty, boxes });
+  }, boxes);
 }
 
 describe.skipIf(!!reason)('the demo\'s views measured on screenshots (headless Chromium)', () => {
-  let server: DemoServer;
-  let context: BrowserContext;
-
-  beforeAll(async () => {
-    [server, context] = await Promise.all([startDemo(), launchChromium()]);
-  });
-  afterAll(async () => {
-    await context?.close();
-    await server?.close();
-  });
+  const demo = demoInChromium();
 
   async function open(query: string): Promise<Page> {
-    const page = await context.newPage();
-    await page.goto(`${server.url}?${query}`);
-    await page.waitForFunction(() => window.__demo !== undefined);
-    await page.evaluate(() => window.__demo.ready);
+    const { page } = await demo.open(`?${query}`);
     await page.evaluate(() => window.__demo.idle());
     expect(await page.evaluate(() => window.__demo.error())).toBe('');
     return page;

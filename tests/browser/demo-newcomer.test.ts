@@ -4,9 +4,9 @@
 //   figure stays put (a smoothed average showed start-up figures for many seconds);
 // - ?paused=1 opens on the clip's first frame, not the rest pose.
 // (The note beside the criterion menu under the paper's criteria: demo.test.ts, with the criteria.)
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { BrowserContext, Page } from 'playwright-core';
-import { analyse, launchChromium, openDemoPage, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { describe, expect, test } from 'vitest';
+import type { Page } from 'playwright-core';
+import { analyse, demoInChromium, frames, skipReason, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -14,25 +14,11 @@ if (reason) console.log(reason);
 interface GcsReadout { ms: number; warmingUp: boolean }
 const gcsReadout = (page: Page) => page.evaluate(() => (window.__demo.readouts() as { gcs: GcsReadout }).gcs);
 
-async function frames(page: Page, n: number): Promise<void> {
-  const f = await page.evaluate(() => window.__demo.frame());
-  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
-}
-
 describe.skipIf(!!reason)('the demo as a newcomer meets it (headless Chromium)', () => {
-  let server: DemoServer;
-  let context: BrowserContext;
-
-  beforeAll(async () => {
-    [server, context] = await Promise.all([startDemo(), launchChromium()]);
-  });
-  afterAll(async () => {
-    await context?.close();
-    await server?.close();
-  });
+  const demo = demoInChromium();
 
   async function open(query: string): Promise<{ page: Page; errors: string[] }> {
-    const { page, errors } = await openDemoPage(context, server, query);
+    const { page, errors } = await demo.open(query);
     expect(await page.evaluate(() => window.__demo.error())).toBe('');
     return { page, errors };
   }

@@ -10,7 +10,7 @@ import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
-import { analyse, existsSync, launchChromium, MODELS_DIR, ROOT, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
+import { analyse, existsSync, frames, launchChromium, MODELS_DIR, ROOT, skipReason, startDemo, type DemoServer, type Rect } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -19,11 +19,6 @@ if (reason) console.log(reason);
 async function viewRegions(page: Page): Promise<Rect[]> {
   const { views, height } = await page.evaluate(() => ({ views: window.__demo.views(), height: window.innerHeight }));
   return views.map((v) => ({ x: v.x + 8, y: 140, width: v.width - 16, height: height - 140 - 80 }));
-}
-
-async function frames(page: Page, n: number): Promise<void> {
-  const f = await page.evaluate(() => window.__demo.frame());
-  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
 }
 
 /** Clicks a lil-gui checkbox by its label. */

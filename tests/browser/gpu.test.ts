@@ -11,9 +11,8 @@
 // table at 8 joints per section, and a crowd (each instance's shader output and its picture).
 import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { Page } from 'playwright-core';
-import { MODELS_DIR, openFixture, ROOT, skipReason, type FixturePage } from './harness.js';
+import { beforeAll, describe, expect, test } from 'vitest';
+import { fixtureForTests, MODELS_DIR, ROOT, skipReason } from './harness.js';
 import { eightInfluenceGlb } from '../helpers/influences-glb.js';
 
 const reason = skipReason();
@@ -32,19 +31,7 @@ const JOINT_NORMAL_TOLERANCE = 1e-5;
 /** Pictures: the share of pixels that may differ (edge pixels flipped by float rounding). */
 const PIXEL_TOLERANCE = 0.002;
 
-let fixture: FixturePage | null = null;
-let page: Page | null = null;
-let errors: string[] = [];
-
-beforeAll(async () => {
-  if (reason) return;
-  fixture = await openFixture('gpu-fixture', '__gpu');
-  ({ page, errors } = fixture);
-});
-
-afterAll(async () => {
-  await fixture?.close();
-});
+const fixture = fixtureForTests('gpu-fixture', '__gpu', !!reason);
 
 interface Result {
   skins: number; backends: string[]; paths: string[]; anisotropy: number; notes: string[]; height: number; positionError: number; normalError: number; normalErrorRaw: number;
@@ -55,7 +42,7 @@ interface Result {
 type Path = 'joints' | 'sections';
 
 async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path, boneScale?: number[], centres = false): Promise<Result> {
-  return page!.evaluate(([m, s, t, c, p, b, k]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
+  return fixture.page.evaluate(([m, s, t, c, p, b, k]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
     .__gpu.check(m as string, { smooth: s, centres: k }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale, centres] as const);
 }
 
@@ -72,7 +59,7 @@ function expectEqual(r: Result, label: string, path: Path): void {
   expect(r.coverage).toBeGreaterThan(0.02);
   expect(r.pixelMotion).toBeGreaterThan(0.005); // the GPU picture follows the animation
   for (const d of r.pixelDiff) expect(d).toBeLessThan(PIXEL_TOLERANCE);
-  expect(errors).toEqual([]);
+  expect(fixture.errors).toEqual([]);
 }
 
 const SHARED = [
@@ -154,7 +141,7 @@ describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (Ces
 
   for (const gpuPath of ['joints', 'sections'] as const) {
     test(`a crowd of 3 (${gpuPath} path): each instance's shader output = the CPU on its own pose; instance 0 drawn = the CPU backend's picture`, async () => {
-      const r = await page!.evaluate(([f, p]) => (window as unknown as { __gpu: { crowd(a: string, b: number[], c?: string, d?: string): Promise<{ path: string; tableSlots: number; instances: number; positionError: number; pixelDiff: number; coverage: number }> } })
+      const r = await fixture.page.evaluate(([f, p]) => (window as unknown as { __gpu: { crowd(a: string, b: number[], c?: string, d?: string): Promise<{ path: string; tableSlots: number; instances: number; positionError: number; pixelDiff: number; coverage: number }> } })
         .__gpu.crowd(f, [0.3, 0.9, 1.6], undefined, p), [`/@fs${file}`, gpuPath] as const);
       console.log(`crowd of ${r.instances}, ${r.path} path (table ${r.tableSlots} joints per section): GPU − CPU ≤ ${r.positionError.toExponential(2)} of the height; ` +
         `instance 0 vs the CPU picture ${(100 * r.pixelDiff).toFixed(3)} % of pixels (character covers ${(100 * r.coverage).toFixed(1)} %)`);
@@ -163,7 +150,7 @@ describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (Ces
       expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
       expect(r.coverage).toBeGreaterThan(0.02);
       expect(r.pixelDiff).toBeLessThan(PIXEL_TOLERANCE);
-      expect(errors).toEqual([]);
+      expect(fixture.errors).toEqual([]);
     });
   }
 });

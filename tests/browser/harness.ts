@@ -6,6 +6,7 @@ import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import type { BrowserContext, Page } from 'playwright-core';
 import type { ViteDevServer } from 'vite';
+import { afterAll, beforeAll } from 'vitest';
 
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
 export const MODELS_DIR = resolve(ROOT, '../shared/models');
@@ -16,7 +17,8 @@ export function skipReason(): string | null {
   return existsSync(CHROMIUM) ? null : `browser tests skipped: no Chromium at ${CHROMIUM} (apt-get install chromium, or set CHROMIUM=/path)`;
 }
 
-async function freePort(): Promise<number> {
+/** A TCP port free on 127.0.0.1 now. */
+export async function freePort(): Promise<number> {
   return new Promise((resolvePort, reject) => {
     const srv = createNetServer();
     srv.once('error', reject);
@@ -91,6 +93,33 @@ export async function openDemoPage(context: BrowserContext, server: DemoServer, 
   return { page, errors };
 }
 
+/** The served demo and a headless Chromium for a describe block's tests: started before them, closed after. */
+export interface DemoInChromium {
+  server: DemoServer;
+  context: BrowserContext;
+  /** openDemoPage on this server and browser. */
+  open(query: string, options?: { dialogs?: boolean }): Promise<{ page: Page; errors: string[] }>;
+}
+
+/** Call in a describe block: the demo and Chromium start in its beforeAll and close in its afterAll. */
+export function demoInChromium(): DemoInChromium {
+  const demo = { open: (query, options) => openDemoPage(demo.context, demo.server, query, options) } as DemoInChromium;
+  beforeAll(async () => {
+    [demo.server, demo.context] = await Promise.all([startDemo(), launchChromium()]);
+  });
+  afterAll(async () => {
+    await demo.context?.close();
+    await demo.server?.close();
+  });
+  return demo;
+}
+
+/** Waits until the demo has drawn `n` more frames. */
+export async function frames(page: Page, n: number): Promise<void> {
+  const f = await page.evaluate(() => window.__demo.frame());
+  await page.waitForFunction((target) => window.__demo.frame() >= target, f + n, { timeout: 60000 });
+}
+
 /** A fixture page (tests/browser/<folder>/index.html) served by Vite's dev server and open in Chromium. */
 export interface FixturePage {
   page: Page;
@@ -119,6 +148,21 @@ export async function openFixture(folder: string, hook: string): Promise<Fixture
   return { page, errors, close: async () => { await context.close(); await server.close(); } };
 }
 
+/** A fixture's page for a test file's tests: opened (openFixture) in beforeAll unless `skip`, closed in afterAll. */
+export function fixtureForTests(folder: string, hook: string, skip: boolean): { page: Page; errors: string[] } {
+  const shared = { errors: [] as string[] } as { page: Page; errors: string[] };
+  let fixture: FixturePage | null = null;
+  beforeAll(async () => {
+    if (skip) return;
+    fixture = await openFixture(folder, hook);
+    ({ page: shared.page, errors: shared.errors } = fixture);
+  });
+  afterAll(async () => {
+    await fixture?.close();
+  });
+  return shared;
+}
+
 export interface Rect { x: number; y: number; width: number; height: number }
 export interface RegionStats {
   /** distinct colours, quantised to 5 bits a channel */
@@ -129,38 +173,43 @@ export interface RegionStats {
   changed: number;
 }
 
+/** A PNG (base64) decoded inside the page: createImageBitmap + OffscreenCanvas, no npm PNG package. */
+async function decodePng(b64: string): Promise<ImageData> {
+  const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+  const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
+  const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+  const ctx = canvas.getContext('2d')!;
+  ctx.drawImage(bitmap, 0, 0);
+  return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
+}
+
 /**
- * Decodes PNG screenshots inside the page (createImageBitmap + OffscreenCanvas, no npm PNG
- * package) and measures regions of them.
+ * Runs `measure` inside the page on the PNGs (base64) decoded there: the one decoder of every
+ * browser test's pixel measures. Like page.evaluate's function, `measure` sees only its arguments.
  */
+export function measurePixels<A, R>(page: Page, pngs: string[], measure: (images: ImageData[], arg: A) => R | Promise<R>, arg: A): Promise<R> {
+  // An expression (page.evaluate calls no function given as a string), its input written into it as JSON.
+  return page.evaluate<R>(`(async ({ pngs, arg }) => (${measure})(await Promise.all(pngs.map(${decodePng})), arg))(${JSON.stringify({ pngs, arg })})`);
+}
+
+/** Measures regions of a PNG screenshot (and, with `before`, what changed from that one). */
 export async function analyse(page: Page, png: Buffer, regions: Rect[], before?: Buffer): Promise<RegionStats[]> {
-  return page.evaluate(async ({ png, before, regions }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx.getImageData(0, 0, bitmap.width, bitmap.height);
-    };
-    const a = await decode(png);
-    const b = before ? await decode(before) : null;
-    return regions.map((r) => {
-      const colours = new Set<number>();
-      let skin = 0, changed = 0, total = 0;
-      for (let y = Math.max(0, r.y); y < Math.min(a.height, r.y + r.height); y++) {
-        for (let x = Math.max(0, r.x); x < Math.min(a.width, r.x + r.width); x++) {
-          const i = 4 * (y * a.width + x);
-          const R = a.data[i], G = a.data[i + 1], B = a.data[i + 2];
-          colours.add(((R >> 3) << 10) | ((G >> 3) << 5) | (B >> 3));
-          if (R > 110 && R - B > 40) skin++;
-          if (b && (Math.abs(R - b.data[i]) > 24 || Math.abs(G - b.data[i + 1]) > 24 || Math.abs(B - b.data[i + 2]) > 24)) changed++;
-          total++;
-        }
+  const pngs = before ? [png, before] : [png];
+  return measurePixels(page, pngs.map((p) => p.toString('base64')), ([a, b], regions) => regions.map((r) => {
+    const colours = new Set<number>();
+    let skin = 0, changed = 0, total = 0;
+    for (let y = Math.max(0, r.y); y < Math.min(a.height, r.y + r.height); y++) {
+      for (let x = Math.max(0, r.x); x < Math.min(a.width, r.x + r.width); x++) {
+        const i = 4 * (y * a.width + x);
+        const R = a.data[i], G = a.data[i + 1], B = a.data[i + 2];
+        colours.add(((R >> 3) << 10) | ((G >> 3) << 5) | (B >> 3));
+        if (R > 110 && R - B > 40) skin++;
+        if (b && (Math.abs(R - b.data[i]) > 24 || Math.abs(G - b.data[i + 1]) > 24 || Math.abs(B - b.data[i + 2]) > 24)) changed++;
+        total++;
       }
-      return { colours: colours.size, skin: skin / Math.max(1, total), changed: changed / Math.max(1, total) };
-    });
-  }, { png: png.toString('base64'), before: before?.toString('base64'), regions });
+    }
+    return { colours: colours.size, skin: skin / Math.max(1, total), changed: changed / Math.max(1, total) };
+  }), regions);
 }
 
 export { existsSync };

@@ -3,11 +3,11 @@
 // by side from one camera. Unbent, the three views are the same picture; bent, LBS's differs from
 // DQS's (its collapse at the inner side), and the readouts say so: LBS loses volume, DQS keeps it
 // and bulges more.
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import { describe, expect, test } from 'vitest';
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
-import type { BrowserContext, Page } from 'playwright-core';
-import { launchChromium, openDemoPage, ROOT, skipReason, startDemo, type DemoServer } from './harness.js';
+import type { Page } from 'playwright-core';
+import { demoInChromium, measurePixels, ROOT, skipReason } from './harness.js';
 
 const reason = skipReason();
 if (reason) console.log(reason);
@@ -18,13 +18,18 @@ interface JointHook {
   readouts(): Record<'gcs' | 'dqs' | 'lbs', Figures | null>; views(): { kind: string; x: number; width: number }[]; error(): string;
   centres(on: boolean): Promise<void>;
 }
+// The demo's hook has `joint` in ?joint mode: typed once here, so the calls below need no cast.
+declare module './harness.js' {
+  interface DemoHook { joint: JointHook }
+}
 const hook = (page: Page) => ({
-  joints: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.joints()),
-  choose: (label: string) => page.evaluate((l) => (window.__demo as unknown as { joint: JointHook }).joint.choose(l), label),
-  bend: (deg: number) => page.evaluate((d) => (window.__demo as unknown as { joint: JointHook }).joint.bend(d), deg),
-  readouts: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.readouts()),
-  views: () => page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.views()),
-  centres: (on: boolean) => page.evaluate((o) => (window.__demo as unknown as { joint: JointHook }).joint.centres(o), on),
+  joints: () => page.evaluate(() => window.__demo.joint.joints()),
+  joint: () => page.evaluate(() => window.__demo.joint.joint()),
+  choose: (label: string) => page.evaluate((l) => window.__demo.joint.choose(l), label),
+  bend: (deg: number) => page.evaluate((d) => window.__demo.joint.bend(d), deg),
+  readouts: () => page.evaluate(() => window.__demo.joint.readouts()),
+  views: () => page.evaluate(() => window.__demo.joint.views()),
+  centres: (on: boolean) => page.evaluate((o) => window.__demo.joint.centres(o), on),
 });
 
 /**
@@ -32,40 +37,27 @@ const hook = (page: Page) => ({
  * `b` of the same one (or of `other`), both cut to the narrower width.
  */
 async function viewDifference(page: Page, png: Buffer, a: { x: number; width: number }, b: { x: number; width: number }, other?: Buffer): Promise<number> {
-  return page.evaluate(async ({ png, other, a, b }) => {
-    const decode = async (b64: string) => {
-      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      const bitmap = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = canvas.getContext('2d')!;
-      ctx.drawImage(bitmap, 0, 0);
-      return ctx;
-    };
-    const first = await decode(png), second = other ? await decode(other) : first;
+  const pngs = other ? [png, other] : [png];
+  return measurePixels(page, pngs.map((p) => p.toString('base64')), ([first, second = first], { a, b }) => {
     // Between the labels and the readouts, clear of the dividers at the columns' edges: the picture itself.
-    const w = Math.min(a.width, b.width) - 6, h = first.canvas.height;
+    const w = Math.min(a.width, b.width) - 6, h = first.height;
     const top = Math.round(0.22 * h), bottom = Math.round(0.82 * h);
-    const A = first.getImageData(a.x + 3, top, w, bottom - top).data, B = second.getImageData(b.x + 3, top, w, bottom - top).data;
     let changed = 0;
-    for (let i = 0; i < A.length; i += 4)
-      if (Math.abs(A[i] - B[i]) > 24 || Math.abs(A[i + 1] - B[i + 1]) > 24 || Math.abs(A[i + 2] - B[i + 2]) > 24) changed++;
-    return changed / (A.length / 4);
-  }, { png: png.toString('base64'), other: other?.toString('base64'), a, b });
+    for (let y = top; y < bottom; y++)
+      for (let x = 0; x < w; x++) {
+        const i = 4 * (y * first.width + a.x + 3 + x), j = 4 * (y * second.width + b.x + 3 + x);
+        const A = first.data, B = second.data;
+        if (Math.abs(A[i] - B[j]) > 24 || Math.abs(A[i + 1] - B[j + 1]) > 24 || Math.abs(A[i + 2] - B[j + 2]) > 24) changed++;
+      }
+    return changed / (w * (bottom - top));
+  }, { a, b });
 }
 
 describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
-  let server: DemoServer;
-  let context: BrowserContext;
-  beforeAll(async () => {
-    [server, context] = await Promise.all([startDemo(), launchChromium()]);
-  });
-  afterAll(async () => {
-    await context?.close();
-    await server?.close();
-  });
+  const demo = demoInChromium();
 
   test('our human\'s left elbow: the same picture unbent; at 135° LBS differs from DQS, loses volume, and DQS bulges more', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?joint');
+    const { page, errors } = await demo.open('?joint');
     try {
       const j = hook(page);
       expect(await page.evaluate(() => window.__demo.error())).toBe('');
@@ -118,13 +110,13 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
   }, 300000);
 
   test('the comparison page\'s joint close-up button opens ?joint on the character on screen', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?model=cesiumman');
+    const { page, errors } = await demo.open('?model=cesiumman');
     try {
       await Promise.all([
         page.waitForURL(/[?&]joint(&|=|$)/),
         page.locator('.lil-gui .controller').filter({ has: page.locator('.name', { hasText: 'joint close-up (knees, elbows) ↗' }) }).locator('button').click(),
       ]);
-      await page.waitForFunction(() => (window as unknown as { __demo?: { ready: Promise<void> } }).__demo !== undefined);
+      await page.waitForFunction(() => window.__demo !== undefined);
       await page.evaluate(() => window.__demo.ready);
       expect(new URL(page.url()).searchParams.get('model')).toBe('cesiumman');
       expect(await hook(page).joints()).toEqual(['left knee', 'right knee', 'left elbow', 'right elbow']);
@@ -135,12 +127,12 @@ describe.skipIf(!!reason)('the joint close-up (headless Chromium)', () => {
   }, 300000);
 
   test('CesiumMan (no bone names): two knees and two elbows found, a knee bent to 135° measured in every view', async () => {
-    const { page, errors } = await openDemoPage(context, server, '?joint=right%20knee&model=cesiumman&bend=135');
+    const { page, errors } = await demo.open('?joint=right%20knee&model=cesiumman&bend=135');
     try {
       const j = hook(page);
       expect(await page.evaluate(() => window.__demo.error())).toBe('');
       expect(await j.joints()).toEqual(['left knee', 'right knee', 'left elbow', 'right elbow']);
-      expect(await page.evaluate(() => (window.__demo as unknown as { joint: JointHook }).joint.joint())).toBe('right knee');
+      expect(await j.joint()).toBe('right knee');
       const r = await j.readouts();
       expect(r.lbs!.volumeChange).toBeLessThan(r.dqs!.volumeChange - 5);
       expect(r.dqs!.bulgeP95).toBeGreaterThan(r.lbs!.bulgeP95);

@@ -10,9 +10,8 @@
 //   GPU backend and a TSL crowd = the CPU backend, and ≠ the same file read without its second set.
 import { existsSync, mkdirSync } from 'node:fs';
 import { join } from 'node:path';
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import type { Page } from 'playwright-core';
-import { MODELS_DIR, openFixture, ROOT, skipReason, type FixturePage } from './harness.js';
+import { beforeAll, describe, expect, test } from 'vitest';
+import { fixtureForTests, MODELS_DIR, ROOT, skipReason } from './harness.js';
 import { eightInfluenceGlb } from '../helpers/influences-glb.js';
 
 const reason = skipReason();
@@ -21,23 +20,11 @@ if (reason) console.log(reason);
 /** The issue's bound: at most 1 % of pixels differ by more than 8/255. */
 const PIXEL_SHARE = 0.01;
 
-let fixture: FixturePage | null = null;
-let page: Page | null = null;
-let errors: string[] = [];
-
-beforeAll(async () => {
-  if (reason) return;
-  fixture = await openFixture('webgpu-fixture', '__webgpu');
-  ({ page, errors } = fixture);
-});
-
-afterAll(async () => {
-  await fixture?.close();
-});
+const fixture = fixtureForTests('webgpu-fixture', '__webgpu', !!reason);
 
 // eslint-disable-next-line @typescript-eslint/no-explicit-any
 async function call<T>(fn: string, ...args: unknown[]): Promise<T> {
-  return page!.evaluate(([f, a]) => (window as unknown as Record<string, Record<string, (...x: unknown[]) => Promise<unknown>>>).__webgpu[f as string](...(a as unknown[])), [fn, args] as const) as Promise<T>;
+  return fixture.page.evaluate(([f, a]) => (window as unknown as Record<string, Record<string, (...x: unknown[]) => Promise<unknown>>>).__webgpu[f as string](...(a as unknown[])), [fn, args] as const) as Promise<T>;
 }
 
 interface Diff { image: number; covered: number }
@@ -66,7 +53,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
           expect(r.coverage).toBeGreaterThan(0.02);
           for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
           for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05); // the pose is applied, not the rest pose
-          expect(errors).toEqual([]);
+          expect(fixture.errors).toEqual([]);
         });
       }
     }
@@ -83,7 +70,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     expect(r.warnings).toEqual([]);
     for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
     for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
-    expect(errors).toEqual([]);
+    expect(fixture.errors).toEqual([]);
   });
 
   // Morph targets apply before GCS (three.js's order, the CPU's too): a swelling morph at 0.8 on the human.
@@ -94,7 +81,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
       expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
       for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
       for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
-      expect(errors).toEqual([]);
+      expect(fixture.errors).toEqual([]);
     });
   }
 
@@ -113,7 +100,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
           expect(r.backends).toEqual(['gpu', 'gpu']);
           expect(r.coverage).toBeGreaterThan(0.02);
           expect(r.diff.image).toBeLessThanOrEqual(PIXEL_SHARE);
-          expect(errors).toEqual([]);
+          expect(fixture.errors).toEqual([]);
         });
       }
     }
@@ -128,7 +115,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     expect(r.moving).toBeGreaterThan(0.01);
     expect(r.bytesPerFrame).toBeGreaterThanOrEqual(16 * r.jointCount * 64);
     expect(r.bytesPerFrame).toBeLessThan(16 * r.jointCount * 64 + 2048 * 16);
-    expect(errors).toEqual([]);
+    expect(fixture.errors).toEqual([]);
   });
 
   interface Fallback { before: string; after: string; note: string; warnings: string[]; vsCpu: Diff; firstVsCpu: Diff; firstCoverage: number; error: string }
@@ -232,7 +219,7 @@ describe.skipIf(!!reason || !!noCesium8)('8 influences per vertex on WebGPURende
         expect(r.vsCpu.covered).toBeLessThanOrEqual(CHARACTER_PIXEL_SHARE);
         expect(r.crowdVsCpu.covered).toBeLessThanOrEqual(CHARACTER_PIXEL_SHARE);
         expect(r.vsFour.covered).toBeGreaterThan(CHARACTER_PIXEL_SHARE); // the comparison sees the second set
-        expect(errors).toEqual([]);
+        expect(fixture.errors).toEqual([]);
       });
     }
   }
@@ -255,7 +242,7 @@ describe.skipIf(!!reason || !!noCesium8)('velocity on WebGPURenderer: a velocity
       expect(r.moving).toBeGreaterThan(0.2); // a walk, not a still picture
       expect(r.vsThree).toBeLessThanOrEqual(VELOCITY_SHARE);
       expect(r.pausedLargest).toBeLessThan(0.01);
-      expect(errors).toEqual([]);
+      expect(fixture.errors).toEqual([]);
     });
   }
 });
@@ -277,7 +264,7 @@ describe.skipIf(!!reason || !!noCesium8)('a normal-mapped character (CesiumMan w
       expect(r.mapShows.covered).toBeGreaterThan(0.1); // the lighting depends on the tangent frame
       expect(r.lbsVsThree.image).toBeLessThanOrEqual(PIXEL_SHARE);
       for (const d of r.gpuVsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
-      expect(errors).toEqual([]);
+      expect(fixture.errors).toEqual([]);
     });
   }
 });

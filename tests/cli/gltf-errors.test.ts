@@ -13,7 +13,7 @@ import { findCycle } from '../../web/lib/gltf/check-nodes.js';
 import { GcsError } from '../../web/lib/errors.js';
 import { initGcsSkin } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
-import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
+import { splitGlb, writeGlbVariant, type Json } from '../helpers/glb.js';
 
 let dir: string;
 let glb: Uint8Array;
@@ -21,12 +21,7 @@ let base: { json: Json; bin: Uint8Array };
 
 /** Writes the default human with its JSON and BIN changed by `edit`; returns the path. */
 function variant(name: string, edit: (json: Json, bin: DataView) => void): string {
-  const json = structuredClone(base.json);
-  const bin = base.bin.slice();
-  edit(json, new DataView(bin.buffer));
-  const file = join(dir, name);
-  writeFileSync(file, packGlb(json, bin));
-  return file;
+  return writeGlbVariant(join(dir, name), base, edit);
 }
 
 /** Byte offset in the BIN chunk of element `i` of accessor `a` (buffer view 0-based, one buffer). */

@@ -15,7 +15,7 @@ import { loadCharacter } from '../../packages/cli/src/gltf.js';
 import { GltfError } from '../../packages/cli/src/gltf-node.js';
 import { LIMITS } from '../../web/lib/gltf/limits.js';
 import { compressGlb } from '../helpers/compressed-gltf.js';
-import { packGlb, splitGlb, type Json } from '../helpers/glb.js';
+import { packGlb, splitGlb, writeGlbVariant, type Json } from '../helpers/glb.js';
 
 const ROOT = join(import.meta.dirname, '../..');
 const BIN = join(ROOT, 'bin/gcs-skin.mjs');
@@ -104,12 +104,7 @@ const SMALL_BUFFER = { byteLength: 4, uri: 'data:application/octet-stream;base64
 
 /** The default human as .glb with its JSON and BIN changed by `edit`. */
 function humanVariant(name: string, edit: (json: Json, bin: DataView) => void): string {
-  const json = structuredClone(human.json);
-  const bin = human.bin.slice();
-  edit(json, new DataView(bin.buffer));
-  const file = join(folder, name);
-  writeFileSync(file, packGlb(json, bin));
-  return file;
+  return writeGlbVariant(join(folder, name), human, edit);
 }
 
 beforeAll(async () => {
@@ -425,14 +420,8 @@ describe('compressed data that lies: refused before decoding, or by what the dec
     for (const a of Object.values(p.attributes) as number[]) json.accessors[a].count = vertices;
     if (indices !== undefined) json.accessors[p.indices].count = indices;
   };
-  const variant = (name: string, source: { json: Json; bin: Uint8Array }, edit: (json: Json, bin: DataView) => void) => {
-    const json = structuredClone(source.json);
-    const bin = source.bin.slice();
-    edit(json, new DataView(bin.buffer));
-    const file = join(folder, name);
-    writeFileSync(file, packGlb(json, bin));
-    return file;
-  };
+  const variant = (name: string, source: { json: Json; bin: Uint8Array }, edit: (json: Json, bin: DataView) => void) =>
+    writeGlbVariant(join(folder, name), source, edit);
 
   it('Draco whose header declares more than its accessors (3 vertices declared): BAD_DATA before the decoder runs', () => {
     expect(expectRefused(variant('draco-liar.glb', compressed.draco, declare(3, 3)), 'BAD_DATA')).toMatch(/declares [\d,]+ triangles where its indices declare 1/);

@@ -1,5 +1,6 @@
 // Splitting a GLB into its JSON and BIN chunk and packing them again, for tests that make bad
 // files from good ones (tests/cli/gltf-errors.test.ts, tests/cli/hostile.test.ts).
+import { writeFileSync } from 'node:fs';
 
 // eslint-disable-next-line @typescript-eslint/no-explicit-any
 export type Json = Record<string, any>;
@@ -29,4 +30,13 @@ export function packGlb(json: Json, bin: Uint8Array): Uint8Array {
   view.setUint32(24 + jsonBytes.length, 0x004e4942, true); // 'BIN\0'
   out.set(bin, 28 + jsonBytes.length);
   return out;
+}
+
+/** Writes `file`: `source`'s GLB with a copy of its JSON and BIN changed by `edit`; returns the path. */
+export function writeGlbVariant(file: string, source: { json: Json; bin: Uint8Array }, edit: (json: Json, bin: DataView) => void): string {
+  const json = structuredClone(source.json);
+  const bin = source.bin.slice();
+  edit(json, new DataView(bin.buffer));
+  writeFileSync(file, packGlb(json, bin));
+  return file;
 }

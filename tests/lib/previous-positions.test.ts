@@ -47,3 +47,22 @@ test('each deform keeps the last one as previousPositions, swapping two arrays (
   }
   rig.dispose();
 });
+
+test('off again after an odd number of deforms: positions read the array the core writes (not the one it freed)', () => {
+  const tube = makeTube({ band: 0.3 });
+  const rig = gcs.createRig(tube.input);
+  const axis = new THREE.Vector3(0, 0, 1);
+  const d = rig.buildGcs(), fresh = rig.buildGcs();
+  d.keepPreviousPositions(true);
+  for (const angle of [0.3, 0.6, 0.9]) d.deform(tubeSkin(rotationAbout(tube.joint, axis, angle))); // the arrays swapped three times
+  d.keepPreviousPositions(false);
+  for (const angle of [1.1, 0.4]) {
+    const skin = tubeSkin(rotationAbout(tube.joint, axis, angle));
+    d.deform(skin);
+    fresh.deform(skin);
+    expect(Array.from(d.positions)).toEqual(Array.from(fresh.positions));
+  }
+  d.dispose();
+  fresh.dispose();
+  rig.dispose();
+});

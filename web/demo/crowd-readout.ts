@@ -6,10 +6,16 @@ import { SteadyFigure } from './steady-figure.js';
 
 const fmtBytes = (b: number) => (b >= 1e6 ? `${(b / 1e6).toFixed(2)} MB` : b >= 1e3 ? `${(b / 1e3).toFixed(1)} KB` : `${b.toFixed(0)} B`);
 
+/** Frames whose samples are kept for the test hook. */
+const KEPT = 240;
+
 export class CrowdReadout {
   readonly element = document.createElement('div');
-  /** The last 240 frames' skinning ms and bytes uploaded. */
-  readonly samples: { ms: number; bytes: number }[] = [];
+  // The last KEPT frames' skinning ms and bytes uploaded, in two rings (nothing made per frame).
+  private readonly ms = new Float64Array(KEPT);
+  private readonly bytes = new Float64Array(KEPT);
+  private kept = 0;
+  private next = 0;
   private readonly steadyMs = new SteadyFigure();
   private readonly steadyBytes = new SteadyFigure();
   private due = true; // a rebuild shows its settings at once, its figures when steady
@@ -23,22 +29,41 @@ export class CrowdReadout {
 
   /** A rebuild: figures start over. */
   reset(): void {
-    this.samples.length = 0;
+    this.kept = 0;
+    this.next = 0;
     this.steadyMs.reset();
     this.steadyBytes.reset();
     this.due = true;
   }
 
   add(ms: number, bytes: number): void {
-    this.samples.push({ ms, bytes });
-    if (this.samples.length > 240) this.samples.shift();
+    this.ms[this.next] = ms;
+    this.bytes[this.next] = bytes;
+    this.next = (this.next + 1) % KEPT;
+    if (this.kept < KEPT) this.kept++;
     this.steadyMs.add(ms);
     this.steadyBytes.add(bytes);
   }
 
-  /** Rewrites the readout right after a rebuild, then every 10th frame. */
-  show(frame: number, head: string, count: number, note: string): void {
-    if (!this.due && frame % 10 !== 1) return;
+  /** The last `frames` frames' samples (all kept when fewer, or when `frames` is 0), oldest first. */
+  last(frames: number): { ms: number[]; bytes: number[] } {
+    const n = frames > 0 ? Math.min(frames, this.kept) : this.kept;
+    const ms: number[] = [], bytes: number[] = [];
+    for (let k = n; k > 0; k--) {
+      const i = (this.next - k + KEPT) % KEPT;
+      ms.push(this.ms[i]);
+      bytes.push(this.bytes[i]);
+    }
+    return { ms, bytes };
+  }
+
+  /** Whether show() is due at `frame`: right after a rebuild, then every 10th frame. */
+  shows(frame: number): boolean {
+    return this.due || frame % 10 === 1;
+  }
+
+  /** Rewrites the readout (when shows(frame) says so: the text is built only then). */
+  show(head: string, count: number, note: string): void {
     this.due = false;
     const perFrame = this.steadyMs.value(), uploaded = this.steadyBytes.value();
     let figures: string;

@@ -173,9 +173,9 @@ export async function startCrowd(): Promise<void> {
   });
 
   const measureLast = (frames: number): CrowdMeasure => {
-    const last = readout.samples.slice(-frames);
-    const ms = median(last.map((s) => s.ms)), bytes = median(last.map((s) => s.bytes));
-    return { renderer: rendererLabel(renderer), characters: count, backend, path: gpuCrowd?.sections.path ?? null, joints: rig.jointCount, frames: last.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
+    const last = readout.last(frames);
+    const ms = median(last.ms), bytes = median(last.bytes);
+    return { renderer: rendererLabel(renderer), characters: count, backend, path: gpuCrowd?.sections.path ?? null, joints: rig.jointCount, frames: last.ms.length, msPerFrame: ms, bytesPerFrame: bytes, msPerCharacter: ms / count, bytesPerCharacter: bytes / count,
       vertices: vertexCount, sections: gpuCrowd?.deformer.sectionCount ?? cpuCrowd?.deformers[0]?.sectionCount ?? 0 };
   };
 
@@ -197,9 +197,11 @@ export async function startCrowd(): Promise<void> {
         w.resolve(measureLast(w.frames));
       }
     }
-    const head = `<b>${count}</b> characters × ${vertexCount.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
-      `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}${params.smooth ? ' (smooth)' : ''}`;
-    readout.show(frame, head, count, note);
+    if (readout.shows(frame)) {
+      const head = `<b>${count}</b> characters × ${vertexCount.toLocaleString('en')} vertices · ${rendererLabel(renderer)} · <b>${backend.toUpperCase()}</b> backend` +
+        `${gpuCrowd ? ` (${PATH_NAMES[gpuCrowd.sections.path]})` : ''}${params.smooth ? ' (smooth)' : ''}`;
+      readout.show(head, count, note);
+    }
     stats.update();
   });
 

@@ -496,7 +496,9 @@ export class Deformer {
   keepPreviousPositions(keep: boolean): void {
     const h = this.live();
     if (!this.gcs.core.gcs_deformer_keep_previous_positions(h, keep ? 1 : 0)) this.gcs.raise('the previous positions could not be kept');
+    // Off after an odd number of swaps, the core keeps the other array: the single view follows it.
     this.positionsPtr = this.gcs.core.gcs_deformer_positions(h);
+    this.positionsView = this.gcs.viewF32(this.positionsPtr, this.vertexCount * 3);
     this.swapped = keep ? [this.positionsPtr, this.gcs.core.gcs_deformer_previous_positions(h)].map((ptr) => ({ ptr, view: this.gcs.viewF32(ptr, this.vertexCount * 3) })) : null;
   }
 

@@ -1,7 +1,7 @@
 // `gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb`
 import { closeSync, constants, fstatSync, ftruncateSync, openSync, writeSync } from 'node:fs';
 import { printable } from '../../../web/lib/gltf/shown-name.js';
-import { wholeNumber } from './args.js';
+import { walkArguments, wholeNumber } from './args.js';
 import { systemReason } from './read-file.js';
 import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from '../../../web/lib/human/index.js';
 
@@ -15,13 +15,8 @@ class UsageError extends Error {}
 
 function parse(argv: string[]) {
   const opts: { vertices?: number; pose?: 'stand' | 'tpose'; seams: boolean; out?: string } = { seams: true };
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    const value = () => {
-      const v = argv[++i];
-      if (v === undefined) throw new UsageError(`${a} needs a value`);
-      return v;
-    };
+  let help = false;
+  walkArguments(argv, (message) => new UsageError(message), (a, value) => {
     if (a === '--vertices' || a === '-n') {
       opts.vertices = wholeNumber(a, value(), MIN_VERTICES, MAX_VERTICES);
     } else if (a === '--pose') {
@@ -30,9 +25,10 @@ function parse(argv: string[]) {
       opts.pose = v;
     } else if (a === '--no-seams') opts.seams = false;
     else if (a === '-o' || a === '--out') opts.out = value();
-    else if (a === '-h' || a === '--help') { process.stdout.write(usage + '\n'); return null; }
+    else if (a === '-h' || a === '--help') return help = true; // the rest unread
     else throw new UsageError(`unknown argument '${a}'`);
-  }
+  });
+  if (help) { process.stdout.write(usage + '\n'); return null; }
   if (!opts.out) throw new UsageError('missing -o out.glb');
   return opts;
 }

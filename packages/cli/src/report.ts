@@ -12,7 +12,7 @@ import { GcsError } from '../../../web/lib/errors.js';
 import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
-import { wholeNumber } from './args.js';
+import { walkArguments, wholeNumber } from './args.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, median, timeInterleaved,
@@ -431,13 +431,7 @@ export function formatReport(r: Report, options: { wide?: boolean } = {}): strin
 function parseArgs(argv: string[]): { file?: string; json: boolean; wide: boolean; help: boolean; options: ReportOptions } {
   const options: ReportOptions = {};
   let file: string | undefined, json = false, wide = false, help = false;
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    const value = () => {
-      const v = argv[++i];
-      if (v === undefined) throw new ReportError(`${a} needs a value`);
-      return v;
-    };
+  walkArguments(argv, (message) => new ReportError(message), (a, value) => {
     const integer = (min: number, max: number) => wholeNumber(a, value(), min, max);
     if (a === '--json') json = true;
     else if (a === '--wide') wide = true;
@@ -449,7 +443,7 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; wide: boolea
     else if (a.startsWith('-') && a !== '-') throw new ReportError(`unknown option '${a}'`); // '-': standard input
     else if (file === undefined) file = a;
     else throw new ReportError(`only one model file, got '${file}' and '${a}'`);
-  }
+  });
   return { file, json, wide, help, options };
 }
 

@@ -10,6 +10,7 @@ import { nodeMaterialSupport, toNodeMaterial } from '../../../web/lib/gpu/node-m
 import { GcsCharacter, GcsCrowd } from '../../../web/lib/webgpu.js';
 import { GcsCharacter as WebGLCharacter } from '../../../web/lib/three.js';
 import { createHuman, type Human } from '../../../web/lib/human/index.js';
+import { drawWith, humanWithTangents, webgpuRenderer } from '../../helpers/velocity-pass.js';
 
 let gcs: GcsSkin;
 let human: Human;
@@ -120,17 +121,8 @@ describe('GcsCharacter and GcsCrowd of gcs-skin/webgpu', () => {
 });
 
 describe('the CPU backend of gcs-skin/webgpu: tangents and velocity from the core pass', () => {
-  /** What the mesh's onBeforeRender sees of a WebGPURenderer drawing a velocity pass (or not). */
-  const renderer = (velocity: boolean) => ({ isWebGPURenderer: true, getMRT: () => (velocity ? { has: (name: string) => name === 'velocity' } : null) });
-  const draw = (mesh: THREE.Mesh, r: unknown) =>
-    mesh.onBeforeRender(r as THREE.WebGPURenderer, new THREE.Scene(), new THREE.PerspectiveCamera(), mesh.geometry, mesh.material as THREE.Material, null as unknown as THREE.Group);
-
   test('tangents are the deformer\'s own output (no copy); a velocity pass gives the mesh previous positions, swapped each update', () => {
-    const mesh = human.mesh.clone() as THREE.SkinnedMesh;
-    mesh.geometry = human.mesh.geometry.clone();
-    mesh.geometry.computeTangents();
-    const group = new THREE.Group();
-    group.add(mesh);
+    const { mesh, group } = humanWithTangents(human);
     const character = new GcsCharacter(gcs, group);
     try {
       const skin = character.skins[0];
@@ -138,13 +130,13 @@ describe('the CPU backend of gcs-skin/webgpu: tangents and velocity from the cor
       expect(skin.deformsTangents).toBe(true);
       expect((g().getAttribute('tangent') as THREE.BufferAttribute).array).toBe(skin.deformer.tangents);
       // Drawn without velocity: nothing changes.
-      draw(skin.mesh, renderer(false));
+      drawWith(skin.mesh, webgpuRenderer(false));
       character.update();
       expect(skin.mesh.material).toBe(mesh.material);
       expect(g().getAttribute('gcsPreviousPosition')).toBeUndefined();
       const bytes = skin.bytesPerFrame;
       // Drawn in a velocity pass: from the next update, previous positions and a node material that reads them.
-      draw(skin.mesh, renderer(true));
+      drawWith(skin.mesh, webgpuRenderer(true));
       const before = skin.deformer.positions.slice();
       mesh.skeleton.bones[3].rotation.x += 0.5; // the human's own skeleton: turned back below
       character.update();

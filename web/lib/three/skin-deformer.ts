@@ -369,7 +369,7 @@ export class SkinDeformer {
   get bytesPerFrame(): number {
     if (this.gpu) return this.gpu.sections.bytesPerUpdate;
     let bytes = 0;
-    for (const name of ['position', 'normal', 'tangent', PREVIOUS_POSITION_ATTRIBUTE]) {
+    for (const name of DYNAMIC_ATTRIBUTES) {
       const a = this.mesh.geometry.getAttribute(name) as THREE.BufferAttribute | undefined;
       if (a && a.usage === THREE.DynamicDrawUsage) bytes += a.array.byteLength;
     }
@@ -410,6 +410,9 @@ export class SkinDeformer {
     return this.isDisposed;
   }
 }
+
+/** The CPU backend's attributes uploaded per update() (bytesPerFrame: a list made once, not per call). */
+const DYNAMIC_ATTRIBUTES = ['position', 'normal', 'tangent', PREVIOUS_POSITION_ATTRIBUTE] as const;
 
 /** Points a dynamic attribute at `array` (a live wasm view) and flags its upload. */
 function sync(attribute: THREE.BufferAttribute | THREE.InterleavedBufferAttribute | undefined, array: Float32Array | null): void {
