@@ -86,7 +86,7 @@ for (const ch of characters) {
       .map((p) => `${name(p.joint)} (${p.reason}: ${num(p.p99, 2)} / ${num(p.max, 2)})`).join(', ');
     const offParts = d.parts.filter((p) => p.reason === 'off-surface').map((p) => name(p.joint));
     d.deform(identitySkin(rig.jointCount));
-    const q = classicBandQuality(d);
+    const q = classicBandQuality(d, input);
     off.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}${rigid ? ' (rigid)' : ''}`, String(frames.length), num(r.p99, 2), num(r.max, 2),
       worst || '— (all carried: on the skin)', offParts.length ? offParts.join(', ') : '—',
       q.triangles ? `${num(q.minAngle, 2)} / ${q.under5} of ${q.triangles} / ${num(q.aspectMax, 1)}` : '—']);
