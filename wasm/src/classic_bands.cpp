@@ -99,57 +99,72 @@ bool segmentsCross(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c, c
 // Flips the inner edges of a band (an edge two of its triangles share) where the other diagonal
 // of their quad gives a larger smallest angle in the bind pose and both new triangles face as the
 // old ones did (Lawson's flips, for the angle): ear clipping chose each strip's diagonals one ear
-// at a time.
+// at a time. Each flip raises the smaller of the two smallest angles, so this ends.
 template <typename At>
 void flipEdges(std::vector<uint32_t>& tris, const At& at) {
-  struct Edge {
-    uint32_t lo, hi, tri;
-    bool operator<(const Edge& o) const { return lo != o.lo ? lo < o.lo : hi != o.hi ? hi < o.hi : tri < o.tri; }
+  const uint32_t T = uint32_t(tris.size() / 3);
+  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); };
+  // across[3t + e]: the triangle across edge e of t (corner e → corner e + 1), or −1; the edges, sorted.
+  std::vector<int32_t> across(size_t(3) * T, -1);
+  std::vector<uint64_t> edges(size_t(3) * T);
+  {
+    std::vector<std::pair<uint64_t, uint32_t>> slots(size_t(3) * T);
+    for (uint32_t s = 0; s < 3 * T; ++s) slots[s] = {key(tris[s], tris[s - s % 3 + (s + 1) % 3]), s};
+    std::sort(slots.begin(), slots.end());
+    for (size_t i = 0; i < slots.size();) {
+      size_t j = i;
+      while (j < slots.size() && slots[j].first == slots[i].first) ++j;
+      if (j - i == 2) across[slots[i].second] = int32_t(slots[i + 1].second / 3), across[slots[i + 1].second] = int32_t(slots[i].second / 3);
+      i = j;
+    }
+    for (size_t i = 0; i < slots.size(); ++i) edges[i] = slots[i].first;
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  }
+  std::vector<float> quality(T);
+  for (uint32_t t = 0; t < T; ++t) quality[t] = smallestSine(at(tris[3 * t]), at(tris[3 * t + 1]), at(tris[3 * t + 2]));
+  auto repoint = [&](int32_t n, uint32_t p, uint32_t q, int32_t to) {  // n's edge {p, q} now faces `to`
+    if (n < 0) return;
+    for (uint32_t s = 0; s < 3; ++s)
+      if (key(tris[3 * size_t(n) + s], tris[3 * size_t(n) + (s + 1) % 3]) == key(p, q)) across[3 * size_t(n) + s] = to;
   };
-  std::vector<Edge> edges;
-  std::vector<float> quality(tris.size() / 3);
-  for (size_t t = 0; t < quality.size(); ++t) quality[t] = smallestSine(at(tris[3 * t]), at(tris[3 * t + 1]), at(tris[3 * t + 2]));
-  for (int pass = 0; pass < 8; ++pass) {
-    edges.clear();
-    for (uint32_t t = 0; t < tris.size() / 3; ++t)
-      for (int e = 0; e < 3; ++e) {
-        const uint32_t a = tris[3 * t + e], b = tris[3 * t + (e + 1) % 3];
-        edges.push_back({std::min(a, b), std::max(a, b), t});
-      }
-    std::sort(edges.begin(), edges.end());
-    std::vector<uint8_t> touched(tris.size() / 3, 0);
-    std::vector<std::pair<uint32_t, uint32_t>> added;  // diagonals made this pass (not in `edges` yet)
-    bool flipped = false;
-    for (size_t e = 0; e + 1 < edges.size(); ++e) {
-      const Edge &x = edges[e], &y = edges[e + 1];
-      if (x.lo != y.lo || x.hi != y.hi || (e + 2 < edges.size() && edges[e + 2].lo == x.lo && edges[e + 2].hi == x.hi)) continue;
-      if (touched[x.tri] || touched[y.tri]) continue;
-      // t1 walks a → b, t2 walks b → a; c and d are their third corners.
-      uint32_t* t1 = &tris[3 * size_t(x.tri)];
-      uint32_t* t2 = &tris[3 * size_t(y.tri)];
-      int i1 = 0;
-      while (!(t1[i1] == x.lo || t1[i1] == x.hi) || !(t1[(i1 + 1) % 3] == x.lo || t1[(i1 + 1) % 3] == x.hi)) ++i1;
-      const uint32_t a = t1[i1], b = t1[(i1 + 1) % 3], c = t1[(i1 + 2) % 3];
-      uint32_t dd = t2[0] != a && t2[0] != b ? t2[0] : t2[1] != a && t2[1] != b ? t2[1] : t2[2];
-      if (c == dd || !mixed(c, a, dd) || !mixed(dd, b, c)) continue;
-      if (std::binary_search(edges.begin(), edges.end(), Edge{std::min(c, dd), std::max(c, dd), 0u},
-                             [](const Edge& p, const Edge& q) { return p.lo != q.lo ? p.lo < q.lo : p.hi < q.hi; }))
-        continue;  // the other diagonal is an edge already
-      if (std::find(added.begin(), added.end(), std::make_pair(std::min(c, dd), std::max(c, dd))) != added.end()) continue;
-      const glm::vec3 A = at(a), B = at(b), C = at(c), D = at(dd);
-      const float before = std::min(quality[x.tri], quality[y.tri]);
+  std::vector<uint32_t> stack(T);
+  std::vector<uint8_t> queued(T, 1);
+  for (uint32_t t = 0; t < T; ++t) stack[t] = T - 1 - t;
+  for (uint32_t flips = 0; !stack.empty() && flips < 16 * T;) {
+    const uint32_t t = stack.back();
+    stack.pop_back();
+    queued[t] = 0;
+    for (uint32_t e = 0; e < 3; ++e) {
+      const int32_t u = across[3 * size_t(t) + e];
+      if (u < 0) continue;
+      const uint32_t a = tris[3 * t + e], b = tris[3 * t + (e + 1) % 3], c = tris[3 * t + (e + 2) % 3];
+      uint32_t f = 0;
+      while (f < 3 && !(tris[3 * size_t(u) + f] == b && tris[3 * size_t(u) + (f + 1) % 3] == a)) ++f;
+      if (f == 3) continue;
+      const uint32_t d = tris[3 * size_t(u) + (f + 2) % 3];
+      if (c == d || !mixed(c, a, d) || !mixed(d, b, c) || std::binary_search(edges.begin(), edges.end(), key(c, d))) continue;
+      const glm::vec3 A = at(a), B = at(b), C = at(c), D = at(d);
       const float q1 = smallestSine(C, A, D), q2 = smallestSine(D, B, C);
-      if (!(std::min(q1, q2) > before + 1e-4f)) continue;
+      if (!(std::min(q1, q2) > std::min(quality[t], quality[u]) + 1e-4f)) continue;
       const glm::vec3 facing = glm::cross(B - A, C - A) + glm::cross(A - B, D - B);
       if (!(glm::dot(glm::cross(A - C, D - C), facing) > 0.0f) || !(glm::dot(glm::cross(B - D, C - D), facing) > 0.0f)) continue;
-      t1[0] = c, t1[1] = a, t1[2] = dd;
-      t2[0] = dd, t2[1] = b, t2[2] = c;
-      quality[x.tri] = q1, quality[y.tri] = q2;
-      touched[x.tri] = touched[y.tri] = 1;
-      added.push_back({std::min(c, dd), std::max(c, dd)});
-      flipped = true;
+      // t = (a, b, c), u = (b, a, d) → t = (c, a, d), u = (d, b, c).
+      const int32_t nbc = across[3 * size_t(t) + (e + 1) % 3], nca = across[3 * size_t(t) + (e + 2) % 3];
+      const int32_t nad = across[3 * size_t(u) + (f + 1) % 3], ndb = across[3 * size_t(u) + (f + 2) % 3];
+      tris[3 * t] = c, tris[3 * t + 1] = a, tris[3 * t + 2] = d;
+      tris[3 * size_t(u)] = d, tris[3 * size_t(u) + 1] = b, tris[3 * size_t(u) + 2] = c;
+      across[3 * size_t(t)] = nca, across[3 * size_t(t) + 1] = nad, across[3 * size_t(t) + 2] = u;
+      across[3 * size_t(u)] = ndb, across[3 * size_t(u) + 1] = nbc, across[3 * size_t(u) + 2] = int32_t(t);
+      repoint(nad, a, d, int32_t(t));
+      repoint(nbc, b, c, u);
+      quality[t] = q1, quality[u] = q2;
+      edges.erase(std::lower_bound(edges.begin(), edges.end(), key(a, b)));
+      edges.insert(std::lower_bound(edges.begin(), edges.end(), key(c, d)), key(c, d));
+      for (uint32_t x : {t, uint32_t(u)})
+        if (!queued[x]) queued[x] = 1, stack.push_back(x);
+      ++flips;
+      break;
     }
-    if (!flipped) break;
   }
 }
 
