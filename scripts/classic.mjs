@@ -77,7 +77,7 @@ for (const ch of characters) {
       .map((p) => `${name(p.joint)} (${p.reason}: ${num(p.p99, 2)} / ${num(p.max, 2)})`).join(', ');
     const offParts = d.parts.filter((p) => p.reason === 'off-surface').map((p) => name(p.joint));
     d.deform(identitySkin(rig.jointCount));
-    const q = classicBandQuality(d);
+    const q = classicBandQuality(d, input);
     off.push([`${ch.name}${ch.meshes.length > 1 ? ` / ${mesh.name}` : ''}${rigid ? ' (rigid)' : ''}`, String(frames.length), num(r.p99, 2), num(r.max, 2),
       worst || '— (all carried: on the skin)', offParts.length ? offParts.join(', ') : '—',
       q.triangles ? `${num(q.minAngle, 2)} / ${q.under5} of ${q.triangles} / ${num(q.aspectMax, 1)}` : '—']);
@@ -92,4 +92,4 @@ console.log('\nLoss: distance of each input vertex the tubes and bands replace t
   'count. Border: welded edges used by one triangle, input / output at 25 × 20 and at the budget. Off-surface: distance of each ' +
   `output vertex to the source surface as DQS poses it, ${FRAMES_PER_CLIP} frames per clip, bulge 0.3, % of the character's height ` +
   '(targets: p99 ≤ 1, max ≤ 2.5); carried skin moves by DQS of its own weights, so it lies on that surface. (rigid): the same mesh ' +
-  'with every vertex bound 100 % to its dominant joint. Band triangles: those joining a tube\'s end ring to carried skin, at the bind pose.');
+  'with every vertex bound 100 % to its dominant joint. Band triangles: those of the bands between a tube\'s end ring and carried skin (neither a tube\'s nor a carried input triangle), at the bind pose.');

@@ -2,7 +2,8 @@
 // Close-ups of the classic model against GCS for docs/classic.md: the demo with Cesium Man paused
 // in a stride, coloured by section / contour (carried skin pale grey), the shared camera moved close
 // to the hips and legs, then to the shoulder and arm (GCS left, classic right); then our human's
-// left hip, where the zip band between the thigh's tube and the carried crotch has long slivers.
+// left hip, where the zip band joins the thigh's tube to the carried crotch (rows of band vertices
+// from the hip loop down to the thigh's first ring at mid-thigh).
 //
 //   node scripts/screenshot-classic.mjs                     → docs/classic-hips.png, docs/classic-arm.png,
 //                                                             docs/classic-bands.png

@@ -532,11 +532,13 @@ typedef enum GcsClassicReason {
 uint32_t gcs_classic_part_count(const GcsDeformer* deformer);
 const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
 /* For each output vertex (vertexCount int32): the contour its ring belongs to (0 … contours − 1,
-   the order of GCS_STAT_SECTIONS), or −1 for a carried input vertex. Null for other deformers. */
+   the order of GCS_STAT_SECTIONS), or −1 for a carried input vertex or a band vertex (a point of
+   the input surface between a tube's end ring and the carried skin, moved as carried skin). Null
+   for other deformers. */
 const int32_t* gcs_classic_contour_of_vertex(const GcsDeformer* deformer);
 /* For each output vertex (vertexCount int32): the rig vertex a carried vertex copies (its texture
-   coordinates, colours and other attributes are that vertex's), or −1 for a resampled (ring or cap)
-   vertex. Null for other deformers. */
+   coordinates, colours and other attributes are that vertex's), or −1 for a resampled (ring, cap
+   or band) vertex. Null for other deformers. */
 const int32_t* gcs_classic_source_of_vertex(const GcsDeformer* deformer);
 /*
  * Detail loss of resampling (the paper's Fig. 5): for each input vertex the tubes and bands replace

@@ -61,6 +61,7 @@ ClassicModel* ClassicBuild::build(const std::vector<uint8_t>* carry) {
   fillEmptyContours();
   contourInfluences();
   addCaps();
+  planBands();
   copyCarriedVertices();
   buildTriangles();
   writeReport();
@@ -1023,6 +1024,8 @@ void ClassicBuild::copyCarriedVertices() {
     m.parts[j].runCount = runCount[j];
     vertex += runCount[j];
   }
+  bandFirst = vertex;  // then the bands' own skin points, carried the same way
+  vertex += uint32_t(bandVertices.size());
   groupOutput.assign(G, -1);
   {
     std::vector<uint32_t> cursor(J);
@@ -1053,6 +1056,13 @@ void ClassicBuild::copyCarriedVertices() {
       m.restNormals[o + c] = rig.normals[v][c];
     }
   }
+  for (size_t b = 0; b < bandVertices.size(); ++b) {
+    const BandVertex& x = bandVertices[b];
+    const size_t o = bandFirst - m.carriedFirst + b;
+    m.carriedJoints[o] = x.joints[0], m.carriedWeights[o] = x.weights[0];
+    if (eight) m.carriedJoints1[o] = x.joints[1], m.carriedWeights1[o] = x.weights[1];
+    for (int c = 0; c < 3; ++c) m.restPositions[3 * o + c] = x.position[c], m.restNormals[3 * o + c] = x.normal[c];
+  }
 }
 
 // 7. Triangles: tube quads (outward winding: rays turn from u to w = n × u, counter-clockwise
@@ -1071,7 +1081,7 @@ void ClassicBuild::buildTriangles() {
     }
   }
   m.tubeIndexCount = uint32_t(m.indices.size());
-  for (const Loop& L : loops) zipBand(L);
+  for (size_t l = 0; l < loops.size(); ++l) zipBand(loops[l], plans[l]);
   for (const ClassicCap& cap : m.caps) {
     ClassicBand fan;
     fan.part = uint32_t(m.contours[cap.contour].part);
@@ -1090,68 +1100,6 @@ void ClassicBuild::buildTriangles() {
     if (!triCarried[t]) continue;
     for (int e = 0; e < 3; ++e) m.indices.push_back(uint32_t(outputOf[rig.indices[3 * t + e]]));
   }
-}
-
-// A band zips an end ring (traversed against the tube's use of its edges: decreasing angle at
-// a proximal end, increasing at a distal one) to its loop (traversed as the carried triangles
-// use its edges, which turns the same way on an outward-wound mesh), always advancing on the
-// side whose next vertex comes first by angle: ring + loop vertices triangles, every edge of
-// both used once, so the seam is closed whatever the two sides' vertex counts.
-void ClassicBuild::zipBand(const Loop& L) {
-  ClassicModel& m = *model;
-  std::vector<float> beta;
-  std::vector<uint32_t> loopOut;
-  const ClassicPart& P = m.parts[L.part];
-  const ClassicContour& c = m.contours[L.distal ? P.contours.back() : P.contours.front()];
-  const float d = L.distal ? 1.0f : -1.0f;
-  const glm::vec3 w = glm::cross(c.normal, c.u);
-  const size_t n = L.groups.size();
-  auto angleOf = [&](uint32_t g) {
-    glm::vec3 x = rig.positions[representative[g]] - c.centre;
-    return d * std::atan2(glm::dot(x, w), glm::dot(x, c.u));
-  };
-  auto wrap = [](float a) {
-    while (a > kPi) a -= 2.0f * kPi;
-    while (a <= -kPi) a += 2.0f * kPi;
-    return a;
-  };
-  float total = 0.0f;
-  for (size_t i = 0; i < n; ++i) total += wrap(angleOf(L.groups[(i + 1) % n]) - angleOf(L.groups[i]));
-  loopOut.resize(n);
-  for (size_t i = 0; i < n; ++i)  // against the ring's turn (an inward-wound input): walk it backwards
-    loopOut[i] = uint32_t(groupOutput[L.groups[total >= 0.0f ? i : n - 1 - i]]);
-  size_t start = 0;
-  float nearest = INFINITY;
-  for (size_t i = 0; i < n; ++i) {
-    float a = std::fabs(wrap(angleOf(L.groups[total >= 0.0f ? i : n - 1 - i])));
-    if (a < nearest) nearest = a, start = i;
-  }
-  std::rotate(loopOut.begin(), loopOut.begin() + ptrdiff_t(start), loopOut.end());
-  beta.resize(n + 1);
-  {
-    auto groupAt = [&](size_t i) { size_t s = (start + i) % n; return L.groups[total >= 0.0f ? s : n - 1 - s]; };
-    beta[0] = wrap(angleOf(groupAt(0)));
-    for (size_t i = 1; i <= n; ++i) beta[i] = beta[i - 1] + wrap(angleOf(groupAt(i % n)) - angleOf(groupAt(i - 1)));
-  }
-  auto ringAt = [&](uint32_t i) { return c.first + (L.distal ? i % k : (k - i % k) % k); };
-  ClassicBand band;
-  band.part = L.part;
-  band.firstIndex = uint32_t(m.indices.size());
-  uint32_t i = 0;
-  size_t jj = 0;
-  const float step = 2.0f * kPi / float(k);
-  while (i < k || jj < n) {
-    bool ringStep = jj == n || (i < k && float(i + 1) * step <= beta[jj + 1]);
-    if (ringStep) {
-      m.indices.insert(m.indices.end(), {ringAt(i), ringAt(i + 1), loopOut[jj % n]});
-      ++i;
-    } else {
-      m.indices.insert(m.indices.end(), {ringAt(i), loopOut[(jj + 1) % n], loopOut[jj % n]});
-      ++jj;
-    }
-  }
-  band.indexCount = uint32_t(m.indices.size()) - band.firstIndex;
-  m.bands.push_back(band);
 }
 
 // 8. The report (parts in joint order), contours per vertex, and the detail-loss inputs: the

@@ -37,6 +37,18 @@ class ClassicBuild {
     uint32_t part = 0;
     bool distal = false;
   };
+  // Per loop: its band (classic_bands.cpp). The band's own vertices are skin points under the band
+  // carried by DQS like the carried skin, after the carried copies: [bandFirst, bandFirst + count).
+  struct BandPlan {
+    std::vector<uint32_t> loop;        // the loop's welded vertices in the ring's turn, from the one nearest ray 0
+    std::vector<float> beta;           // their unwrapped angles about the end ring (n + 1: back to the first)
+    std::vector<uint32_t> triangles;   // kRingRef | ring index, kLoopRef | loop index, or a band vertex; empty: one zip
+  };
+  struct BandVertex {
+    glm::vec3 position, normal;
+    glm::uvec4 joints[2];              // slots 0..3, 4..7
+    glm::vec4 weights[2];
+  };
 
   // --- Steps 1–3: the rig's analysis (kept across rebuilds).
   void findParts();          // 1. parts by dominant weight (welded), their parents and children
@@ -61,9 +73,13 @@ class ClassicBuild {
   void fillEmptyContours();  //    misses filled, empty contours from their neighbours
   void contourInfluences();  //    the skin each contour resamples, as influences
   void addCaps();            //    flat fans on closed ends that meet nothing
+  void planBands();          //    band rows of new skin vertices between each end ring and its loop
+  bool planBand(const Loop& loop, BandPlan& plan);
+  BandVertex skinPoint(const glm::vec3& x, const glm::vec3* corner, const uint32_t* v, uint32_t fallbackJoint,
+                       const glm::vec3& fallbackNormal) const;
   void copyCarriedVertices();// 6. carried input vertices, grouped by part
   void buildTriangles();     // 7. tube quads, bands, caps, carried triangles
-  void zipBand(const Loop& loop);
+  void zipBand(const Loop& loop, const BandPlan& plan);
   void writeReport();        // 8. report, contour and source per vertex, detail-loss inputs
   void restPose();           // 9. the bind pose as the initial output
 
@@ -131,6 +147,21 @@ class ClassicBuild {
   std::vector<uint32_t> probeTriangles;
   std::vector<uint32_t> gathered, cut;           // castPart's parts, and the triangles a contour may cut
   std::vector<Loop> loops;
+  std::vector<BandPlan> plans;
+  std::vector<BandVertex> bandVertices;
+  uint32_t bandFirst = 0;
+  // Bands laid by earlier builds (the rebuild after the on-skin test meets the same loops and end
+  // rings on every part it does not carry): the plan, its band vertices from 0, what it was laid from.
+  struct LaidBand {
+    uint32_t part;
+    bool distal;
+    std::vector<uint32_t> groups, gathered;
+    glm::vec3 centre, normal, u;
+    std::vector<float> radii;
+    BandPlan plan;
+    std::vector<BandVertex> vertices;
+  };
+  std::vector<LaidBand> laidBands;
   std::vector<uint8_t> triCarried;               // per rig triangle: it has a carried vertex
   std::vector<int32_t> gOwner;                   // per welded vertex: the part whose tube replaces it, or −1
   std::vector<uint32_t> root;                    // union-find over welded vertices

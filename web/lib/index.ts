@@ -807,14 +807,17 @@ export class ClassicDeformer extends Deformer {
   }
   /**
    * For each output vertex, the contour (ring) it lies on, 0 … sectionCount − 1, or −1 for a
-   * carried input vertex: what the demo colours by. A copy (valid until the next rebuild).
+   * carried input vertex or a band vertex (a point of the input surface between a tube's end ring
+   * and the carried skin, moved as carried skin): what the demo colours by. A copy (valid until
+   * the next rebuild).
    */
   get contourOfVertex(): Int32Array {
     return this.perVertex(this.gcs.core.gcs_classic_contour_of_vertex(this.live()));
   }
   /**
    * For each output vertex, the rig vertex a carried vertex copies (take its texture coordinates
-   * and colours from there), or −1 for a resampled vertex. A copy (valid until the next rebuild).
+   * and colours from there), or −1 for a resampled (ring, cap or band) vertex. A copy (valid until
+   * the next rebuild).
    */
   get sourceOfVertex(): Int32Array {
     return this.perVertex(this.gcs.core.gcs_classic_source_of_vertex(this.live()));

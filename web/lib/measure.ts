@@ -942,15 +942,23 @@ export interface BandQuality {
 /**
  * Minimum angle and aspect ratio of the zip-band triangles of a classic model in its current pose
  * (call it after a deform with identity matrices for the bind pose): long slivers shade as streaks.
+ * A band triangle is any triangle that is neither the tubes' (every corner a ring or cap vertex)
+ * nor a carried triangle of `input` (every corner a copied input vertex, and the three of them one
+ * of the input's triangles): it joins a ring to carried skin, touches a band's own vertices, or
+ * runs along a loop.
  */
-export function classicBandQuality(deformer: ClassicDeformer): BandQuality {
+export function classicBandQuality(deformer: ClassicDeformer, input: Pick<RigInput, 'indices'>): BandQuality {
   const I = deformer.indices, X = deformer.positions, ring = deformer.contourOfVertex, source = deformer.sourceOfVertex;
+  const key = (a: number, b: number, c: number) => [a, b, c].sort((x, y) => x - y).join();
+  const carried = new Set<string>();
+  for (let t = 0; t + 2 < input.indices.length; t += 3) carried.add(key(input.indices[t], input.indices[t + 1], input.indices[t + 2]));
   const angles: number[] = [], aspects: number[] = [];
   const at = (v: number) => [X[3 * v], X[3 * v + 1], X[3 * v + 2]];
   const dist = (p: number[], q: number[]) => Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
   for (let t = 0; t < I.length; t += 3) {
     const v = [I[t], I[t + 1], I[t + 2]];
-    if (!v.some((x) => ring[x] >= 0) || !v.some((x) => source[x] >= 0)) continue;
+    if (v.every((x) => ring[x] >= 0)) continue;
+    if (v.every((x) => source[x] >= 0) && carried.has(key(source[v[0]], source[v[1]], source[v[2]]))) continue;
     const [a, b, c] = v.map(at);
     const la = dist(b, c), lb = dist(c, a), lc = dist(a, b);
     const s = (la + lb + lc) / 2, area = Math.sqrt(Math.max(0, s * (s - la) * (s - lb) * (s - lc)));
