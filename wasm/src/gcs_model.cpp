@@ -4,7 +4,6 @@
 #include <cstring>
 #include <new>
 #include <tuple>
-#include <unordered_map>
 #include "error.h"
 #include "rotation_centres.h"
 
@@ -28,38 +27,126 @@ struct Branch {
   float sProximal = 0.0f, sDistal = 1.0f;
 };
 
-// Writes the output mesh section by section (a counting sort of the vertices by section) given
-// each welded group's section; m.sections[i].count/first are filled here. Returns, for each rig
-// vertex, its output index.
-std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
-                                     const std::vector<uint32_t>& sectionOfGroup) {
-  const uint32_t S = uint32_t(m.sections.size());
+// The distinct keys of a build, numbered in order of first sight: open addressing over a
+// power-of-two table of key numbers (a node-based map allocates per key and chases pointers; the
+// default build looks up two or three keys per welded vertex on every slider step).
+template <class Key, class Hash>
+class FlatIndex {
+ public:
+  explicit FlatIndex(size_t expected) { grow(expected); }
+  uint32_t idOf(const Key& key) {
+    const size_t h = Hash()(key);
+    for (size_t i = h & mask;; i = (i + 1) & mask) {
+      const uint32_t id = slots[i];
+      if (id == 0) break;
+      if (hashes[id - 1] == h && keys[id - 1] == key) return id - 1;
+    }
+    keys.push_back(key);
+    hashes.push_back(h);
+    if (4 * keys.size() > slots.size()) grow(keys.size());
+    else place(uint32_t(keys.size()), h);
+    return uint32_t(keys.size() - 1);
+  }
+  std::vector<Key> keys;
+
+ private:
+  void place(uint32_t id, size_t h) {
+    size_t i = h & mask;
+    while (slots[i]) i = (i + 1) & mask;
+    slots[i] = id;
+  }
+  void grow(size_t count) {  // to a table at most an eighth full, every key placed again
+    size_t size = 64;
+    while (size < 8 * count) size *= 2;
+    slots.assign(size, 0);
+    mask = size - 1;
+    for (size_t k = 0; k < keys.size(); ++k) place(uint32_t(k + 1), hashes[k]);
+  }
+  std::vector<uint32_t> slots;  // key number + 1, 0 empty
+  std::vector<size_t> hashes;   // per key
+  size_t mask = 0;
+};
+
+// An output run: the vertices of one section that blend with the same other sections.
+struct RunKey {
+  uint32_t section = 0, other = 0, third = 0;
+  bool operator==(const RunKey& o) const { return section == o.section && other == o.other && third == o.third; }
+  bool operator<(const RunKey& o) const { return std::tie(section, other, third) < std::tie(o.section, o.other, o.third); }
+};
+struct RunKeyHash {
+  size_t operator()(const RunKey& k) const {
+    uint64_t h = (uint64_t(k.other) << 32 | k.third) * 0x9e3779b97f4a7c15ull ^ uint64_t(k.section) * 0xbf58476d1ce4e5b9ull;
+    return size_t(h ^ (h >> 29));
+  }
+};
+
+// Writes the output mesh run by run: a counting sort of the vertices (stable in vertex order) by
+// their welded group's run, the runs ordered by (section, other, third). A section's vertices are
+// then contiguous, and within it those that blend alike (groupBlendRuns' order, in one pass).
+// `otherOfGroup` / `thirdOfGroup` null: one run per section (no blends). Fills
+// m.sections[i].count/first and, with blends, m.blendRuns; calls perVertex(output, vertex, group)
+// for each vertex. Returns, for each rig vertex, its output index.
+template <class PerVertex>
+std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
+                                 const std::vector<uint32_t>& sectionOfGroup, const uint32_t* otherOfGroup,
+                                 const uint32_t* thirdOfGroup, PerVertex perVertex) {
+  const uint32_t S = uint32_t(m.sections.size()), G = uint32_t(sectionOfGroup.size());
+  // Each group's run: its section, or (with blends) a number of its (section, other, third) ranked by the triple.
+  std::vector<uint32_t> runOfGroup;
+  std::vector<RunKey> runs;
+  if (otherOfGroup) {
+    FlatIndex<RunKey, RunKeyHash> table(S);
+    runOfGroup.resize(G);
+    for (uint32_t g = 0; g < G; ++g) runOfGroup[g] = table.idOf({sectionOfGroup[g], otherOfGroup[g], thirdOfGroup[g]});
+    const uint32_t R = uint32_t(table.keys.size());
+    std::vector<uint32_t> order(R), rank(R);
+    for (uint32_t r = 0; r < R; ++r) order[r] = r;
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return table.keys[a] < table.keys[b]; });
+    runs.resize(R);
+    for (uint32_t r = 0; r < R; ++r) rank[order[r]] = r, runs[r] = table.keys[order[r]];
+    for (uint32_t& run : runOfGroup) run = rank[run];
+  }
+  const std::vector<uint32_t>& runOf = otherOfGroup ? runOfGroup : sectionOfGroup;
+  const uint32_t R = otherOfGroup ? uint32_t(runs.size()) : S;
+  std::vector<uint32_t> cursor(R, 0);
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++cursor[runOf[group[v]]];
   for (Section& sec : m.sections) sec.count = 0;
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++m.sections[sectionOfGroup[group[v]]].count;
   uint32_t first = 0;
+  for (uint32_t r = 0; r < R; ++r) {
+    const uint32_t count = cursor[r];
+    m.sections[otherOfGroup ? runs[r].section : r].count += count;
+    if (otherOfGroup) m.blendRuns.push_back({first, count, runs[r].section, runs[r].other, runs[r].third});
+    cursor[r] = first;
+    first += count;
+  }
+  first = 0;
   for (Section& sec : m.sections) sec.first = first, first += sec.count;
   m.allocateOutput(rig.vertexCount);
   m.restPositions.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
   m.restNormals.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
   m.sourceVertex.resize(rig.vertexCount);
   m.sectionOfVertex.resize(rig.vertexCount);
-  std::vector<uint32_t> cursor(S);
-  for (uint32_t i = 0; i < S; ++i) cursor[i] = m.sections[i].first;
   std::vector<uint32_t> outputOf(rig.vertexCount);
   for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    uint32_t sec = sectionOfGroup[group[v]];
-    uint32_t o = cursor[sec]++;
+    const uint32_t g = group[v], o = cursor[runOf[g]]++;
     outputOf[v] = o;
     m.sourceVertex[o] = v;
-    m.sectionOfVertex[o] = sec;
+    m.sectionOfVertex[o] = sectionOfGroup[g];
     for (int c = 0; c < 3; ++c) {
       m.restPositions[3 * o + c] = rig.positions[v][c];
       m.restNormals[3 * o + c] = rig.normals[v][c];
     }
+    perVertex(o, v, g);
   }
   m.indices.resize(rig.indices.size());
   for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
   return outputOf;
+}
+
+// layoutRuns with one run per section (the blends, if any, grouped later: groupBlendRuns).
+std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
+                                     const std::vector<uint32_t>& sectionOfGroup) {
+  return layoutRuns(rig, m, group, sectionOfGroup, nullptr, nullptr, [](uint32_t, uint32_t, uint32_t) {});
 }
 
 // Smooth mode: sorts each section's vertices by the section they blend with (a stable counting
@@ -110,10 +197,11 @@ void groupBlendRuns(GcsDeformerImpl& m) {
 }
 
 // Bounding spheres (for the adjusted-section statistic), the introspection table, the per-frame
-// buffers, and the rest pose in the output.
-void finishModel(GcsDeformerImpl& m) {
+// buffers, and the rest pose in the output. Smooth mode: the blend runs too, unless the layout
+// grouped them (`runsGrouped`).
+void finishModel(GcsDeformerImpl& m, bool runsGrouped = false) {
   const uint32_t S = uint32_t(m.sections.size());
-  if (m.settings.smooth) groupBlendRuns(m);
+  if (m.settings.smooth && !runsGrouped) groupBlendRuns(m);
   m.sectionInfo.resize(size_t(S) * 8);
   for (uint32_t i = 0; i < S; ++i) {
     Section& sec = m.sections[i];
@@ -299,19 +387,19 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
                          std::vector<uint32_t>& sectionOfGroup) {
   const uint32_t G = uint32_t(representative.size());
   const uint32_t Q = 2 * (m.settings.sections - 2);
-  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
-  std::vector<WeightKey> keys;
+  FlatIndex<WeightKey, WeightKeyHash> table(size_t(G) / 8);
+  const std::vector<WeightKey>& keys = table.keys;
   std::vector<uint32_t> keyOf(G);
-  // Each group's cleaned weights, read once (`slots` joints, `slots` weights, a count).
+  // Each group's cleaned weights, kept on the rig (`slots` joints, `slots` weights, a count).
+  cleanGroupWeights(rig);
   const uint32_t slots = rig.influenceSlots;
-  std::vector<uint32_t> cleanJoints(size_t(G) * slots);
-  std::vector<float> cleanWeightsOf(size_t(G) * slots);
-  std::vector<uint8_t> cleanCount(G);
+  const std::vector<uint32_t>& cleanJoints = rig.cleanJoint;
+  const std::vector<float>& cleanWeightsOf = rig.cleanWeight;
+  const std::vector<uint8_t>& cleanCount = rig.cleanCount;
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t* joint = &cleanJoints[size_t(g) * slots];
-    float* weight = &cleanWeightsOf[size_t(g) * slots];
-    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
-    cleanCount[g] = uint8_t(n);
+    const uint32_t* joint = &cleanJoints[size_t(g) * slots];
+    const float* weight = &cleanWeightsOf[size_t(g) * slots];
+    const uint32_t n = cleanCount[g];
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
@@ -327,12 +415,7 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
     }
     key.q[d] = std::max(others < Q ? Q - others : 0u, std::max(largest, 1u));
     key.canonical(Q);
-    auto it = keyIndex.find(key);
-    if (it == keyIndex.end()) {
-      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
-      keys.push_back(key);
-    }
-    keyOf[g] = it->second;
+    keyOf[g] = table.idOf(key);
   }
   // Mean weights per key on its own joints.
   const uint32_t K = uint32_t(keys.size());
@@ -403,25 +486,35 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
   const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
-  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
-  keyIndex.reserve(size_t(G) / 4 + 64);  // nodes are far fewer than vertices; no rehash on the way
-  std::vector<WeightKey> keys;
+  FlatIndex<WeightKey, WeightKeyHash> table(size_t(G) / 8);  // nodes are far fewer than vertices
+  const std::vector<WeightKey>& keys = table.keys;
   auto keyId = [&](WeightKey key) {
     key.canonical(total);
-    auto it = keyIndex.find(key);
-    if (it == keyIndex.end()) {
-      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
-      keys.push_back(key);
-    }
-    return it->second;
+    return table.idOf(key);
   };
+  // Each joint's rigid core, looked up once (about half the human's welded vertices sit on one).
+  std::vector<uint32_t> rigidKey(rig.jointCount, ~0u);
+  auto rigidId = [&](uint32_t j) {
+    if (rigidKey[j] == ~0u) {
+      WeightKey key;
+      key.n = 1;
+      key.joint[0] = j;
+      key.q[0] = total;
+      rigidKey[j] = keyId(key);
+    }
+    return rigidKey[j];
+  };
+  cleanGroupWeights(rig);  // each group's cleaned weights, kept on the rig
+  const uint32_t slots = rig.influenceSlots;
   std::vector<uint32_t> lowKey(G), highKey(G), thirdKey(G);
   blendOfGroup.assign(G, 0.0f);
   blendThirdOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
     uint32_t joint[kMaxInfluences] = {};
     float weight[kMaxInfluences] = {};
-    const uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    const uint32_t n = rig.cleanCount[g];
+    std::memcpy(joint, &rig.cleanJoint[size_t(g) * slots], n * sizeof(uint32_t));
+    std::memcpy(weight, &rig.cleanWeight[size_t(g) * slots], n * sizeof(float));
     if (n == 3) {
       // One triangulation per joint triple: the joints in a fixed order (by index).
       for (uint32_t i = 1; i < 3; ++i)
@@ -448,6 +541,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     const float frac = x - float(level);
     // The node at level l: d keeps 8·(Q − l) units, the shape u's 8·l units go by largest remainders.
     auto nodeKey = [&](uint32_t l) {
+      if (l == 0) return rigidId(joint[d]);  // the key below would reduce to it (canonical)
       WeightKey key;
       key.n = n;
       const uint32_t units = 8 * l;
@@ -534,7 +628,8 @@ namespace {
 
 // The welded rig: each vertex's group (vertices at one bind-pose position) and each group's first vertex.
 struct Welded {
-  std::vector<uint32_t> group, representative;
+  const std::vector<uint32_t>& group;
+  const std::vector<uint32_t>& representative;
 };
 
 // Weights criterion: sections (plain) or nodes (smooth) from the weights, their centres of
@@ -548,21 +643,23 @@ bool buildWeightsCriterion(const Rig& rig, GcsDeformerImpl& m, const Welded& wel
                      blendThirdOfGroup);
   else buildWeightSections(rig, m, welded.representative, sectionOfGroup);
   if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
-  const std::vector<uint32_t> outputOf = layoutSections(rig, m, welded.group, sectionOfGroup);
-  if (smooth) {
-    m.blendOther.resize(rig.vertexCount);
-    m.blendF.resize(rig.vertexCount);
-    m.blendThird.resize(rig.vertexCount);
-    m.blendThirdF.resize(rig.vertexCount);
-    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-      const uint32_t o = outputOf[v], g = welded.group[v];
-      m.blendOther[o] = otherOfGroup[g];
-      m.blendF[o] = blendOfGroup[g];
-      m.blendThird[o] = thirdOfGroup[g];
-      m.blendThirdF[o] = blendThirdOfGroup[g];
-    }
+  if (!smooth) {
+    layoutSections(rig, m, welded.group, sectionOfGroup);
+    finishModel(m);
+    return true;
   }
-  finishModel(m);
+  m.blendOther.resize(rig.vertexCount);
+  m.blendF.resize(rig.vertexCount);
+  m.blendThird.resize(rig.vertexCount);
+  m.blendThirdF.resize(rig.vertexCount);
+  layoutRuns(rig, m, welded.group, sectionOfGroup, otherOfGroup.data(), thirdOfGroup.data(),
+             [&](uint32_t o, uint32_t, uint32_t g) {
+               m.blendOther[o] = otherOfGroup[g];
+               m.blendF[o] = blendOfGroup[g];
+               m.blendThird[o] = thirdOfGroup[g];
+               m.blendThirdF[o] = blendThirdOfGroup[g];
+             });
+  finishModel(m, true);
   return true;
 }
 
@@ -889,8 +986,8 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     m.jointCount = rig.jointCount;
     m.jointCentres = rig.jointCentres;
     m.adjustTolerance = 1e-3f * rig.height;
-    Welded welded;
-    welded.group = weldByPosition(rig, welded.representative);
+    weldRig(rig);  // kept on the rig: the sliders rebuild it again and again
+    const Welded welded{rig.weldGroup, rig.weldRepresentative};
     const bool built = settings.criterion == GCS_CRITERION_WEIGHTS ? buildWeightsCriterion(rig, m, welded)
                                                                     : PaperBuild(rig, m, welded).run();
     if (!built) {

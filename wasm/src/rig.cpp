@@ -14,11 +14,14 @@ bool allFinite(const float* values, size_t count) {
 }
 
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
-  if (rig.welded) {
-    representative = rig.weldRepresentative;
-    return rig.weldGroup;
-  }
-  representative.clear();
+  weldRig(rig);
+  representative = rig.weldRepresentative;
+  return rig.weldGroup;
+}
+
+void weldRig(const Rig& rig) {
+  if (rig.welded) return;
+  std::vector<uint32_t> representative;
   // A sort of the exact position bits, not a hash: O(n log n) for any input (a hash of raw float
   // bits put integer grids of power-of-two sizes into a few buckets: quadratic).
   struct Entry {
@@ -59,10 +62,24 @@ std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& repr
     }
     group[v] = id;
   }
-  rig.weldGroup = group;
-  rig.weldRepresentative = representative;
-  rig.welded = true;  // (after both copies: a failed allocation leaves no half cache)
-  return group;
+  rig.weldGroup.swap(group);
+  rig.weldRepresentative.swap(representative);
+  rig.welded = true;  // (after both: a failed allocation leaves no half cache)
+}
+
+void cleanGroupWeights(const Rig& rig) {
+  if (rig.cleaned) return;
+  weldRig(rig);
+  const size_t G = rig.weldRepresentative.size(), slots = rig.influenceSlots;
+  std::vector<uint32_t> joint(G * slots);
+  std::vector<float> weight(G * slots);
+  std::vector<uint8_t> count(G);
+  for (size_t g = 0; g < G; ++g)
+    count[g] = uint8_t(cleanWeights(rig, rig.weldRepresentative[g], &joint[g * slots], &weight[g * slots]));
+  rig.cleanJoint.swap(joint);
+  rig.cleanWeight.swap(weight);
+  rig.cleanCount.swap(count);
+  rig.cleaned = true;
 }
 
 uint32_t Rig::dominantJoint(uint32_t v) const {

@@ -42,6 +42,12 @@ struct Rig {
   // change, and the sliders rebuild the same rig again and again.
   mutable std::vector<uint32_t> weldGroup, weldRepresentative;
   mutable bool welded = false;
+  // cleanWeights of each welded group's first vertex (influenceSlots entries per group, `count`
+  // used), computed by the first weights-criterion build and kept: no section count changes them.
+  mutable std::vector<uint32_t> cleanJoint;
+  mutable std::vector<float> cleanWeight;
+  mutable std::vector<uint8_t> cleanCount;
+  mutable bool cleaned = false;
   // The surface the centres of rotation integrate over (rotation_centres.h), built by the first
   // build that asks and kept, like the weld.
   mutable std::shared_ptr<const CentreSurface> centreSurface;
@@ -63,6 +69,11 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 // each group). Both models group by it, so a seam can never open.
 // (Computed once per rig, then copied from its cache.)
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
+// Fills the rig's weld cache (weldGroup, weldRepresentative) if it is not yet: the builds that
+// only read it take it from there without a copy.
+void weldRig(const Rig& rig);
+// Fills the rig's cleanJoint / cleanWeight / cleanCount (per welded group) if they are not yet.
+void cleanGroupWeights(const Rig& rig);
 
 // A vertex's skin weights as the GCS criteria read them: influences below 0.5 % dropped (but the
 // largest), the same joint listed twice merged, the rest normalised to sum 1. Returns their count.
