@@ -391,11 +391,11 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
   const std::vector<WeightKey>& keys = table.keys;
   std::vector<uint32_t> keyOf(G);
   // Each group's cleaned weights, kept on the rig (`slots` joints, `slots` weights, a count).
-  cleanGroupWeights(rig);
-  const uint32_t slots = rig.influenceSlots;
-  const std::vector<uint32_t>& cleanJoints = rig.cleanJoint;
-  const std::vector<float>& cleanWeightsOf = rig.cleanWeight;
-  const std::vector<uint8_t>& cleanCount = rig.cleanCount;
+  const WeightGroups& groups = weightGroupsOf(rig);
+  const uint32_t slots = groups.slots;
+  const std::vector<uint32_t>& cleanJoints = groups.joint;
+  const std::vector<float>& cleanWeightsOf = groups.weight;
+  const std::vector<uint8_t>& cleanCount = groups.count;
   for (uint32_t g = 0; g < G; ++g) {
     const uint32_t* joint = &cleanJoints[size_t(g) * slots];
     const float* weight = &cleanWeightsOf[size_t(g) * slots];
@@ -504,17 +504,24 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     }
     return rigidKey[j];
   };
-  cleanGroupWeights(rig);  // each group's cleaned weights, kept on the rig
-  const uint32_t slots = rig.influenceSlots;
+  const WeightGroups& groups = weightGroupsOf(rig);  // each group's cleaned weights, kept on the rig
+  const uint32_t slots = groups.slots;
+  // The node of a two-joint group at level l > 0 depends on its ordered pair (d, other) and l
+  // only: its other joint's share is w_o / s · 8l with s = 1 − w_d = w_o to a few ulps (d weighs
+  // at least 1/2, so 1 − w_d is exact), which the largest remainder rounds to 8l. So each (pair,
+  // level) is looked up once (while the table stays in proportion to the groups).
+  const uint32_t levels = Q + 1;
+  const bool byPair = groups.pairs.size() * levels <= size_t(G) + 4096;
+  std::vector<uint32_t> pairNode(byPair ? groups.pairs.size() * levels : 0, ~0u);
   std::vector<uint32_t> lowKey(G), highKey(G), thirdKey(G);
   blendOfGroup.assign(G, 0.0f);
   blendThirdOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
     uint32_t joint[kMaxInfluences] = {};
     float weight[kMaxInfluences] = {};
-    const uint32_t n = rig.cleanCount[g];
-    std::memcpy(joint, &rig.cleanJoint[size_t(g) * slots], n * sizeof(uint32_t));
-    std::memcpy(weight, &rig.cleanWeight[size_t(g) * slots], n * sizeof(float));
+    const uint32_t n = groups.count[g];
+    for (uint32_t i = 0; i < n; ++i)
+      joint[i] = groups.joint[size_t(g) * slots + i], weight[i] = groups.weight[size_t(g) * slots + i];
     if (n == 3) {
       // One triangulation per joint triple: the joints in a fixed order (by index).
       for (uint32_t i = 1; i < 3; ++i)
@@ -540,8 +547,10 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     const uint32_t level = std::min(uint32_t(std::floor(x)), Q);
     const float frac = x - float(level);
     // The node at level l: d keeps 8·(Q − l) units, the shape u's 8·l units go by largest remainders.
+    uint32_t* pairLevels = byPair && groups.pairOf[g] != ~0u ? &pairNode[size_t(groups.pairOf[g]) * levels] : nullptr;
     auto nodeKey = [&](uint32_t l) {
       if (l == 0) return rigidId(joint[d]);  // the key below would reduce to it (canonical)
+      if (pairLevels && pairLevels[l] != ~0u) return pairLevels[l];
       WeightKey key;
       key.n = n;
       const uint32_t units = 8 * l;
@@ -562,7 +571,9 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
         ++key.q[best], rem[best] = -1.0f, ++used;
       }
       key.q[d] = 8 * (Q - l);
-      return keyId(key);
+      const uint32_t id = keyId(key);
+      if (pairLevels) pairLevels[l] = id;
+      return id;
     };
     lowKey[g] = nodeKey(level);
     highKey[g] = thirdKey[g] = lowKey[g];

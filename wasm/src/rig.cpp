@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <unordered_map>
 #include "error.h"
 
 namespace gcs {
@@ -67,19 +68,30 @@ void weldRig(const Rig& rig) {
   rig.welded = true;  // (after both: a failed allocation leaves no half cache)
 }
 
-void cleanGroupWeights(const Rig& rig) {
-  if (rig.cleaned) return;
+const WeightGroups& weightGroupsOf(const Rig& rig) {
+  if (rig.weightGroups) return *rig.weightGroups;
   weldRig(rig);
-  const size_t G = rig.weldRepresentative.size(), slots = rig.influenceSlots;
-  std::vector<uint32_t> joint(G * slots);
-  std::vector<float> weight(G * slots);
-  std::vector<uint8_t> count(G);
-  for (size_t g = 0; g < G; ++g)
-    count[g] = uint8_t(cleanWeights(rig, rig.weldRepresentative[g], &joint[g * slots], &weight[g * slots]));
-  rig.cleanJoint.swap(joint);
-  rig.cleanWeight.swap(weight);
-  rig.cleanCount.swap(count);
-  rig.cleaned = true;
+  auto groups = std::make_shared<WeightGroups>();
+  WeightGroups& w = *groups;
+  const size_t G = rig.weldRepresentative.size(), slots = w.slots = rig.influenceSlots;
+  w.joint.resize(G * slots);
+  w.weight.resize(G * slots);
+  w.count.resize(G);
+  w.pairOf.assign(G, ~0u);
+  std::unordered_map<uint64_t, uint32_t> pairIndex;
+  for (size_t g = 0; g < G; ++g) {
+    const uint32_t* joint = &w.joint[g * slots];
+    const float* weight = &w.weight[g * slots];
+    const uint32_t n = w.count[g] = uint8_t(cleanWeights(rig, rig.weldRepresentative[g], &w.joint[g * slots], &w.weight[g * slots]));
+    if (n != 2) continue;
+    const uint32_t d = weight[1] > weight[0] ? 1 : 0;  // the first of equal weights, as buildWeightNodes
+    const uint64_t key = uint64_t(joint[d]) << 32 | joint[1 - d];
+    auto it = pairIndex.emplace(key, uint32_t(w.pairs.size())).first;
+    if (it->second == w.pairs.size()) w.pairs.push_back(glm::uvec2(joint[d], joint[1 - d]));
+    w.pairOf[g] = it->second;
+  }
+  rig.weightGroups = std::move(groups);
+  return *rig.weightGroups;
 }
 
 uint32_t Rig::dominantJoint(uint32_t v) const {

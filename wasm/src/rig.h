@@ -10,6 +10,19 @@ namespace gcs {
 
 struct CentreSurface;
 
+// Each welded group's weights as cleanWeights gives them (`slots` entries per group, count[g]
+// used) and, for a group of exactly two joints, the index of its ordered pair (dominant joint,
+// other joint; the dominant as the weights criterion picks it) in `pairs`, else ~0u. No section
+// count changes any of it: computed by the first weights-criterion build and kept on the rig.
+struct WeightGroups {
+  uint32_t slots = 4;
+  std::vector<uint32_t> joint;
+  std::vector<float> weight;
+  std::vector<uint8_t> count;
+  std::vector<uint32_t> pairOf;
+  std::vector<glm::uvec2> pairs;
+};
+
 constexpr uint32_t kMaxInfluences = GCS_MAX_INFLUENCES;  // per vertex, and so per section
 
 struct Rig {
@@ -42,12 +55,8 @@ struct Rig {
   // change, and the sliders rebuild the same rig again and again.
   mutable std::vector<uint32_t> weldGroup, weldRepresentative;
   mutable bool welded = false;
-  // cleanWeights of each welded group's first vertex (influenceSlots entries per group, `count`
-  // used), computed by the first weights-criterion build and kept: no section count changes them.
-  mutable std::vector<uint32_t> cleanJoint;
-  mutable std::vector<float> cleanWeight;
-  mutable std::vector<uint8_t> cleanCount;
-  mutable bool cleaned = false;
+  // What the weights criterion reads of each welded group (weightGroupsOf), kept like the weld.
+  mutable std::shared_ptr<const WeightGroups> weightGroups;
   // The surface the centres of rotation integrate over (rotation_centres.h), built by the first
   // build that asks and kept, like the weld.
   mutable std::shared_ptr<const CentreSurface> centreSurface;
@@ -72,8 +81,8 @@ std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& repr
 // Fills the rig's weld cache (weldGroup, weldRepresentative) if it is not yet: the builds that
 // only read it take it from there without a copy.
 void weldRig(const Rig& rig);
-// Fills the rig's cleanJoint / cleanWeight / cleanCount (per welded group) if they are not yet.
-void cleanGroupWeights(const Rig& rig);
+// The rig's WeightGroups, computed by the first call and kept.
+const WeightGroups& weightGroupsOf(const Rig& rig);
 
 // A vertex's skin weights as the GCS criteria read them: influences below 0.5 % dropped (but the
 // largest), the same joint listed twice merged, the rest normalised to sum 1. Returns their count.
