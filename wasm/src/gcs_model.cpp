@@ -83,60 +83,52 @@ struct RunKeyHash {
 // Writes the output mesh run by run: a counting sort of the vertices (stable in vertex order) by
 // their welded group's run, the runs ordered by (section, other, third). A section's vertices are
 // then contiguous, and within it those that blend alike (groupBlendRuns' order, in one pass).
-// `otherOfGroup` / `thirdOfGroup` null: one run per section (no blends). Fills
-// m.sections[i].count/first and, with blends, m.blendRuns; calls perVertex(output, vertex, group)
-// for each vertex. Returns, for each rig vertex, its output index.
+// `runs` in any order; with `blends`, m.blendRuns and the per-vertex blendOther / blendThird are
+// filled from them. Fills m.sections[i].count/first; calls perVertex(output, group) for each
+// vertex. Returns, for each rig vertex, its output index.
 template <class PerVertex>
 std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
-                                 const std::vector<uint32_t>& sectionOfGroup, const uint32_t* otherOfGroup,
-                                 const uint32_t* thirdOfGroup, PerVertex perVertex) {
-  const uint32_t S = uint32_t(m.sections.size()), G = uint32_t(sectionOfGroup.size());
-  // Each group's run: its section, or (with blends) a number of its (section, other, third) ranked by the triple.
-  std::vector<uint32_t> runOfGroup;
-  std::vector<RunKey> runs;
-  if (otherOfGroup) {
-    FlatIndex<RunKey, RunKeyHash> table(S);
-    runOfGroup.resize(G);
-    for (uint32_t g = 0; g < G; ++g) runOfGroup[g] = table.idOf({sectionOfGroup[g], otherOfGroup[g], thirdOfGroup[g]});
-    const uint32_t R = uint32_t(table.keys.size());
-    std::vector<uint32_t> order(R), rank(R);
-    for (uint32_t r = 0; r < R; ++r) order[r] = r;
-    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return table.keys[a] < table.keys[b]; });
-    runs.resize(R);
-    for (uint32_t r = 0; r < R; ++r) rank[order[r]] = r, runs[r] = table.keys[order[r]];
-    for (uint32_t& run : runOfGroup) run = rank[run];
-  }
-  const std::vector<uint32_t>& runOf = otherOfGroup ? runOfGroup : sectionOfGroup;
-  const uint32_t R = otherOfGroup ? uint32_t(runs.size()) : S;
-  std::vector<uint32_t> cursor(R, 0);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++cursor[runOf[group[v]]];
+                                 const std::vector<uint32_t>& runOfGroup, const std::vector<RunKey>& runs, bool blends,
+                                 PerVertex perVertex) {
+  const uint32_t R = uint32_t(runs.size());
+  std::vector<uint32_t> order(R), rank(R);
+  for (uint32_t r = 0; r < R; ++r) order[r] = r;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return runs[a] < runs[b]; });
+  for (uint32_t r = 0; r < R; ++r) rank[order[r]] = r;
+  std::vector<uint32_t> cursor(R, 0);  // per ranked run: its vertex count, then its next output slot
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++cursor[rank[runOfGroup[group[v]]]];
   for (Section& sec : m.sections) sec.count = 0;
   uint32_t first = 0;
   for (uint32_t r = 0; r < R; ++r) {
+    const RunKey& run = runs[order[r]];
     const uint32_t count = cursor[r];
-    m.sections[otherOfGroup ? runs[r].section : r].count += count;
-    if (otherOfGroup) m.blendRuns.push_back({first, count, runs[r].section, runs[r].other, runs[r].third});
+    m.sections[run.section].count += count;
+    if (blends && count) m.blendRuns.push_back({first, count, run.section, run.other, run.third});
     cursor[r] = first;
     first += count;
   }
   first = 0;
   for (Section& sec : m.sections) sec.first = first, first += sec.count;
-  m.allocateOutput(rig.vertexCount);
-  m.restPositions.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-  m.restNormals.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-  m.sourceVertex.resize(rig.vertexCount);
-  m.sectionOfVertex.resize(rig.vertexCount);
-  std::vector<uint32_t> outputOf(rig.vertexCount);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    const uint32_t g = group[v], o = cursor[runOf[g]]++;
+  const uint32_t V = rig.vertexCount;
+  m.allocateOutput(V);
+  m.restPositions.resize(size_t(V) * 3 + 1);
+  m.restNormals.resize(size_t(V) * 3 + 1);
+  m.sourceVertex.resize(V);
+  m.sectionOfVertex.resize(V);
+  if (blends) m.blendOther.resize(V), m.blendThird.resize(V);
+  std::vector<uint32_t> outputOf(V);
+  for (uint32_t v = 0; v < V; ++v) {
+    const uint32_t g = group[v], r = rank[runOfGroup[g]], o = cursor[r]++;
+    const RunKey& run = runs[order[r]];
     outputOf[v] = o;
     m.sourceVertex[o] = v;
-    m.sectionOfVertex[o] = sectionOfGroup[g];
+    m.sectionOfVertex[o] = run.section;
+    if (blends) m.blendOther[o] = run.other, m.blendThird[o] = run.third;
     for (int c = 0; c < 3; ++c) {
       m.restPositions[3 * o + c] = rig.positions[v][c];
       m.restNormals[3 * o + c] = rig.normals[v][c];
     }
-    perVertex(o, v, g);
+    perVertex(o, g);
   }
   m.indices.resize(rig.indices.size());
   for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
@@ -146,7 +138,9 @@ std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::
 // layoutRuns with one run per section (the blends, if any, grouped later: groupBlendRuns).
 std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
                                      const std::vector<uint32_t>& sectionOfGroup) {
-  return layoutRuns(rig, m, group, sectionOfGroup, nullptr, nullptr, [](uint32_t, uint32_t, uint32_t) {});
+  std::vector<RunKey> runs(m.sections.size());
+  for (uint32_t i = 0; i < uint32_t(runs.size()); ++i) runs[i] = {i, i, i};
+  return layoutRuns(rig, m, group, sectionOfGroup, runs, false, [](uint32_t, uint32_t) {});
 }
 
 // Smooth mode: sorts each section's vertices by the section they blend with (a stable counting
@@ -478,11 +472,11 @@ LatticeCell latticeCell(const float (&weight)[kMaxInfluences], uint32_t Q) {
 // (on the human: ~250 nodes instead of ~1,150 for its 1,469 three-joint vertices). Lattice points
 // with a zero weight are the two-joint nodes above (the same keys), so the skin stays seamless
 // where a third joint's weight fades out.
-void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
-                      std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
-                      std::vector<float>& blendOfGroup, std::vector<uint32_t>& thirdOfGroup,
-                      std::vector<float>& blendThirdOfGroup) {
-  const uint32_t G = uint32_t(representative.size());
+//   Output: each group's run (the nodes it blends: own, other, third) as an index into `runs`
+// (section numbers), and its factors towards the other and the third.
+void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>& runOfGroup, std::vector<RunKey>& runs,
+                      std::vector<float>& blendOfGroup, std::vector<float>& blendThirdOfGroup) {
+  const uint32_t G = uint32_t(rig.weldRepresentative.size());
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
   const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
@@ -513,7 +507,11 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
   const uint32_t levels = Q + 1;
   const bool byPair = groups.pairs.size() * levels <= size_t(G) + 4096;
   std::vector<uint32_t> pairNode(byPair ? groups.pairs.size() * levels : 0, ~0u);
-  std::vector<uint32_t> lowKey(G), highKey(G), thirdKey(G);
+  // Runs as key triples (low, high, third), numbered in order of first sight; the run of a rigid
+  // vertex per joint, and of a two-joint group per (pair, level, blends or not), looked up once.
+  FlatIndex<RunKey, RunKeyHash> runTable(size_t(G) / 8);
+  std::vector<uint32_t> rigidRun(rig.jointCount, ~0u), pairRun(pairNode.size() * 2, ~0u);
+  runOfGroup.resize(G);
   blendOfGroup.assign(G, 0.0f);
   blendThirdOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
@@ -522,6 +520,15 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     const uint32_t n = groups.count[g];
     for (uint32_t i = 0; i < n; ++i)
       joint[i] = groups.joint[size_t(g) * slots + i], weight[i] = groups.weight[size_t(g) * slots + i];
+    if (n == 1) {
+      uint32_t& run = rigidRun[joint[0]];
+      if (run == ~0u) {
+        const uint32_t k = rigidId(joint[0]);
+        run = runTable.idOf({k, k, k});
+      }
+      runOfGroup[g] = run;
+      continue;
+    }
     if (n == 3) {
       // One triangulation per joint triple: the joints in a fixed order (by index).
       for (uint32_t i = 1; i < 3; ++i)
@@ -534,7 +541,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
         for (int i = 0; i < 3; ++i) key.joint[i] = joint[i], key.q[i] = 8 * cell.x[c][i];
         ids[c] = keyId(key);
       }
-      lowKey[g] = ids[0], highKey[g] = ids[1], thirdKey[g] = ids[2];
+      runOfGroup[g] = runTable.idOf({ids[0], ids[1], ids[2]});
       blendOfGroup[g] = cell.mu[1];
       blendThirdOfGroup[g] = cell.mu[2];
       continue;
@@ -575,25 +582,26 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
       if (pairLevels) pairLevels[l] = id;
       return id;
     };
-    lowKey[g] = nodeKey(level);
-    highKey[g] = thirdKey[g] = lowKey[g];
-    if (frac > 1e-6f && level < Q) {
-      highKey[g] = nodeKey(level + 1);
-      blendOfGroup[g] = frac;
+    const bool blends = frac > 1e-6f && level < Q;
+    if (blends) blendOfGroup[g] = frac;
+    uint32_t* run = pairLevels ? &pairRun[2 * (size_t(groups.pairOf[g]) * levels + level) + blends] : nullptr;
+    if (run && *run != ~0u) {
+      runOfGroup[g] = *run;
+      continue;
     }
+    const uint32_t low = nodeKey(level), high = blends ? nodeKey(level + 1) : low;
+    runOfGroup[g] = runTable.idOf({low, high, low});
+    if (run) *run = runOfGroup[g];
   }
   // Each node's blend: exactly its key's weights.
   const std::vector<uint32_t> sectionOfKey = sectionsFromKeys(m, keys, [&](uint32_t k, uint32_t slot) {
     return float(keys[k].q[slot]) / float(total);
   });
   const uint32_t K = uint32_t(keys.size());
-  sectionOfGroup.resize(G);
-  otherOfGroup.resize(G);
-  thirdOfGroup.resize(G);
-  for (uint32_t g = 0; g < G; ++g) {
-    sectionOfGroup[g] = sectionOfKey[lowKey[g]];
-    otherOfGroup[g] = sectionOfKey[highKey[g]];
-    thirdOfGroup[g] = sectionOfKey[thirdKey[g]];
+  runs.resize(runTable.keys.size());
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const RunKey& k = runTable.keys[r];
+    runs[r] = {sectionOfKey[k.section], sectionOfKey[k.other], sectionOfKey[k.third]};
   }
   m.partCount = 0;
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
@@ -646,30 +654,25 @@ struct Welded {
 // Weights criterion: sections (plain) or nodes (smooth) from the weights, their centres of
 // rotation, the output layout, the per-vertex blends. False (the error recorded) on failure.
 bool buildWeightsCriterion(const Rig& rig, GcsDeformerImpl& m, const Welded& welded) {
-  const bool smooth = m.settings.smooth;
-  std::vector<uint32_t> sectionOfGroup, otherOfGroup, thirdOfGroup;
-  std::vector<float> blendOfGroup, blendThirdOfGroup;
-  if (smooth)
-    buildWeightNodes(rig, m, welded.representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
-                     blendThirdOfGroup);
-  else buildWeightSections(rig, m, welded.representative, sectionOfGroup);
-  if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
-  if (!smooth) {
+  if (!m.settings.smooth) {
+    std::vector<uint32_t> sectionOfGroup;
+    buildWeightSections(rig, m, welded.representative, sectionOfGroup);
+    if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
     layoutSections(rig, m, welded.group, sectionOfGroup);
     finishModel(m);
     return true;
   }
-  m.blendOther.resize(rig.vertexCount);
+  std::vector<uint32_t> runOfGroup;
+  std::vector<RunKey> runs;
+  std::vector<float> blendOfGroup, blendThirdOfGroup;
+  buildWeightNodes(rig, m, runOfGroup, runs, blendOfGroup, blendThirdOfGroup);
+  if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
   m.blendF.resize(rig.vertexCount);
-  m.blendThird.resize(rig.vertexCount);
   m.blendThirdF.resize(rig.vertexCount);
-  layoutRuns(rig, m, welded.group, sectionOfGroup, otherOfGroup.data(), thirdOfGroup.data(),
-             [&](uint32_t o, uint32_t, uint32_t g) {
-               m.blendOther[o] = otherOfGroup[g];
-               m.blendF[o] = blendOfGroup[g];
-               m.blendThird[o] = thirdOfGroup[g];
-               m.blendThirdF[o] = blendThirdOfGroup[g];
-             });
+  layoutRuns(rig, m, welded.group, runOfGroup, runs, true, [&](uint32_t o, uint32_t g) {
+    m.blendF[o] = blendOfGroup[g];
+    m.blendThirdF[o] = blendThirdOfGroup[g];
+  });
   finishModel(m, true);
   return true;
 }

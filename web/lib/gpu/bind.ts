@@ -62,16 +62,38 @@ function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offs
     : { array: (attr as THREE.BufferAttribute).array as TypedArray, stride: attr.itemSize, offset: 0 };
 }
 
+const BIT_VIEWS: Record<number, (new (buffer: ArrayBufferLike, byteOffset: number, length: number) => TypedArray) | undefined> = {
+  1: Uint8Array, 2: Uint16Array, 4: Uint32Array,
+};
+
+/** out[o · size + k] = array[map[o] · stride + offset + k]. */
+function gather(array: TypedArray, stride: number, offset: number, size: number, map: Uint32Array, out: TypedArray): void {
+  const n = map.length;
+  if (size === 2 && stride === 2 && offset === 0) {
+    for (let o = 0; o < n; o++) {
+      const s = 2 * map[o];
+      out[2 * o] = array[s];
+      out[2 * o + 1] = array[s + 1];
+    }
+    return;
+  }
+  for (let o = 0; o < n; o++) {
+    const s = map[o] * stride + offset;
+    for (let k = 0; k < size; k++) out[o * size + k] = array[s + k];
+  }
+}
+
 /** @internal A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
 export function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
   const { array, stride, offset } = rawArray(attr);
   const size = attr.itemSize;
   const Ctor = array.constructor as new (length: number) => TypedArray;
   const out = new Ctor(map.length * size);
-  for (let o = 0; o < map.length; o++) {
-    const s = map[o] * stride + offset;
-    for (let k = 0; k < size; k++) out[o * size + k] = array[s + k];
-  }
+  // The bits through one unsigned view per element width: the gather loop sees three array
+  // classes in all, not one per attribute type (it runs at every rebuild, for every attribute).
+  const Bits = BIT_VIEWS[array.BYTES_PER_ELEMENT];
+  if (Bits) gather(new Bits(array.buffer, array.byteOffset, array.length), stride, offset, size, map, new Bits(out.buffer, 0, out.length));
+  else gather(array, stride, offset, size, map, out);
   const result = (attr as { isFloat16BufferAttribute?: boolean }).isFloat16BufferAttribute
     ? new THREE.Float16BufferAttribute(out as Uint16Array, size, attr.normalized)
     : new THREE.BufferAttribute(out, size, attr.normalized);
