@@ -55,7 +55,7 @@ class FlatIndex {
     while (slots[i]) i = (i + 1) & mask;
     slots[i] = id;
   }
-  void grow(size_t count) {  // to a table at most an eighth full, every key placed again
+  void grow(size_t count) {  // kept at most a quarter full: regrown to an eighth, every key placed again
     size_t size = 64;
     while (size < 8 * count) size *= 2;
     slots.assign(size, 0);
@@ -338,13 +338,20 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
   const uint32_t K = uint32_t(keys.size());
   std::vector<uint32_t> order(K);
   for (uint32_t k = 0; k < K; ++k) order[k] = k;
-  auto rank = [&](uint32_t k) {
-    const WeightKey& key = keys[k];
-    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
-                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3], key.joint[4], key.q[4],
-                           key.joint[5], key.q[5], key.joint[6], key.q[6], key.joint[7], key.q[7]);
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
+  // By (dominant joint, rigid core first, joint count, then joints and weights slot by slot).
+  std::vector<uint32_t> dominantJoint(K);
+  for (uint32_t k = 0; k < K; ++k) dominantJoint[k] = keys[k].joint[keys[k].dominant()];
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const WeightKey &x = keys[a], &y = keys[b];
+    if (dominantJoint[a] != dominantJoint[b]) return dominantJoint[a] < dominantJoint[b];
+    if ((x.n == 1) != (y.n == 1)) return x.n == 1;
+    if (x.n != y.n) return x.n < y.n;
+    for (uint32_t i = 0; i < kMaxInfluences; ++i) {
+      if (x.joint[i] != y.joint[i]) return x.joint[i] < y.joint[i];
+      if (x.q[i] != y.q[i]) return x.q[i] < y.q[i];
+    }
+    return false;
+  });
   std::vector<uint32_t> sectionOfKey(K);
   m.sections.resize(K);
   m.influences.clear();
@@ -381,7 +388,7 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
                          std::vector<uint32_t>& sectionOfGroup) {
   const uint32_t G = uint32_t(representative.size());
   const uint32_t Q = 2 * (m.settings.sections - 2);
-  FlatIndex<WeightKey, WeightKeyHash> table(size_t(G) / 8);
+  FlatIndex<WeightKey, WeightKeyHash> table(256);  // sections are far fewer than vertices (it grows)
   const std::vector<WeightKey>& keys = table.keys;
   std::vector<uint32_t> keyOf(G);
   // Each group's cleaned weights, kept on the rig (`slots` joints, `slots` weights, a count).
@@ -480,7 +487,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>&
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
   const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
-  FlatIndex<WeightKey, WeightKeyHash> table(size_t(G) / 8);  // nodes are far fewer than vertices
+  FlatIndex<WeightKey, WeightKeyHash> table(256);  // nodes are far fewer than vertices (it grows)
   const std::vector<WeightKey>& keys = table.keys;
   auto keyId = [&](WeightKey key) {
     key.canonical(total);
@@ -509,7 +516,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>&
   std::vector<uint32_t> pairNode(byPair ? groups.pairs.size() * levels : 0, ~0u);
   // Runs as key triples (low, high, third), numbered in order of first sight; the run of a rigid
   // vertex per joint, and of a two-joint group per (pair, level, blends or not), looked up once.
-  FlatIndex<RunKey, RunKeyHash> runTable(size_t(G) / 8);
+  FlatIndex<RunKey, RunKeyHash> runTable(1024);
   std::vector<uint32_t> rigidRun(rig.jointCount, ~0u), pairRun(pairNode.size() * 2, ~0u);
   runOfGroup.resize(G);
   blendOfGroup.assign(G, 0.0f);
