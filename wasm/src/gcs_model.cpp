@@ -110,7 +110,7 @@ std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::
   first = 0;
   for (Section& sec : m.sections) sec.first = first, first += sec.count;
   const uint32_t V = rig.vertexCount;
-  m.allocateOutput(V);
+  m.vertexCount = V;  // the output arrays: finishModel copies the rest pose into them
   m.restPositions.resize(size_t(V) * 3 + 1);
   m.restNormals.resize(size_t(V) * 3 + 1);
   m.sourceVertex.resize(V);
@@ -280,8 +280,8 @@ void finishModel(GcsDeformerImpl& m, bool runsGrouped = false) {
     const Section& sec = m.sections[m.blendedSections[b]];
     if (sec.aboutCentre) m.nodeCentre[b] = glm::vec4(sec.rotationCentre, 1.0f);
   }
-  std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
-  std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
+  m.positions = m.restPositions;
+  m.normals = m.restNormals;
 }
 
 // A section key of the weights criterion: up to 8 (joint, quantised weight) pairs sorted by joint.
