@@ -142,7 +142,7 @@ function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint3
     geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
     if (sourceVertex) {
       for (const [name, attr] of Object.entries(src.attributes))
-        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, deformer));
       // The deformer's own tangent output (xyz turned, w carried), drawn in place like positions.
       const tangents = deformer.tangents;
       if (tangents) geometry.setAttribute('tangent', new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage));
