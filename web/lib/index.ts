@@ -568,6 +568,11 @@ export class Deformer {
     return ptr ? this.gcs.viewU32(ptr, this.vertexCount).slice() : null;
   }
 
+  /** @internal True when every output vertex is a rig vertex (sourceVertex is not null), without copying them. */
+  get keepsVertices(): boolean {
+    return this.gcs.core.gcs_deformer_source_vertex(this.live()) !== 0;
+  }
+
   /**
    * @internal Per-vertex data of the rig's vertices in this deformer's output order: `source`
    * holds `count` items `strideBytes` apart, `itemBytes` each; item o of the result is item
