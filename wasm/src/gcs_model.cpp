@@ -83,13 +83,14 @@ struct RunKeyHash {
 // Writes the output mesh run by run: a counting sort of the vertices (stable in vertex order) by
 // their welded group's run, the runs ordered by (section, other, third). A section's vertices are
 // then contiguous, and within it those that blend alike (groupBlendRuns' order, in one pass).
-// `runs` in any order; with `blends`, m.blendRuns and the per-vertex blendOther / blendThird are
-// filled from them. Fills m.sections[i].count/first; calls perVertex(output, group) for each
-// vertex. Returns, for each rig vertex, its output index.
-template <class PerVertex>
+// `runs` in any order. With blends (`blendOfGroup` and `blendThirdOfGroup` not null: each group's
+// factors towards its run's other and third), m.blendRuns and the per-vertex blendOther, blendF,
+// blendThird, blendThirdF are filled too. Fills m.sections[i].count/first. Returns, for each rig
+// vertex, its output index.
 std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
-                                 const std::vector<uint32_t>& runOfGroup, const std::vector<RunKey>& runs, bool blends,
-                                 PerVertex perVertex) {
+                                 const std::vector<uint32_t>& runOfGroup, const std::vector<RunKey>& runs,
+                                 const float* blendOfGroup, const float* blendThirdOfGroup) {
+  const bool blends = blendOfGroup != nullptr;
   const uint32_t R = uint32_t(runs.size());
   std::vector<uint32_t> order(R), rank(R);
   for (uint32_t r = 0; r < R; ++r) order[r] = r;
@@ -115,7 +116,7 @@ std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::
   m.restNormals.resize(size_t(V) * 3 + 1);
   m.sourceVertex.resize(V);
   m.sectionOfVertex.resize(V);
-  if (blends) m.blendOther.resize(V), m.blendThird.resize(V);
+  if (blends) m.blendOther.resize(V), m.blendThird.resize(V), m.blendF.resize(V), m.blendThirdF.resize(V);
   std::vector<uint32_t> outputOf(V);
   for (uint32_t v = 0; v < V; ++v) {
     const uint32_t g = group[v], r = rank[runOfGroup[g]], o = cursor[r]++;
@@ -123,12 +124,14 @@ std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::
     outputOf[v] = o;
     m.sourceVertex[o] = v;
     m.sectionOfVertex[o] = run.section;
-    if (blends) m.blendOther[o] = run.other, m.blendThird[o] = run.third;
+    if (blends) {
+      m.blendOther[o] = run.other, m.blendF[o] = blendOfGroup[g];
+      m.blendThird[o] = run.third, m.blendThirdF[o] = blendThirdOfGroup[g];
+    }
     for (int c = 0; c < 3; ++c) {
       m.restPositions[3 * o + c] = rig.positions[v][c];
       m.restNormals[3 * o + c] = rig.normals[v][c];
     }
-    perVertex(o, g);
   }
   m.indices.resize(rig.indices.size());
   for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
@@ -140,7 +143,7 @@ std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const s
                                      const std::vector<uint32_t>& sectionOfGroup) {
   std::vector<RunKey> runs(m.sections.size());
   for (uint32_t i = 0; i < uint32_t(runs.size()); ++i) runs[i] = {i, i, i};
-  return layoutRuns(rig, m, group, sectionOfGroup, runs, false, [](uint32_t, uint32_t) {});
+  return layoutRuns(rig, m, group, sectionOfGroup, runs, nullptr, nullptr);
 }
 
 // Smooth mode: sorts each section's vertices by the section they blend with (a stable counting
@@ -330,15 +333,12 @@ struct WeightKeyHash {
   }
 };
 
-// The sections of the weights criterion from their keys, ordered by dominant joint, its rigid core
-// first, then by key (a part is contiguous); `weightOf(key, slot)` is the blend weight of the key's
-// joint in that slot (ignored for a rigid core: weight 1). Returns each key's section index.
-template <class WeightOf>
-std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<WeightKey>& keys, WeightOf weightOf) {
+// The keys in section order: by dominant joint, its rigid core first, then by joint count, then
+// joints and weights slot by slot (a part is contiguous).
+std::vector<uint32_t> sectionOrder(const std::vector<WeightKey>& keys) {
   const uint32_t K = uint32_t(keys.size());
   std::vector<uint32_t> order(K);
   for (uint32_t k = 0; k < K; ++k) order[k] = k;
-  // By (dominant joint, rigid core first, joint count, then joints and weights slot by slot).
   std::vector<uint32_t> dominantJoint(K);
   for (uint32_t k = 0; k < K; ++k) dominantJoint[k] = keys[k].joint[keys[k].dominant()];
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
@@ -352,6 +352,16 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
     }
     return false;
   });
+  return order;
+}
+
+// The sections of the weights criterion from their keys, ordered by dominant joint, its rigid core
+// first, then by key (a part is contiguous); `weightOf(key, slot)` is the blend weight of the key's
+// joint in that slot (ignored for a rigid core: weight 1). Returns each key's section index.
+template <class WeightOf>
+std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<WeightKey>& keys, WeightOf weightOf) {
+  const uint32_t K = uint32_t(keys.size());
+  const std::vector<uint32_t> order = sectionOrder(keys);
   std::vector<uint32_t> sectionOfKey(K);
   m.sections.resize(K);
   m.influences.clear();
@@ -674,12 +684,7 @@ bool buildWeightsCriterion(const Rig& rig, GcsDeformerImpl& m, const Welded& wel
   std::vector<float> blendOfGroup, blendThirdOfGroup;
   buildWeightNodes(rig, m, runOfGroup, runs, blendOfGroup, blendThirdOfGroup);
   if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
-  m.blendF.resize(rig.vertexCount);
-  m.blendThirdF.resize(rig.vertexCount);
-  layoutRuns(rig, m, welded.group, runOfGroup, runs, true, [&](uint32_t o, uint32_t g) {
-    m.blendF[o] = blendOfGroup[g];
-    m.blendThirdF[o] = blendThirdOfGroup[g];
-  });
+  layoutRuns(rig, m, welded.group, runOfGroup, runs, blendOfGroup.data(), blendThirdOfGroup.data());
   finishModel(m, true);
   return true;
 }

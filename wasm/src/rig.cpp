@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstring>
 #include <new>
-#include <unordered_map>
 #include "error.h"
 
 namespace gcs {
@@ -78,17 +77,20 @@ const WeightGroups& weightGroupsOf(const Rig& rig) {
   w.weight.resize(G * slots);
   w.count.resize(G);
   w.pairOf.assign(G, ~0u);
-  std::unordered_map<uint64_t, uint32_t> pairIndex;
+  std::vector<std::pair<uint64_t, uint32_t>> twoJoints;  // (dominant << 32 | other, group)
   for (size_t g = 0; g < G; ++g) {
     const uint32_t* joint = &w.joint[g * slots];
     const float* weight = &w.weight[g * slots];
     const uint32_t n = w.count[g] = uint8_t(cleanWeights(rig, rig.weldRepresentative[g], &w.joint[g * slots], &w.weight[g * slots]));
     if (n != 2) continue;
     const uint32_t d = weight[1] > weight[0] ? 1 : 0;  // the first of equal weights, as buildWeightNodes
-    const uint64_t key = uint64_t(joint[d]) << 32 | joint[1 - d];
-    auto it = pairIndex.emplace(key, uint32_t(w.pairs.size())).first;
-    if (it->second == w.pairs.size()) w.pairs.push_back(glm::uvec2(joint[d], joint[1 - d]));
-    w.pairOf[g] = it->second;
+    twoJoints.push_back({uint64_t(joint[d]) << 32 | joint[1 - d], uint32_t(g)});
+  }
+  std::sort(twoJoints.begin(), twoJoints.end());
+  for (size_t i = 0; i < twoJoints.size(); ++i) {
+    const uint64_t pair = twoJoints[i].first;
+    if (i == 0 || pair != twoJoints[i - 1].first) w.pairs.push_back(glm::uvec2(uint32_t(pair >> 32), uint32_t(pair)));
+    w.pairOf[twoJoints[i].second] = uint32_t(w.pairs.size() - 1);
   }
   rig.weightGroups = std::move(groups);
   return *rig.weightGroups;
