@@ -160,3 +160,24 @@ describe('per-frame input', () => {
     expectGcsError(() => rig.buildGcs(), 'DISPOSED', /disposed/);
   });
 });
+
+describe('vertex data gathered into the output order (what the adapters carry: uv, colours…)', () => {
+  test('a source shorter than the rig, or a deformer without source vertices, is refused; the deformer stays usable', () => {
+    const tube = makeTube();
+    const rig = gcs.createRig(tube.input);
+    const d = rig.buildGcs({});
+    const V = tube.input.positions.length / 3;
+    const ids = new Float32Array(V).map((_, i) => i);
+    const bytes = (a: Float32Array) => new Uint8Array(a.buffer);
+    const gathered = new Float32Array(d.gather(bytes(ids), V, 4, 4).buffer);
+    expect(Array.from(gathered)).toEqual(Array.from(d.sourceVertex!)); // item o is source item sourceVertex[o]
+    expectGcsError(() => d.gather(bytes(ids.subarray(0, V - 1).slice()), V - 1, 4, 4), 'INVALID_ARGUMENT', /past the/);
+    expectGcsError(() => d.gather(bytes(ids), V, 4, 8), 'INVALID_ARGUMENT', /itemBytes/);
+    d.deform(tubeSkin(new THREE.Matrix4()));
+    const classic = rig.buildClassic({});
+    expectGcsError(() => classic.gather(bytes(ids), V, 4, 4), 'INVALID_ARGUMENT', /source vertices/);
+    classic.dispose();
+    d.dispose();
+    rig.dispose();
+  });
+});

@@ -278,6 +278,15 @@ const uint32_t* gcs_deformer_indices(const GcsDeformer* deformer);
 /* For each output vertex, the rig vertex it comes from; null for resampled (classic) vertices
    that come from no rig vertex (there, see gcs_deformer_source_part). */
 const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* deformer);
+/*
+ * Vertex data in the output order: item o of `out` (vertexCount items of itemBytes bytes) is item
+ * gcs_deformer_source_vertex[o] of `source`, whose sourceCount items start strideBytes apart (an
+ * interleaved attribute: its stride). What the adapters carry at every build (uv, colours…).
+ * Returns 0 with GCS_ERR_INVALID_ARGUMENT for a deformer without source vertices, itemBytes 0 or
+ * above strideBytes, or a source vertex ≥ sourceCount (nothing written then).
+ */
+int gcs_deformer_gather(const GcsDeformer* deformer, const void* source, uint32_t sourceCount, uint32_t strideBytes,
+                        uint32_t itemBytes, void* out);
 
 /*
  * Per-deformer statistics (a float per query; unknown queries return NaN, no error).

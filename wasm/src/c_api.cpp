@@ -273,6 +273,32 @@ const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* d) {
   return d && !d->impl->sourceVertex.empty() ? d->impl->sourceVertex.data() : nullptr;
 }
 
+int gcs_deformer_gather(const GcsDeformer* d, const void* source, uint32_t sourceCount, uint32_t strideBytes,
+                        uint32_t itemBytes, void* out) {
+  gcs::clearError();
+  if (!d || d->impl->sourceVertex.empty() || !source || !out || itemBytes == 0 || itemBytes > strideBytes)
+    return fail(GCS_ERR_INVALID_ARGUMENT, "gather needs a deformer with source vertices, a source and an output, and 0 < itemBytes <= strideBytes");
+  const std::vector<uint32_t>& from = d->impl->sourceVertex;
+  for (uint32_t v : from)
+    if (v >= sourceCount) return fail(GCS_ERR_INVALID_ARGUMENT, "gather: source vertex %u is past the %u items given", v, sourceCount);
+  const auto* src = static_cast<const uint8_t*>(source);
+  auto* dst = static_cast<uint8_t*>(out);
+  const size_t n = from.size();
+  // Whole 32-bit words where the layout allows (every float or 32-bit attribute), else bytes.
+  if (itemBytes % 4 == 0 && strideBytes % 4 == 0 && reinterpret_cast<uintptr_t>(src) % 4 == 0 &&
+      reinterpret_cast<uintptr_t>(dst) % 4 == 0) {
+    const uint32_t words = itemBytes / 4, stride = strideBytes / 4;
+    const auto* s32 = reinterpret_cast<const uint32_t*>(src);
+    auto* d32 = reinterpret_cast<uint32_t*>(dst);
+    for (size_t o = 0; o < n; ++o)
+      for (uint32_t k = 0; k < words; ++k) d32[o * words + k] = s32[size_t(from[o]) * stride + k];
+  } else {
+    for (size_t o = 0; o < n; ++o)
+      for (uint32_t k = 0; k < itemBytes; ++k) dst[o * itemBytes + k] = src[size_t(from[o]) * strideBytes + k];
+  }
+  return 1;
+}
+
 float gcs_deformer_stat(const GcsDeformer* d, uint32_t stat) {
   return d && stat <= GCS_STAT_ADJUSTED_SECTIONS ? d->impl->stat(GcsStat(stat)) : std::nanf("");
 }

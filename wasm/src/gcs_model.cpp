@@ -4,7 +4,6 @@
 #include <cstring>
 #include <new>
 #include <tuple>
-#include <unordered_map>
 #include "error.h"
 #include "rotation_centres.h"
 
@@ -28,30 +27,107 @@ struct Branch {
   float sProximal = 0.0f, sDistal = 1.0f;
 };
 
-// Writes the output mesh section by section (a counting sort of the vertices by section) given
-// each welded group's section; m.sections[i].count/first are filled here. Returns, for each rig
+// The distinct keys of a build, numbered in order of first sight: open addressing over a
+// power-of-two table of key numbers (a node-based map allocates per key and chases pointers; the
+// default build looks up two or three keys per welded vertex on every slider step).
+template <class Key, class Hash>
+class FlatIndex {
+ public:
+  explicit FlatIndex(size_t expected) { grow(expected); }
+  uint32_t idOf(const Key& key) {
+    const size_t h = Hash()(key);
+    for (size_t i = h & mask;; i = (i + 1) & mask) {
+      const uint32_t id = slots[i];
+      if (id == 0) break;
+      if (hashes[id - 1] == h && keys[id - 1] == key) return id - 1;
+    }
+    keys.push_back(key);
+    hashes.push_back(h);
+    if (4 * keys.size() > slots.size()) grow(keys.size());
+    else place(uint32_t(keys.size()), h);
+    return uint32_t(keys.size() - 1);
+  }
+  std::vector<Key> keys;
+
+ private:
+  void place(uint32_t id, size_t h) {
+    size_t i = h & mask;
+    while (slots[i]) i = (i + 1) & mask;
+    slots[i] = id;
+  }
+  void grow(size_t count) {  // kept at most a quarter full: regrown to an eighth, every key placed again
+    size_t size = 64;
+    while (size < 8 * count) size *= 2;
+    slots.assign(size, 0);
+    mask = size - 1;
+    for (size_t k = 0; k < keys.size(); ++k) place(uint32_t(k + 1), hashes[k]);
+  }
+  std::vector<uint32_t> slots;  // key number + 1, 0 empty
+  std::vector<size_t> hashes;   // per key
+  size_t mask = 0;
+};
+
+// An output run: the vertices of one section that blend with the same other sections.
+struct RunKey {
+  uint32_t section = 0, other = 0, third = 0;
+  bool operator==(const RunKey& o) const { return section == o.section && other == o.other && third == o.third; }
+  bool operator<(const RunKey& o) const { return std::tie(section, other, third) < std::tie(o.section, o.other, o.third); }
+};
+struct RunKeyHash {
+  size_t operator()(const RunKey& k) const {
+    uint64_t h = (uint64_t(k.other) << 32 | k.third) * 0x9e3779b97f4a7c15ull ^ uint64_t(k.section) * 0xbf58476d1ce4e5b9ull;
+    return size_t(h ^ (h >> 29));
+  }
+};
+
+// Writes the output mesh run by run: a counting sort of the vertices (stable in vertex order) by
+// their welded group's run, the runs ordered by (section, other, third). A section's vertices are
+// then contiguous, and within it those that blend alike (groupBlendRuns' order, in one pass).
+// `runs` in any order. With blends (`blendOfGroup` and `blendThirdOfGroup` not null: each group's
+// factors towards its run's other and third), m.blendRuns and the per-vertex blendOther, blendF,
+// blendThird, blendThirdF are filled too. Fills m.sections[i].count/first. Returns, for each rig
 // vertex, its output index.
-std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
-                                     const std::vector<uint32_t>& sectionOfGroup) {
-  const uint32_t S = uint32_t(m.sections.size());
+std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
+                                 const std::vector<uint32_t>& runOfGroup, const std::vector<RunKey>& runs,
+                                 const float* blendOfGroup, const float* blendThirdOfGroup) {
+  const bool blends = blendOfGroup != nullptr;
+  const uint32_t R = uint32_t(runs.size());
+  std::vector<uint32_t> order(R), rank(R);
+  for (uint32_t r = 0; r < R; ++r) order[r] = r;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return runs[a] < runs[b]; });
+  for (uint32_t r = 0; r < R; ++r) rank[order[r]] = r;
+  std::vector<uint32_t> cursor(R, 0);  // per ranked run: its vertex count, then its next output slot
+  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++cursor[rank[runOfGroup[group[v]]]];
   for (Section& sec : m.sections) sec.count = 0;
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) ++m.sections[sectionOfGroup[group[v]]].count;
   uint32_t first = 0;
+  for (uint32_t r = 0; r < R; ++r) {
+    const RunKey& run = runs[order[r]];
+    const uint32_t count = cursor[r];
+    m.sections[run.section].count += count;
+    if (blends && count) m.blendRuns.push_back({first, count, run.section, run.other, run.third});
+    cursor[r] = first;
+    first += count;
+  }
+  first = 0;
   for (Section& sec : m.sections) sec.first = first, first += sec.count;
-  m.allocateOutput(rig.vertexCount);
-  m.restPositions.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-  m.restNormals.assign(size_t(rig.vertexCount) * 3 + 1, 0.0f);
-  m.sourceVertex.resize(rig.vertexCount);
-  m.sectionOfVertex.resize(rig.vertexCount);
-  std::vector<uint32_t> cursor(S);
-  for (uint32_t i = 0; i < S; ++i) cursor[i] = m.sections[i].first;
-  std::vector<uint32_t> outputOf(rig.vertexCount);
-  for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-    uint32_t sec = sectionOfGroup[group[v]];
-    uint32_t o = cursor[sec]++;
+  const uint32_t V = rig.vertexCount;
+  m.vertexCount = V;  // the output arrays: finishModel copies the rest pose into them
+  m.restPositions.resize(size_t(V) * 3 + 1);
+  m.restNormals.resize(size_t(V) * 3 + 1);
+  m.sourceVertex.resize(V);
+  m.sectionOfVertex.resize(V);
+  if (blends) m.blendOther.resize(V), m.blendThird.resize(V), m.blendF.resize(V), m.blendThirdF.resize(V);
+  std::vector<uint32_t> outputOf(V);
+  for (uint32_t v = 0; v < V; ++v) {
+    const uint32_t g = group[v], r = rank[runOfGroup[g]], o = cursor[r]++;
+    const RunKey& run = runs[order[r]];
     outputOf[v] = o;
     m.sourceVertex[o] = v;
-    m.sectionOfVertex[o] = sec;
+    m.sectionOfVertex[o] = run.section;
+    if (blends) {
+      m.blendOther[o] = run.other, m.blendF[o] = blendOfGroup[g];
+      m.blendThird[o] = run.third, m.blendThirdF[o] = blendThirdOfGroup[g];
+    }
     for (int c = 0; c < 3; ++c) {
       m.restPositions[3 * o + c] = rig.positions[v][c];
       m.restNormals[3 * o + c] = rig.normals[v][c];
@@ -60,6 +136,14 @@ std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const s
   m.indices.resize(rig.indices.size());
   for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
   return outputOf;
+}
+
+// layoutRuns with one run per section (the blends, if any, grouped later: groupBlendRuns).
+std::vector<uint32_t> layoutSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& group,
+                                     const std::vector<uint32_t>& sectionOfGroup) {
+  std::vector<RunKey> runs(m.sections.size());
+  for (uint32_t i = 0; i < uint32_t(runs.size()); ++i) runs[i] = {i, i, i};
+  return layoutRuns(rig, m, group, sectionOfGroup, runs, nullptr, nullptr);
 }
 
 // Smooth mode: sorts each section's vertices by the section they blend with (a stable counting
@@ -110,10 +194,11 @@ void groupBlendRuns(GcsDeformerImpl& m) {
 }
 
 // Bounding spheres (for the adjusted-section statistic), the introspection table, the per-frame
-// buffers, and the rest pose in the output.
-void finishModel(GcsDeformerImpl& m) {
+// buffers, and the rest pose in the output. Smooth mode: the blend runs too, unless the layout
+// grouped them (`runsGrouped`).
+void finishModel(GcsDeformerImpl& m, bool runsGrouped = false) {
   const uint32_t S = uint32_t(m.sections.size());
-  if (m.settings.smooth) groupBlendRuns(m);
+  if (m.settings.smooth && !runsGrouped) groupBlendRuns(m);
   m.sectionInfo.resize(size_t(S) * 8);
   for (uint32_t i = 0; i < S; ++i) {
     Section& sec = m.sections[i];
@@ -198,8 +283,8 @@ void finishModel(GcsDeformerImpl& m) {
     const Section& sec = m.sections[m.blendedSections[b]];
     if (sec.aboutCentre) m.nodeCentre[b] = glm::vec4(sec.rotationCentre, 1.0f);
   }
-  std::memcpy(m.positions.data(), m.restPositions.data(), m.restPositions.size() * sizeof(float));
-  std::memcpy(m.normals.data(), m.restNormals.data(), m.restNormals.size() * sizeof(float));
+  m.positions = m.restPositions;
+  m.normals = m.restNormals;
 }
 
 // A section key of the weights criterion: up to 8 (joint, quantised weight) pairs sorted by joint.
@@ -248,21 +333,35 @@ struct WeightKeyHash {
   }
 };
 
+// The keys in section order: by dominant joint, its rigid core first, then by joint count, then
+// joints and weights slot by slot (a part is contiguous).
+std::vector<uint32_t> sectionOrder(const std::vector<WeightKey>& keys) {
+  const uint32_t K = uint32_t(keys.size());
+  std::vector<uint32_t> order(K);
+  for (uint32_t k = 0; k < K; ++k) order[k] = k;
+  std::vector<uint32_t> dominantJoint(K);
+  for (uint32_t k = 0; k < K; ++k) dominantJoint[k] = keys[k].joint[keys[k].dominant()];
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const WeightKey &x = keys[a], &y = keys[b];
+    if (dominantJoint[a] != dominantJoint[b]) return dominantJoint[a] < dominantJoint[b];
+    if ((x.n == 1) != (y.n == 1)) return x.n == 1;
+    if (x.n != y.n) return x.n < y.n;
+    for (uint32_t i = 0; i < kMaxInfluences; ++i) {
+      if (x.joint[i] != y.joint[i]) return x.joint[i] < y.joint[i];
+      if (x.q[i] != y.q[i]) return x.q[i] < y.q[i];
+    }
+    return false;
+  });
+  return order;
+}
+
 // The sections of the weights criterion from their keys, ordered by dominant joint, its rigid core
 // first, then by key (a part is contiguous); `weightOf(key, slot)` is the blend weight of the key's
 // joint in that slot (ignored for a rigid core: weight 1). Returns each key's section index.
 template <class WeightOf>
 std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<WeightKey>& keys, WeightOf weightOf) {
   const uint32_t K = uint32_t(keys.size());
-  std::vector<uint32_t> order(K);
-  for (uint32_t k = 0; k < K; ++k) order[k] = k;
-  auto rank = [&](uint32_t k) {
-    const WeightKey& key = keys[k];
-    return std::make_tuple(key.joint[key.dominant()], key.n == 1 ? 0u : 1u, key.n, key.joint[0], key.q[0], key.joint[1],
-                           key.q[1], key.joint[2], key.q[2], key.joint[3], key.q[3], key.joint[4], key.q[4],
-                           key.joint[5], key.q[5], key.joint[6], key.q[6], key.joint[7], key.q[7]);
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return rank(a) < rank(b); });
+  const std::vector<uint32_t> order = sectionOrder(keys);
   std::vector<uint32_t> sectionOfKey(K);
   m.sections.resize(K);
   m.influences.clear();
@@ -299,19 +398,19 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
                          std::vector<uint32_t>& sectionOfGroup) {
   const uint32_t G = uint32_t(representative.size());
   const uint32_t Q = 2 * (m.settings.sections - 2);
-  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
-  std::vector<WeightKey> keys;
+  FlatIndex<WeightKey, WeightKeyHash> table(256);  // sections are far fewer than vertices (it grows)
+  const std::vector<WeightKey>& keys = table.keys;
   std::vector<uint32_t> keyOf(G);
-  // Each group's cleaned weights, read once (`slots` joints, `slots` weights, a count).
-  const uint32_t slots = rig.influenceSlots;
-  std::vector<uint32_t> cleanJoints(size_t(G) * slots);
-  std::vector<float> cleanWeightsOf(size_t(G) * slots);
-  std::vector<uint8_t> cleanCount(G);
+  // Each group's cleaned weights, kept on the rig (`slots` joints, `slots` weights, a count).
+  const WeightGroups& groups = weightGroupsOf(rig);
+  const uint32_t slots = groups.slots;
+  const std::vector<uint32_t>& cleanJoints = groups.joint;
+  const std::vector<float>& cleanWeightsOf = groups.weight;
+  const std::vector<uint8_t>& cleanCount = groups.count;
   for (uint32_t g = 0; g < G; ++g) {
-    uint32_t* joint = &cleanJoints[size_t(g) * slots];
-    float* weight = &cleanWeightsOf[size_t(g) * slots];
-    uint32_t n = cleanWeights(rig, representative[g], joint, weight);
-    cleanCount[g] = uint8_t(n);
+    const uint32_t* joint = &cleanJoints[size_t(g) * slots];
+    const float* weight = &cleanWeightsOf[size_t(g) * slots];
+    const uint32_t n = cleanCount[g];
     uint32_t d = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (weight[i] > weight[d]) d = i;
@@ -327,12 +426,7 @@ void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<u
     }
     key.q[d] = std::max(others < Q ? Q - others : 0u, std::max(largest, 1u));
     key.canonical(Q);
-    auto it = keyIndex.find(key);
-    if (it == keyIndex.end()) {
-      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
-      keys.push_back(key);
-    }
-    keyOf[g] = it->second;
+    keyOf[g] = table.idOf(key);
   }
   // Mean weights per key on its own joints.
   const uint32_t K = uint32_t(keys.size());
@@ -395,33 +489,63 @@ LatticeCell latticeCell(const float (&weight)[kMaxInfluences], uint32_t Q) {
 // (on the human: ~250 nodes instead of ~1,150 for its 1,469 three-joint vertices). Lattice points
 // with a zero weight are the two-joint nodes above (the same keys), so the skin stays seamless
 // where a third joint's weight fades out.
-void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
-                      std::vector<uint32_t>& sectionOfGroup, std::vector<uint32_t>& otherOfGroup,
-                      std::vector<float>& blendOfGroup, std::vector<uint32_t>& thirdOfGroup,
-                      std::vector<float>& blendThirdOfGroup) {
-  const uint32_t G = uint32_t(representative.size());
+//   Output: each group's run (the nodes it blends: own, other, third) as an index into `runs`
+// (section numbers), and its factors towards the other and the third.
+void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>& runOfGroup, std::vector<RunKey>& runs,
+                      std::vector<float>& blendOfGroup, std::vector<float>& blendThirdOfGroup) {
+  const uint32_t G = uint32_t(rig.weldRepresentative.size());
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
   const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
-  std::unordered_map<WeightKey, uint32_t, WeightKeyHash> keyIndex;
-  keyIndex.reserve(size_t(G) / 4 + 64);  // nodes are far fewer than vertices; no rehash on the way
-  std::vector<WeightKey> keys;
+  FlatIndex<WeightKey, WeightKeyHash> table(256);  // nodes are far fewer than vertices (it grows)
+  const std::vector<WeightKey>& keys = table.keys;
   auto keyId = [&](WeightKey key) {
     key.canonical(total);
-    auto it = keyIndex.find(key);
-    if (it == keyIndex.end()) {
-      it = keyIndex.emplace(key, uint32_t(keys.size())).first;
-      keys.push_back(key);
-    }
-    return it->second;
+    return table.idOf(key);
   };
-  std::vector<uint32_t> lowKey(G), highKey(G), thirdKey(G);
+  // Each joint's rigid core, looked up once (about half the human's welded vertices sit on one).
+  std::vector<uint32_t> rigidKey(rig.jointCount, ~0u);
+  auto rigidId = [&](uint32_t j) {
+    if (rigidKey[j] == ~0u) {
+      WeightKey key;
+      key.n = 1;
+      key.joint[0] = j;
+      key.q[0] = total;
+      rigidKey[j] = keyId(key);
+    }
+    return rigidKey[j];
+  };
+  const WeightGroups& groups = weightGroupsOf(rig);  // each group's cleaned weights, kept on the rig
+  const uint32_t slots = groups.slots;
+  // The node of a two-joint group at level l > 0 depends on its ordered pair (d, other) and l
+  // only: its other joint's share is w_o / s · 8l with s = 1 − w_d = w_o to a few ulps (d weighs
+  // at least 1/2, so 1 − w_d is exact), which the largest remainder rounds to 8l. So each (pair,
+  // level) is looked up once (while the table stays in proportion to the groups).
+  const uint32_t levels = Q + 1;
+  const bool byPair = groups.pairs.size() * levels <= size_t(G) + 4096;
+  std::vector<uint32_t> pairNode(byPair ? groups.pairs.size() * levels : 0, ~0u);
+  // Runs as key triples (low, high, third), numbered in order of first sight; the run of a rigid
+  // vertex per joint, and of a two-joint group per (pair, level, blends or not), looked up once.
+  FlatIndex<RunKey, RunKeyHash> runTable(1024);
+  std::vector<uint32_t> rigidRun(rig.jointCount, ~0u), pairRun(pairNode.size() * 2, ~0u);
+  runOfGroup.resize(G);
   blendOfGroup.assign(G, 0.0f);
   blendThirdOfGroup.assign(G, 0.0f);
   for (uint32_t g = 0; g < G; ++g) {
     uint32_t joint[kMaxInfluences] = {};
     float weight[kMaxInfluences] = {};
-    const uint32_t n = cleanWeights(rig, representative[g], joint, weight);
+    const uint32_t n = groups.count[g];
+    for (uint32_t i = 0; i < n; ++i)
+      joint[i] = groups.joint[size_t(g) * slots + i], weight[i] = groups.weight[size_t(g) * slots + i];
+    if (n == 1) {
+      uint32_t& run = rigidRun[joint[0]];
+      if (run == ~0u) {
+        const uint32_t k = rigidId(joint[0]);
+        run = runTable.idOf({k, k, k});
+      }
+      runOfGroup[g] = run;
+      continue;
+    }
     if (n == 3) {
       // One triangulation per joint triple: the joints in a fixed order (by index).
       for (uint32_t i = 1; i < 3; ++i)
@@ -434,7 +558,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
         for (int i = 0; i < 3; ++i) key.joint[i] = joint[i], key.q[i] = 8 * cell.x[c][i];
         ids[c] = keyId(key);
       }
-      lowKey[g] = ids[0], highKey[g] = ids[1], thirdKey[g] = ids[2];
+      runOfGroup[g] = runTable.idOf({ids[0], ids[1], ids[2]});
       blendOfGroup[g] = cell.mu[1];
       blendThirdOfGroup[g] = cell.mu[2];
       continue;
@@ -447,7 +571,10 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
     const uint32_t level = std::min(uint32_t(std::floor(x)), Q);
     const float frac = x - float(level);
     // The node at level l: d keeps 8·(Q − l) units, the shape u's 8·l units go by largest remainders.
+    uint32_t* pairLevels = byPair && groups.pairOf[g] != ~0u ? &pairNode[size_t(groups.pairOf[g]) * levels] : nullptr;
     auto nodeKey = [&](uint32_t l) {
+      if (l == 0) return rigidId(joint[d]);  // the key below would reduce to it (canonical)
+      if (pairLevels && pairLevels[l] != ~0u) return pairLevels[l];
       WeightKey key;
       key.n = n;
       const uint32_t units = 8 * l;
@@ -468,27 +595,30 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint
         ++key.q[best], rem[best] = -1.0f, ++used;
       }
       key.q[d] = 8 * (Q - l);
-      return keyId(key);
+      const uint32_t id = keyId(key);
+      if (pairLevels) pairLevels[l] = id;
+      return id;
     };
-    lowKey[g] = nodeKey(level);
-    highKey[g] = thirdKey[g] = lowKey[g];
-    if (frac > 1e-6f && level < Q) {
-      highKey[g] = nodeKey(level + 1);
-      blendOfGroup[g] = frac;
+    const bool blends = frac > 1e-6f && level < Q;
+    if (blends) blendOfGroup[g] = frac;
+    uint32_t* run = pairLevels ? &pairRun[2 * (size_t(groups.pairOf[g]) * levels + level) + blends] : nullptr;
+    if (run && *run != ~0u) {
+      runOfGroup[g] = *run;
+      continue;
     }
+    const uint32_t low = nodeKey(level), high = blends ? nodeKey(level + 1) : low;
+    runOfGroup[g] = runTable.idOf({low, high, low});
+    if (run) *run = runOfGroup[g];
   }
   // Each node's blend: exactly its key's weights.
   const std::vector<uint32_t> sectionOfKey = sectionsFromKeys(m, keys, [&](uint32_t k, uint32_t slot) {
     return float(keys[k].q[slot]) / float(total);
   });
   const uint32_t K = uint32_t(keys.size());
-  sectionOfGroup.resize(G);
-  otherOfGroup.resize(G);
-  thirdOfGroup.resize(G);
-  for (uint32_t g = 0; g < G; ++g) {
-    sectionOfGroup[g] = sectionOfKey[lowKey[g]];
-    otherOfGroup[g] = sectionOfKey[highKey[g]];
-    thirdOfGroup[g] = sectionOfKey[thirdKey[g]];
+  runs.resize(runTable.keys.size());
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const RunKey& k = runTable.keys[r];
+    runs[r] = {sectionOfKey[k.section], sectionOfKey[k.other], sectionOfKey[k.third]};
   }
   m.partCount = 0;
   for (uint32_t i = 0; i < K; ++i) m.partCount += i == 0 || m.sections[i].part != m.sections[i - 1].part;
@@ -534,35 +664,28 @@ namespace {
 
 // The welded rig: each vertex's group (vertices at one bind-pose position) and each group's first vertex.
 struct Welded {
-  std::vector<uint32_t> group, representative;
+  const std::vector<uint32_t>& group;
+  const std::vector<uint32_t>& representative;
 };
 
 // Weights criterion: sections (plain) or nodes (smooth) from the weights, their centres of
 // rotation, the output layout, the per-vertex blends. False (the error recorded) on failure.
 bool buildWeightsCriterion(const Rig& rig, GcsDeformerImpl& m, const Welded& welded) {
-  const bool smooth = m.settings.smooth;
-  std::vector<uint32_t> sectionOfGroup, otherOfGroup, thirdOfGroup;
-  std::vector<float> blendOfGroup, blendThirdOfGroup;
-  if (smooth)
-    buildWeightNodes(rig, m, welded.representative, sectionOfGroup, otherOfGroup, blendOfGroup, thirdOfGroup,
-                     blendThirdOfGroup);
-  else buildWeightSections(rig, m, welded.representative, sectionOfGroup);
-  if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
-  const std::vector<uint32_t> outputOf = layoutSections(rig, m, welded.group, sectionOfGroup);
-  if (smooth) {
-    m.blendOther.resize(rig.vertexCount);
-    m.blendF.resize(rig.vertexCount);
-    m.blendThird.resize(rig.vertexCount);
-    m.blendThirdF.resize(rig.vertexCount);
-    for (uint32_t v = 0; v < rig.vertexCount; ++v) {
-      const uint32_t o = outputOf[v], g = welded.group[v];
-      m.blendOther[o] = otherOfGroup[g];
-      m.blendF[o] = blendOfGroup[g];
-      m.blendThird[o] = thirdOfGroup[g];
-      m.blendThirdF[o] = blendThirdOfGroup[g];
-    }
+  if (!m.settings.smooth) {
+    std::vector<uint32_t> sectionOfGroup;
+    buildWeightSections(rig, m, welded.representative, sectionOfGroup);
+    if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
+    layoutSections(rig, m, welded.group, sectionOfGroup);
+    finishModel(m);
+    return true;
   }
-  finishModel(m);
+  std::vector<uint32_t> runOfGroup;
+  std::vector<RunKey> runs;
+  std::vector<float> blendOfGroup, blendThirdOfGroup;
+  buildWeightNodes(rig, m, runOfGroup, runs, blendOfGroup, blendThirdOfGroup);
+  if (m.settings.centres && !placeRotationCentres(rig, m)) return false;
+  layoutRuns(rig, m, welded.group, runOfGroup, runs, blendOfGroup.data(), blendThirdOfGroup.data());
+  finishModel(m, true);
   return true;
 }
 
@@ -889,8 +1012,8 @@ GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
     m.jointCount = rig.jointCount;
     m.jointCentres = rig.jointCentres;
     m.adjustTolerance = 1e-3f * rig.height;
-    Welded welded;
-    welded.group = weldByPosition(rig, welded.representative);
+    weldRig(rig);  // kept on the rig: the sliders rebuild it again and again
+    const Welded welded{rig.weldGroup, rig.weldRepresentative};
     const bool built = settings.criterion == GCS_CRITERION_WEIGHTS ? buildWeightsCriterion(rig, m, welded)
                                                                     : PaperBuild(rig, m, welded).run();
     if (!built) {

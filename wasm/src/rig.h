@@ -10,6 +10,19 @@ namespace gcs {
 
 struct CentreSurface;
 
+// Each welded group's weights as cleanWeights gives them (`slots` entries per group, count[g]
+// used) and, for a group of exactly two joints, the index of its ordered pair (dominant joint,
+// other joint; the dominant as the weights criterion picks it) in `pairs`, else ~0u. No section
+// count changes any of it: computed by the first weights-criterion build and kept on the rig.
+struct WeightGroups {
+  uint32_t slots = 4;
+  std::vector<uint32_t> joint;
+  std::vector<float> weight;
+  std::vector<uint8_t> count;
+  std::vector<uint32_t> pairOf;
+  std::vector<glm::uvec2> pairs;
+};
+
 constexpr uint32_t kMaxInfluences = GCS_MAX_INFLUENCES;  // per vertex, and so per section
 
 struct Rig {
@@ -42,6 +55,8 @@ struct Rig {
   // change, and the sliders rebuild the same rig again and again.
   mutable std::vector<uint32_t> weldGroup, weldRepresentative;
   mutable bool welded = false;
+  // What the weights criterion reads of each welded group (weightGroupsOf), kept like the weld.
+  mutable std::shared_ptr<const WeightGroups> weightGroups;
   // The surface the centres of rotation integrate over (rotation_centres.h), built by the first
   // build that asks and kept, like the weld.
   mutable std::shared_ptr<const CentreSurface> centreSurface;
@@ -63,6 +78,11 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 // each group). Both models group by it, so a seam can never open.
 // (Computed once per rig, then copied from its cache.)
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
+// Fills the rig's weld cache (weldGroup, weldRepresentative) if it is not yet: the builds that
+// only read it take it from there without a copy.
+void weldRig(const Rig& rig);
+// The rig's WeightGroups, computed by the first call and kept.
+const WeightGroups& weightGroupsOf(const Rig& rig);
 
 // A vertex's skin weights as the GCS criteria read them: influences below 0.5 % dropped (but the
 // largest), the same joint listed twice merged, the rest normalised to sum 1. Returns their count.

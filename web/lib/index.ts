@@ -570,6 +570,34 @@ export class Deformer {
     return ptr ? this.gcs.viewU32(ptr, this.vertexCount).slice() : null;
   }
 
+  /** @internal True when every output vertex is a rig vertex (sourceVertex is not null), without copying them. */
+  get keepsVertices(): boolean {
+    return this.gcs.core.gcs_deformer_source_vertex(this.live()) !== 0;
+  }
+
+  /**
+   * @internal Per-vertex data of the rig's vertices in this deformer's output order: `source`
+   * holds `count` items `strideBytes` apart, `itemBytes` each; item o of the result is item
+   * sourceVertex[o]. Gathered in wasm (the adapters carry uv, colours… at every build, a slider
+   * drag every frame). INVALID_ARGUMENT without source vertices or past `count`.
+   */
+  gather(source: Uint8Array, count: number, strideBytes: number, itemBytes: number): Uint8Array {
+    const h = this.live();
+    const core = this.gcs.core;
+    const bytes = this.vertexCount * itemBytes;
+    const src = core.gcs_alloc(Math.max(1, source.byteLength));
+    const out = src ? core.gcs_alloc(Math.max(1, bytes)) : 0;
+    try {
+      if (!out) this.gcs.raise(`out of memory: could not allocate ${source.byteLength + bytes} bytes to gather vertex data`);
+      new Uint8Array(core.memory.buffer, src, source.byteLength).set(source);
+      if (!core.gcs_deformer_gather(h, src, count, strideBytes, itemBytes, out)) this.gcs.raise('the vertex data could not be gathered');
+      return new Uint8Array(core.memory.buffer, out, bytes).slice();
+    } finally {
+      if (src) core.gcs_free(src);
+      if (out) core.gcs_free(out);
+    }
+  }
+
   /**
    * Deforms for one frame from J skinning matrices S_j = posed world · inverse bind (column-major,
    * 16 floats each, bind-pose mesh space → posed mesh space). One copy into wasm, no allocation.

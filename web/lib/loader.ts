@@ -38,6 +38,7 @@ export interface CoreExports {
   gcs_deformer_index_count(d: number): number;
   gcs_deformer_indices(d: number): number;
   gcs_deformer_source_vertex(d: number): number;
+  gcs_deformer_gather(d: number, source: number, sourceCount: number, strideBytes: number, itemBytes: number, out: number): number;
   gcs_deformer_stat(d: number, stat: number): number;
   gcs_gcs_section_of_vertex(d: number): number;
   gcs_gcs_section_info(d: number): number;

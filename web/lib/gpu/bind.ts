@@ -4,7 +4,7 @@
  * per-vertex section data, and the source's other attributes carried in that order.
  */
 import * as THREE from 'three';
-import type { GcsDeformer } from '../index.js';
+import type { Deformer, GcsDeformer } from '../index.js';
 import { sectionAttributes } from './sections.js';
 
 /** Identity skin matrices (the bind pose) for `jointCount` joints, J × 16 floats. */
@@ -37,11 +37,11 @@ export function bindGeometry(deformer: GcsDeformer, jointCount: number, source: 
   const sourceVertex = deformer.sourceVertex;
   if (!sourceVertex) return geometry;
   for (const [key, attr] of Object.entries(source.attributes))
-    if (!SKINNING_ATTRIBUTES.has(key) || (key === 'tangent' && options.tangents)) geometry.setAttribute(key, remapAttribute(attr, sourceVertex));
+    if (!SKINNING_ATTRIBUTES.has(key) || (key === 'tangent' && options.tangents)) geometry.setAttribute(key, remapAttribute(attr, deformer));
   if (options.morphs) {
     for (const key of ['position', 'normal'] as const) {
       const list = source.morphAttributes[key];
-      if (list?.length) geometry.morphAttributes[key] = list.map((a) => remapAttribute(a, sourceVertex));
+      if (list?.length) geometry.morphAttributes[key] = list.map((a) => remapAttribute(a, deformer));
     }
     geometry.morphTargetsRelative = source.morphTargetsRelative;
   }
@@ -62,16 +62,18 @@ function rawArray(attr: AnyAttribute): { array: TypedArray; stride: number; offs
     : { array: (attr as THREE.BufferAttribute).array as TypedArray, stride: attr.itemSize, offset: 0 };
 }
 
-/** @internal A copy of `attr` in output-vertex order (output o takes source vertex map[o]), same type and normalisation. */
-export function remapAttribute(attr: AnyAttribute, map: Uint32Array): THREE.BufferAttribute {
+/**
+ * @internal A copy of `attr` in `deformer`'s output-vertex order (output o takes source vertex
+ * sourceVertex[o]), same type and normalisation: gathered in wasm, so a rebuild runs no loop per
+ * vertex in JavaScript (a slider drag rebuilds every frame).
+ */
+export function remapAttribute(attr: AnyAttribute, deformer: Deformer): THREE.BufferAttribute {
   const { array, stride, offset } = rawArray(attr);
-  const size = attr.itemSize;
-  const Ctor = array.constructor as new (length: number) => TypedArray;
-  const out = new Ctor(map.length * size);
-  for (let o = 0; o < map.length; o++) {
-    const s = map[o] * stride + offset;
-    for (let k = 0; k < size; k++) out[o * size + k] = array[s + k];
-  }
+  const size = attr.itemSize, bytes = array.BYTES_PER_ELEMENT;
+  const Ctor = array.constructor as new (buffer: ArrayBufferLike) => TypedArray;
+  const start = array.byteOffset + offset * bytes;
+  const source = new Uint8Array(array.buffer, start, Math.max(0, (attr.count - 1) * stride + size) * bytes);
+  const out = new Ctor(deformer.gather(source, attr.count, stride * bytes, size * bytes).buffer);
   const result = (attr as { isFloat16BufferAttribute?: boolean }).isFloat16BufferAttribute
     ? new THREE.Float16BufferAttribute(out as Uint16Array, size, attr.normalized)
     : new THREE.BufferAttribute(out, size, attr.normalized);

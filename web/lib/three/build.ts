@@ -72,17 +72,17 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
   const deformer = build(from.rig);
   let gpu: GpuBuild | null = null;
   try {
-    const sourceVertex = deformer.sourceVertex;
+    const keepsVertices = deformer.keepsVertices;
     const morph = method === 'classic' ? null : morphData(from.source.geometry);
     if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
     if (onGpu) {
       gpu = prepareGpu(from, deformer as GcsDeformer, gpuPath === 'auto' ? undefined : gpuPath);
-      const geometry = makeGeometry(from, deformer, sourceVertex, gpu);
+      const geometry = makeGeometry(from, deformer, keepsVertices, gpu);
       return { method, gcs: gcsOptions, classic: classicOptions, deformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
     }
     // The same deform call turns them (the classic model resamples and takes none).
-    if (from.tangents && sourceVertex) deformer.setTangents(from.tangents);
-    const geometry = makeGeometry(from, deformer, sourceVertex, null);
+    if (from.tangents && keepsVertices) deformer.setTangents(from.tangents);
+    const geometry = makeGeometry(from, deformer, keepsVertices, null);
     return { method, gcs: gcsOptions, classic: classicOptions, deformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu: null, note, backend, gpuPath };
   } catch (e) {
     if (gpu) disposeGpu(gpu);
@@ -128,7 +128,7 @@ function prepareGpu(from: BuildSource, deformer: GcsDeformer, path?: GpuPath): G
 }
 
 /** The output geometry of a build: the deformer's buffers (CPU) or the bind pose with section data (GPU), and the source's other attributes. */
-function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint32Array | null, gpu: GpuBuild | null): THREE.BufferGeometry {
+function makeGeometry(from: BuildSource, deformer: Deformer, keepsVertices: boolean, gpu: GpuBuild | null): THREE.BufferGeometry {
   const src = from.source.geometry;
   const indices = deformer.indices;
   let geometry: THREE.BufferGeometry;
@@ -140,9 +140,9 @@ function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint3
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));
     geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
     geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
-    if (sourceVertex) {
+    if (keepsVertices) {
       for (const [name, attr] of Object.entries(src.attributes))
-        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, sourceVertex));
+        if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, deformer));
       // The deformer's own tangent output (xyz turned, w carried), drawn in place like positions.
       const tangents = deformer.tangents;
       if (tangents) geometry.setAttribute('tangent', new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage));
@@ -157,8 +157,9 @@ function makeGeometry(from: BuildSource, deformer: Deformer, sourceVertex: Uint3
   // (Checked only when there are groups, a draw range or several materials: a slider drag rebuilds
   // every frame, and the check reads every index.)
   const ranged = src.groups.length > 0 || src.drawRange.start !== 0 || src.drawRange.count !== Infinity || Array.isArray(from.mesh.material);
-  let sameOrder = !!sourceVertex;
-  if (sourceVertex && ranged) {
+  let sameOrder = keepsVertices;
+  if (keepsVertices && ranged) {
+    const sourceVertex = deformer.sourceVertex!; // a copy: read only here (a slider drag rebuilds every frame)
     const srcIndex = src.index;
     if (srcIndex && indices.length !== srcIndex.count) sameOrder = false;
     const order = srcIndex?.array; // an index attribute is never interleaved
