@@ -895,14 +895,17 @@ void ClassicBuild::contourInfluences() {
       return P.split && m.parts[x].isPart && member(c.part, x);
     };
     const glm::vec3 base = rig.jointCentres[P.joint];
-    if (alongPart != c.part || alongProximal != c.proximal) {
+    // The proximal part widens the set only when it is not the parent already (a contour shared
+    // with the parent has it as its proximal): then the sorted list of the part's others serves.
+    const int32_t proximal = c.proximal >= 0 && c.proximal != P.parent && c.proximal != P.child ? c.proximal : -1;
+    if (alongPart != c.part || alongProximal != proximal) {
       along.clear();
       for (uint32_t x = 0; x < J; ++x)
         if (m.parts[x].isPart && near(x))
           for (uint32_t i = vertexFirst[x]; i < vertexFirst[x + 1]; ++i)
             along.push_back({glm::dot(rig.positions[vertexList[i]] - base, P.axis), vertexList[i]});
       std::sort(along.begin(), along.end());
-      alongPart = c.part, alongProximal = c.proximal;
+      alongPart = c.part, alongProximal = proximal;
     }
     float reach = 0.0f;
     for (uint32_t r = 0; r < k; ++r) reach = std::max(reach, m.radii[c.radii + r]);
