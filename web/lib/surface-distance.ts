@@ -42,26 +42,38 @@ export class TriangleGrid {
     this.dims = size.map((s) => Math.max(1, Math.ceil(s / this.cell) + 1));
     const [nx, ny, nz] = this.dims;
     const count = new Int32Array(nx * ny * nz + 1);
-    const eachCell = (t: number, fn: (cell: number) => void) => {
+    // Each triangle's range of cells (its box), once: x0 y0 z0 x1 y1 z1, x0 = -1 when not finite.
+    const range = new Int32Array(6 * triCount);
+    for (let t = 0; t < triCount; t++) {
       const a = 3 * indices[3 * t], b = 3 * indices[3 * t + 1], c = 3 * indices[3 * t + 2];
-      const r0 = [0, 0, 0], r1 = [0, 0, 0];
       for (let k = 0; k < 3; k++) {
         const mn = Math.min(positions[a + k], positions[b + k], positions[c + k]);
         const mx = Math.max(positions[a + k], positions[b + k], positions[c + k]);
-        if (!Number.isFinite(mn) || !Number.isFinite(mx)) return;
-        r0[k] = this.clampCell(k, mn);
-        r1[k] = this.clampCell(k, mx);
+        if (!Number.isFinite(mn) || !Number.isFinite(mx)) { range[6 * t] = -1; break; }
+        range[6 * t + k] = this.clampCell(k, mn);
+        range[6 * t + 3 + k] = this.clampCell(k, mx);
       }
-      for (let z = r0[2]; z <= r1[2]; z++)
-        for (let y = r0[1]; y <= r1[1]; y++)
-          for (let x = r0[0]; x <= r1[0]; x++) fn((z * ny + y) * nx + x);
-    };
-    for (let t = 0; t < triCount; t++) eachCell(t, (cell) => count[cell + 1]++);
-    for (let i = 0; i < nx * ny * nz; i++) count[i + 1] += count[i];
-    this.cellStart = count;
-    this.cellTriangles = new Int32Array(count[nx * ny * nz]);
-    const cursor = count.slice(0, nx * ny * nz);
-    for (let t = 0; t < triCount; t++) eachCell(t, (cell) => { this.cellTriangles[cursor[cell]++] = t; });
+    }
+    // Two passes over the ranges: count the triangles per cell, then list them (cell by cell).
+    for (let pass = 0; pass < 2; pass++) {
+      if (pass === 1) {
+        for (let i = 0; i < nx * ny * nz; i++) count[i + 1] += count[i];
+        this.cellStart = count;
+        this.cellTriangles = new Int32Array(count[nx * ny * nz]);
+      }
+      const cursor = pass === 1 ? count.slice(0, nx * ny * nz) : count;
+      for (let t = 0; t < triCount; t++) {
+        const r = 6 * t;
+        if (range[r] < 0) continue;
+        for (let z = range[r + 2]; z <= range[r + 5]; z++)
+          for (let y = range[r + 1]; y <= range[r + 4]; y++)
+            for (let x = range[r]; x <= range[r + 3]; x++) {
+              const cell = (z * ny + y) * nx + x;
+              if (pass === 0) count[cell + 1]++;
+              else this.cellTriangles[cursor[cell]++] = t;
+            }
+      }
+    }
     if (this.stamp.length < triCount) this.stamp = new Int32Array(triCount);
     this.stamp.fill(0);
     this.query = 0;
@@ -92,10 +104,15 @@ export class TriangleGrid {
     const q = ++this.query;
     let best = Infinity;
     const maxShell = Math.max(nx, ny, nz);
+    // How far the point lies inside its own cell: its distance to the nearest face (0 outside).
+    const [ox, oy, oz] = this.origin, cell = this.cell;
+    const inside = Math.max(0, Math.min(x - (ox + cx * cell), ox + (cx + 1) * cell - x, y - (oy + cy * cell),
+      oy + (cy + 1) * cell - y, z - (oz + cz * cell), oz + (cz + 1) * cell - z));
     for (let r = 0; r <= maxShell; r++) {
-      // Every triangle not seen yet lies in cells at least r cells away: r·cell minus the point's
-      // offset inside its own cell, so (r − 1)·cell bounds it from below.
-      if (best <= (r - 1) * this.cell) break;
+      // A triangle not seen yet has its box outside the cells scanned (those within r − 1 of the
+      // point's): it lies at least (r − 1)·cell plus the point's depth in its own cell away. A
+      // point on the surface (the classic model's rings) stops after its own cell.
+      if (best <= (r - 1) * cell + inside) break;
       for (let k = cz - r; k <= cz + r; k++) {
         if (k < 0 || k >= nz) continue;
         for (let j = cy - r; j <= cy + r; j++) {
