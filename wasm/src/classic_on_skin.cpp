@@ -78,13 +78,13 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
         if (slot[v] < 0) slot[v] = int32_t(cornerOf.size()), cornerOf.push_back(v);
       }
   const uint32_t C = uint32_t(cornerOf.size());
-  std::vector<float> rest(size_t(C) * 3), restNormals(size_t(C) * 3), posed(size_t(C) * 3), posedNormals(size_t(C) * 3);
+  std::vector<float> rest(size_t(C) * 3), posed(size_t(C) * 3);
   const bool eight = rig.influenceSlots == 8;
   std::vector<glm::uvec4> joints(C), joints1(eight ? C : 0);
   std::vector<glm::vec4> weights(C), weights1(eight ? C : 0);
   for (uint32_t i = 0; i < C; ++i) {
     const uint32_t v = cornerOf[i];
-    for (int c = 0; c < 3; ++c) rest[3 * i + c] = rig.positions[v][c], restNormals[3 * i + c] = rig.normals[v][c];
+    for (int c = 0; c < 3; ++c) rest[3 * i + c] = rig.positions[v][c];
     joints[i] = rig.joints[v], weights[i] = rig.weights[v];
     if (eight) joints1[i] = rig.joints1[v], weights1[i] = rig.weights1[v];
   }
@@ -94,7 +94,7 @@ std::vector<uint8_t> offSurfaceParts(const Rig& rig, ClassicModel& m, const std:
     probeSkin(rig, axes[probe], angles[probe], skin);
     const ScaleState scale = m.poseRings(skin.data());  // (the rings only: the rest is not tested)
     dqsVertices(m.poses.data(), scale, joints.data(), weights.data(), eight ? joints1.data() : nullptr,
-                eight ? weights1.data() : nullptr, rest.data(), restNormals.data(), posed.data(), posedNormals.data(), C);
+                eight ? weights1.data() : nullptr, rest.data(), nullptr, posed.data(), nullptr, C);
     for (uint32_t j = 0; j < J; ++j) {
       const ClassicPart& P = m.parts[j];
       if (!P.resampled) continue;

@@ -97,8 +97,8 @@ void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uve
   glm::mat4 pm, nm;
   for (uint32_t v = 0; v < n; ++v) {
     const float* p = &restPositions[3 * size_t(v)];
-    const float* q = &restNormals[3 * size_t(v)];
-    glm::vec3 rp, rn;
+    const float* q = normals ? &restNormals[3 * size_t(v)] : p;  // (not read without normals)
+    glm::vec3 rp, rn(0.0f);
     if (scale.uniform) {
       // Every K = s·I: rotate s·x by the blended unit quaternion and translate (no matrices).
       const glm::uvec4 j = joints[v];
@@ -129,7 +129,7 @@ void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uve
       const glm::vec3 x = scale.s * glm::vec3(p[0], p[1], p[2]), nn(q[0], q[1], q[2]);
       // r·x = x + 2u×(u×x + w·x)
       rp = x + 2.0f * glm::cross(u, glm::cross(u, x) + br.w * x) + t;
-      rn = nn + 2.0f * glm::cross(u, glm::cross(u, nn) + br.w * nn);
+      if (normals) rn = nn + 2.0f * glm::cross(u, glm::cross(u, nn) + br.w * nn);
     } else {
       uint32_t k = 0;
       for (int i = 0; i < 4; ++i) {
@@ -146,10 +146,14 @@ void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uve
       bool renorm = false;
       blendPoses(blend, w8, k, scale, pm, nm, renorm);
       rp = glm::vec3(pm * glm::vec4(p[0], p[1], p[2], 1.0f));
-      rn = glm::vec3(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
-      if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one
+      if (normals) {
+        rn = glm::vec3(nm * glm::vec4(q[0], q[1], q[2], 0.0f));
+        if (renorm) rn = unitOr(rn, glm::vec3(q[0], q[1], q[2]));  // a normal K has flattened away: the rest one
+      }
     }
-    for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c], normals[3 * size_t(v) + c] = rn[c];
+    for (int c = 0; c < 3; ++c) positions[3 * size_t(v) + c] = rp[c];
+    if (normals)
+      for (int c = 0; c < 3; ++c) normals[3 * size_t(v) + c] = rn[c];
   }
 }
 

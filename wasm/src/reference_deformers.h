@@ -37,7 +37,8 @@ SkinningDeformer* buildSkinning(const Rig& rig, GcsDeformerKind kind);
 // Dual-quaternion skinning of n vertices (rest positions and normals xyz-interleaved, with their
 // joints and weights: slots 0..3, and slots 4..7 in joints1/weights1 or null) under one frame's
 // decomposed joint poses (decomposeAll): what the DQS deformer does to every vertex and the classic
-// model to its carried skin.
+// model to its carried skin. Null restNormals and normals: positions only (the classic build's
+// on-skin probes).
 void dqsVertices(const JointPose* poses, const ScaleState& scale, const glm::uvec4* joints, const glm::vec4* weights,
                  const glm::uvec4* joints1, const glm::vec4* weights1, const float* restPositions,
                  const float* restNormals, float* positions, float* normals, uint32_t n);
