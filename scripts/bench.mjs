@@ -515,7 +515,7 @@ console.log('\nTargets:');
 const rows4 = [['target', 'value', 'goal', 'result']];
 for (const t of results.targets.filter((x) => !results.crowd.targets.includes(x))) {
   const v = t.value === null ? 'n/a' : t.unit === 'ratio' ? `${t.value.toFixed(2)}×` : `${ms(t.value)} ms`;
-  rows4.push([t.name, v, t.goal, t.met === null ? `n/a ${t.note}` : t.met ? (t.note ? `met (${t.note})` : 'met') : t.retired ? t.note : `MISSED (${t.note})`]);
+  rows4.push([t.name, v, t.goal, t.met === null ? `n/a ${t.note}` : t.met ? (t.note ? `met (${t.note})` : 'met') : t.retired ? t.note : t.note ? `MISSED (${t.note})` : 'MISSED']);
 }
 rows4.push(...crowdTargetRows(results.crowd));
 console.log(fmtTable(rows4));
