@@ -781,8 +781,9 @@ void checkStructure(Built& b, const RigInput& in) {
     for (uint32_t o = 0; contourOf && sourceOf && o < N; ++o) {
       CHECK(contourOf[o] >= -1 && float(contourOf[o]) < statSections, "output vertex %u on contour %d of %g", o,
             contourOf[o], double(statSections));
-      // A vertex is resampled (on a contour) or a copy of a rig vertex, never both.
-      CHECK((contourOf[o] >= 0) == (sourceOf[o] < 0) && sourceOf[o] < int32_t(in.vertexCount),
+      // A vertex is on a contour (a ring or cap), a copy of a rig vertex, or neither (a band
+      // vertex: gcs_skin.h), never both.
+      CHECK(!(contourOf[o] >= 0 && sourceOf[o] >= 0) && sourceOf[o] >= -1 && sourceOf[o] < int32_t(in.vertexCount),
             "output vertex %u: contour %d, source %d", o, contourOf[o], sourceOf[o]);
     }
     for (uint32_t which = 0; which < 3; ++which) {
