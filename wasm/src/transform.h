@@ -144,13 +144,13 @@ inline glm::mat3 normalMatrix(const glm::quat& rotation, const glm::mat3& k, boo
   return normalMatrix(glm::mat3_cast(rotation), k, renormalise);
 }
 
-// The pose of a skin matrix whose 3×3 is c·R, R a rotation and c > 0 (a rig without scale
-// animation, Mixamo's ×100 included: nearly every joint of every frame): its Gram matrix SᵀS is
-// c²·I, so R = S/c and K = c·I without rotationOf's normalisations and the product Rᵀ·S. False
-// (out untouched) when SᵀS differs from c²·I by more than 2e-6·c² (K then differs from c·I by about
-// 1e-6·c, well inside decomposeEach's 1e-5 for a uniform frame), for a mirror, and for c² outside
-// [1e-12, 1e12] (the general path keeps tiny and huge scales in float range).
-inline bool decomposeSimilarity(const glm::mat4& s, JointPose& out) {
+// The rotation, scale and normal matrix of a skin matrix whose 3×3 is c·R, R a rotation and c > 0
+// (a rig without scale animation, Mixamo's ×100 included: nearly every joint of every frame): its
+// Gram matrix SᵀS is c²·I, so R = S/c and K = c·I without rotationOf's normalisations and the
+// product Rᵀ·S. False (out untouched) when SᵀS differs from c²·I by more than 2e-6·c² (K then
+// differs from c·I by about 1e-6·c, well inside decomposeEach's 1e-5 for a uniform frame), for a
+// mirror, and for c² outside [1e-12, 1e12] (the general path keeps tiny and huge scales in range).
+inline bool similarityPart(const glm::mat4& s, JointPose& out) {
   const glm::vec3 a(s[0]), b(s[1]), c(s[2]);
   const float aa = glm::dot(a, a), bb = glm::dot(b, b), cc = glm::dot(c, c);
   const float c2 = (aa + bb + cc) * (1.0f / 3.0f);
@@ -162,31 +162,26 @@ inline bool decomposeSimilarity(const glm::mat4& s, JointPose& out) {
     return false;
   const float k = std::sqrt(c2), inv = 1.0f / k;
   const glm::mat3 rm(a * inv, b * inv, c * inv);
-  const glm::quat r = glm::normalize(glm::quat_cast(rm));
-  out.rotation = r;
-  out.translation = glm::vec3(s[3]);
+  out.rotation = glm::normalize(glm::quat_cast(rm));
   out.scale = glm::mat3(k);
-  const glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
-  out.real = glm::vec4(r.x, r.y, r.z, r.w);
-  out.dual = glm::vec4(d.x, d.y, d.z, d.w);
   out.normal = glm::mat4(rm);  // orthonormal within 1e-6: normals stay unit
-  out.normal[3][3] = 0.0f;
   out.renormalise = false;
   return true;
 }
 
 inline void decompose(const glm::mat4& s, JointPose& out) {
-  if (decomposeSimilarity(s, out)) return;
-  out.rotation = rotationOf(s);
+  if (!similarityPart(s, out)) {
+    out.rotation = rotationOf(s);
+    const glm::mat3 rm = glm::mat3_cast(out.rotation);
+    out.scale = glm::transpose(rm) * glm::mat3(s);
+    out.normal = glm::mat4(normalMatrix(rm, out.scale, out.renormalise));
+  }
+  out.normal[3][3] = 0.0f;
   out.translation = glm::vec3(s[3]);
-  const glm::mat3 rm = glm::mat3_cast(out.rotation);
-  out.scale = glm::transpose(rm) * glm::mat3(s);
   const glm::quat r = out.rotation;
-  glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
+  const glm::quat d = 0.5f * (glm::quat(0.0f, out.translation.x, out.translation.y, out.translation.z) * r);
   out.real = glm::vec4(r.x, r.y, r.z, r.w);
   out.dual = glm::vec4(d.x, d.y, d.z, d.w);
-  out.normal = glm::mat4(normalMatrix(rm, out.scale, out.renormalise));
-  out.normal[3][3] = 0.0f;
 }
 
 // Decomposes the skin matrices of the joints jointAt(0 … count−1) and tells what their scales have
