@@ -34,8 +34,7 @@ export function bindGeometry(deformer: GcsDeformer, jointCount: number, source: 
   geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
   geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
   for (const { name, attribute } of sectionAttributes(deformer)) geometry.setAttribute(name, attribute);
-  const sourceVertex = deformer.sourceVertex;
-  if (!sourceVertex) return geometry;
+  if (!deformer.keepsVertices) return geometry;
   for (const [key, attr] of Object.entries(source.attributes))
     if (!SKINNING_ATTRIBUTES.has(key) || (key === 'tangent' && options.tangents)) geometry.setAttribute(key, remapAttribute(attr, deformer));
   if (options.morphs) {
