@@ -150,8 +150,9 @@ typedef enum GcsDeformerKind {
  *                   around its weights, below). The JS API turns it on by default for the weights
  *                   criterion; zero there is the stepped, fastest level of detail.
  *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
- *   centres         weights criterion, nonzero: every blended section turns about its centre of
- *                   rotation (below) instead of moving by the dual-quaternion blend's translation.
+ *   centres         weights criterion, nonzero: every section of a bending pair turns about its
+ *                   centre of rotation (below) instead of moving by the dual-quaternion blend's
+ *                   translation.
  *                   Ignored by Y / axial.
  *
  * Weights criterion (docs/method.md §2): welded vertices (same bind-pose position) are binned by their
@@ -175,7 +176,9 @@ typedef enum GcsDeformerKind {
  * gcs_gcs_blend_third_factor): continuous in every weight, and the corners are shared by the cell's
  * vertices (corners with a zero weight are two-joint nodes). Up to three nodes per welded vertex.
  * Centres of rotation (weights criterion, `centres` nonzero; Le & Hodgins, "Real-time Skeletal Skinning
- * with Optimized Centers of Rotation", SIGGRAPH 2016): a blended section of weights w has the centre
+ * with Optimized Centers of Rotation", SIGGRAPH 2016): a section of a bending pair (two joints, one
+ * the other's parent; pivot c its child's joint centre) with weights w has the centre
+ * p = c + min(1, 0.01·height / |p* − c|)·(p* − c) (docs/method.md), with
  *   p* = Σ_t sim(w, v_t) a_t c_t / Σ_t sim(w, v_t) a_t,
  *   sim(w, v) = Σ_{j<k} w_j w_k v_j v_k exp(−(w_j v_k − w_k v_j)² / 0.1²),
  * over the rig's triangles t (bind-pose area a_t, centroid c_t, v_t the mean of its three corners'
@@ -183,9 +186,9 @@ typedef enum GcsDeformerKind {
  * on the rig: rebuilding the same rig does not recompute it). Per frame the section keeps the 3×3
  * part M = R·K of its blend (R from the normalised, hemisphere-aligned blend of its joints'
  * rotations, K the blended scale parts: the same as without centres, so normals turn the same way)
- * and takes the translation t = Σ w_j (S_j p* − p*) − (M p* − p*): M p* + t = Σ w_j S_j p*, the
+ * and takes the translation t = Σ w_j (S_j p − p) − (M p − p): M p + t = Σ w_j S_j p, the
  * centre moves by linear blend skinning (identity poses give t = 0 exactly). A rigid core is S_j as
- * ever; a section whose integral is empty (no triangle weighs on two of its joints) keeps the
+ * ever; any other section (three or more joints, two unrelated joints, an empty integral) keeps the
  * dual-quaternion blend. gcs_gcs_section_centres lists the centres.
  * Y / axial criteria (the paper, docs/method.md §4): parts by dominant weight, shared sections from
  * triangles spanning a part and its parent part, inner bins along Y or the bone axis, section
@@ -397,9 +400,9 @@ const float* gcs_gcs_section_influences(const GcsDeformer* deformer);
 /*
  * gcs_gcs_section_centres: sectionCount × 4 floats, one RGBA32F texel per section: its centre of
  *   rotation (x, y, z, 1) in the bind pose (mesh space), or (0, 0, 0, 0) where the section has none
- *   (a rigid core, a section whose integral is empty, every section of a deformer built without
- *   centres). A section with a centre moves by M = R·K as above and t = Σ_i w_i (S_i p* − p*) −
- *   (M p* − p*) (gcs_build_gcs). Null where gcs_gcs_section_influences is null.
+ *   (a rigid core, a section that is not a bending pair or whose integral is empty, every section
+ *   of a deformer built without centres). A section with a centre p moves by M = R·K as above and
+ *   t = Σ_i w_i (S_i p − p) − (M p − p) (gcs_build_gcs). Null where gcs_gcs_section_influences is null.
  */
 const float* gcs_gcs_section_centres(const GcsDeformer* deformer);
 uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* deformer);

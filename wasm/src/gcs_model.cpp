@@ -625,7 +625,8 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>&
 }
 
 // Weights criterion with centres: each blended section's centre of rotation from its blend weights
-// (a rigid core needs none: it is S_j; where the integral is empty the section keeps the plain blend).
+// (nodeCentre: a bending pair's only; a rigid core needs none, it is S_j; any other section keeps the
+// plain blend).
 bool placeRotationCentres(const Rig& rig, GcsDeformerImpl& m) {
   const CentreSurface* surface = centreSurfaceOf(rig);
   if (!surface) return false;
@@ -637,7 +638,7 @@ bool placeRotationCentres(const Rig& rig, GcsDeformerImpl& m) {
       joints[k] = m.influences[sec.influenceFirst + k].joint;
       weights[k] = m.influences[sec.influenceFirst + k].weight;
     }
-    sec.aboutCentre = rotationCentre(*surface, joints, weights, sec.influenceCount, sec.rotationCentre);
+    sec.aboutCentre = nodeCentre(rig, *surface, joints, weights, sec.influenceCount, sec.rotationCentre);
   }
   return true;
 }

@@ -194,4 +194,24 @@ bool rotationCentre(const CentreSurface& surface, const uint32_t* joints, const 
   return true;
 }
 
+
+bool nodeCentre(const Rig& rig, const CentreSurface& surface, const uint32_t* joints, const float* weights, uint32_t count,
+                glm::vec3& centre) {
+  // A bending pair: two joints, one the other's parent. Anything else keeps the dual-quaternion
+  // blend (a chain of three or more joints has no single pivot; two unrelated joints do not bend
+  // about one another).
+  if (count != 2) return false;
+  const uint32_t child = rig.parents[joints[1]] == int32_t(joints[0]) ? joints[1]
+                         : rig.parents[joints[0]] == int32_t(joints[1]) ? joints[0]
+                                                                        : ~0u;
+  if (child == ~0u) return false;
+  glm::vec3 p;
+  if (!rotationCentre(surface, joints, weights, count, p)) return false;
+  // The centre on the line from the pivot to p*, at most kCentreLever of the height from the pivot.
+  const glm::vec3 pivot = rig.jointCentres[child], lever = p - pivot;
+  const float length = glm::length(lever), most = kCentreLever * rig.height;
+  centre = length > most ? pivot + lever * (most / length) : p;
+  return true;
+}
+
 }  // namespace gcs

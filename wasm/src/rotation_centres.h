@@ -18,6 +18,12 @@ namespace gcs {
 // The paper's σ: a pair's similarity halves where the weight ratios differ by about 0.08.
 constexpr float kCentreSigma = 0.1f;
 
+// The longest lever arm, pivot to centre, in units of the rig's height. The centre moves along the
+// chord (linear blend skinning), so a node's shift against DQS grows with its lever arm: it takes
+// away the bulge on the outside of the bend and pushes the inside through itself. At 1 % the
+// inside stays within about DQS's self-intersections on our characters (docs/method.md).
+constexpr float kCentreLever = 0.01f;
+
 // What the integral reads from the surface, grouped by joint pair: sim is a sum over pairs of
 // joints, and a triangle adds to pair (j, k) only where both weigh on it. Triangles whose weights
 // on the pair fall in one cell of a 1/kCentreCells grid are summed into one term (their moments
@@ -56,5 +62,14 @@ const CentreSurface* centreSurfaceOf(const Rig& rig);
 // is empty (no triangle weighs on two of the joints) or vanishes: the caller keeps the plain blend.
 bool rotationCentre(const CentreSurface& surface, const uint32_t* joints, const float* weights, uint32_t count,
                     glm::vec3& centre);
+
+// The centre a node of `count` joints turns about, false where it keeps the dual-quaternion blend.
+// Only a bending pair has one: two joints, one the other's parent. Its centre lies on the line from
+// the pivot (the child's joint centre) to p*, at most kCentreLever of the rig's height from the pivot
+// (docs/method.md). The per-frame motion t = Σ w_j S_j p − M p is unchanged, so a centre at the
+// pivot is the dual-quaternion blend exactly for a child turning about its joint, and the line is a
+// smooth hand-over from DQS (lever 0) to the paper's centre (lever |p* − pivot|).
+bool nodeCentre(const Rig& rig, const CentreSurface& surface, const uint32_t* joints, const float* weights, uint32_t count,
+                glm::vec3& centre);
 
 }  // namespace gcs

@@ -94,10 +94,11 @@ export interface GcsOptions {
   /** Y/axial only: spread a joint's twist along the child part. Default false. */
   twistSpread?: boolean;
   /**
-   * Weights criterion: each blended section turns by its joints' blended rotation about its centre
-   * of rotation (Le & Hodgins 2016: the average of the bind-pose surface whose weights resemble
-   * the section's, computed once at build time), the centre moving by linear blend skinning: DQS's
-   * volume at a bent joint without its bulge. `false`: the dual-quaternion blend. Default false.
+   * Weights criterion: each section of a bending pair (two joints, one the other's parent) turns by
+   * its joints' blended rotation about its centre of rotation (Le & Hodgins 2016: the average of the
+   * bind-pose surface whose weights resemble the section's, brought to within 1 % of the height of
+   * the joint; computed once at build time), the centre moving by linear blend skinning: less of
+   * DQS's bulge at a bent joint, some volume lost. `false`: the dual-quaternion blend. Default false.
    * Ignored by 'y' and 'axial'.
    */
   centres?: boolean;
