@@ -42,8 +42,12 @@ describe('GPU backend (three.js adapter)', () => {
           const out = patchVertexShader(src, smooth, path);
           expect(out).not.toContain('#include <skinning_vertex>');
           expect(out).not.toContain('#include <skinbase_vertex>');
-          expect(out).toContain(path === 'joints' ? 'gcsSectionBlend' : 'gcsRows');
-          expect(out).not.toContain(path === 'joints' ? 'gcsRows' : 'gcsSectionBlend');
+          // The joint-level vertex stage reads node transforms (the node pass blends them once per frame).
+          expect(out).toContain(path === 'joints' ? 'gcsNode(' : 'gcsRows');
+          expect(out).not.toContain(path === 'joints' ? 'gcsRows' : 'gcsNode(');
+          expect(out).not.toContain('gcsSectionBlend');
+          // Where skinbase_vertex is compiled out (MeshBasicMaterial without an env map), skinning_vertex reads the transform.
+          expect(out).toMatch(/#ifndef GCS_BASE[\s\S]*#endif[\s\S]*transformed = /);
           expect(out.startsWith('#define GCS_SMOOTH')).toBe(smooth);
         }
       }

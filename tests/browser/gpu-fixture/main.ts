@@ -10,7 +10,6 @@ import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib
 import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend } from '../../../web/lib/three.js';
 import { GcsCrowd } from '../../../web/lib/crowd.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
-import type { TableSlots } from '../../../web/lib/gpu/layout.js';
 import { firstFour } from '../../helpers/influences.js';
 import { load, stage } from '../fixture-scene.js';
 
@@ -43,8 +42,12 @@ const READ_FRAGMENT = /* glsl */ `
 varying vec4 vOut;
 void main() { gl_FragColor = vOut; }`;
 
-/** What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals, float32. */
-function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath, slots: TableSlots): { positions: Float32Array; normals: Float32Array } {
+/**
+ * What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals,
+ * float32. `uniforms`: what its material's vertex stage reads (joint-level path: the node texture,
+ * written by the node pass when the mesh was last drawn).
+ */
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath): { positions: Float32Array; normals: Float32Array } {
   const src = mesh.geometry;
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
@@ -55,7 +58,7 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   }
   const material = new THREE.ShaderMaterial({
     uniforms: { ...(uniforms as Record<string, THREE.IUniform>), readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
-    vertexShader: patchVertexShader(READ_VERTEX, smooth, path, slots),
+    vertexShader: patchVertexShader(READ_VERTEX, smooth, path),
     fragmentShader: READ_FRAGMENT,
   });
   const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
@@ -80,6 +83,12 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   target.dispose();
   material.dispose();
   return out;
+}
+
+/** The uniforms a GPU-backend mesh's patched material reads in its vertex stage. */
+function vertexUniforms(mesh: THREE.Mesh): Record<string, THREE.IUniform | undefined> {
+  const material = (Array.isArray(mesh.material) ? mesh.material[0] : mesh.material) as THREE.Material;
+  return material.userData.gcsUniforms as Record<string, THREE.IUniform | undefined>;
 }
 
 export interface CheckResult {
@@ -165,10 +174,11 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     if (boneScale) scaled!.scale.multiply(new THREE.Vector3(...boneScale));
     if (character.backend !== 'gpu') character.rebuild(undefined, { backend: 'gpu' });
     character.update();
+    renderer.render(scene, camera); // the joint-level path's node pass runs before the first draw
     character.skins.forEach((skin, k) => {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
-      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path, sections.tableSlots);
+      const gpuOut = readBack(mesh, vertexUniforms(mesh), sections.smooth, sections.path);
       const d = skin.deformer as GcsDeformer;
       const S = (skin as unknown as { skin: Float32Array }).skin;
       d.deform(S); // the same frame on the CPU
@@ -245,11 +255,16 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
     writeSkinMatrices(source!, c.skins, c.offsetOf(i), tmp);
   });
   c.update();
+  const drawn = new THREE.Scene(); // one draw runs the node pass (joint-level path) for every instance
+  drawn.add(c.mesh);
+  renderer.render(drawn, camera);
+  drawn.remove(c.mesh);
   const sections = c.sections, height = c.rig.height;
   const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, positionError: 0, pixelDiff: 1, coverage: 0 };
-  const base = sections.uniforms.gcsBase.value, stride = sections.uniforms.gcsStride.value;
+  const uniforms = vertexUniforms(c.mesh);
+  const base = uniforms.gcsBase!.value as number, stride = uniforms.gcsStride!.value as number;
   times.forEach((_, i) => {
-    const gpuOut = readBack(c.mesh, { ...sections.uniforms, gcsBase: { value: base + i * stride } }, sections.smooth, sections.path, sections.tableSlots);
+    const gpuOut = readBack(c.mesh, { ...uniforms, gcsBase: { value: base + i * stride } }, sections.smooth, sections.path);
     c.deformer.deform(c.skins.subarray(c.offsetOf(i), c.offsetOf(i) + 16 * c.jointCount));
     const cpu = c.deformer.positions;
     for (let v = 0; v < c.deformer.vertexCount; v++) {

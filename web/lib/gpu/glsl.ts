@@ -6,7 +6,7 @@
 import { GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
+  GPU_TEXELS_PER_NODE, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -109,22 +109,21 @@ const POSITION = /* glsl */ `
 
 // ------------------------------------------------------------ the joint-level path (weights criterion)
 // Matrices are GLSL's (column-major); the math is GcsDeformerImpl::sectionTransformsWeights,
-// blendPoses and normalMatrix (wasm/src), step for step.
+// blendPoses and normalMatrix (wasm/src), step for step. It runs once per node and frame in the node
+// pass (node-pass.ts: a fragment per output texel, all instances of a crowd in one draw); the vertex
+// stage reads the result (NODE_PARS) and blends.
 
-/** Declarations: joint poses (per frame), the section table (static), the per-section blend. */
-const JOINT_PARS = /* glsl */ `
+/** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
+const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
-uniform highp sampler2D gcsTable;${COMMON_PARS}
+uniform highp sampler2D gcsTable;
 vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
 	int w = textureSize( t, 0 ).x;
 	return texelFetch( t, ivec2( i % w, i / w ), 0 );
 }
-// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
-void gcsJoint( const in int j, out mat3 s, out vec3 t, out vec4 q ) {
-	int i = gcsBase + j * ${GPU_TEXELS_PER_JOINT};
-	#ifdef USE_INSTANCING
-	i += gl_InstanceID * gcsStride;
-	#endif
+// Joint j's pose (its texels from \`base\`, the instance's first): S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out vec4 q ) {
+	int i = base + j * ${GPU_TEXELS_PER_JOINT};
 	vec4 r0 = gcsTexel( gcsJoints, i ), r1 = gcsTexel( gcsJoints, i + 1 ), r2 = gcsTexel( gcsJoints, i + 2 );
 	q = gcsTexel( gcsJoints, i + 3 );
 	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
@@ -159,13 +158,13 @@ mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
 }
 // Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
 // dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first,
-// or with a centre of rotation the blend's M about it.
+// or with a centre of rotation the blend's M about it. \`base\`: the instance's first joint texel.
 // GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
-void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
 	int row = GCS_TABLE_TEXELS * s;
 	vec4 joints = gcsTexel( gcsTable, row ), weights = gcsTexel( gcsTable, row + 1 );
 	mat3 S; vec3 t; vec4 q;
-	gcsJoint( int( joints.x ), S, t, q );
+	gcsJoint( base, int( joints.x ), S, t, q );
 	if ( joints.y < 0.0 ) {
 		M = S; T = t;
 		mat3 r = gcsRotation( q, 2.0 );
@@ -188,7 +187,7 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 		float id = joints[ k ], w = weights[ k ];
 		#endif
 		if ( id < 0.0 ) break;
-		if ( k > 0 ) gcsJoint( int( id ), S, t, q );
+		if ( k > 0 ) gcsJoint( base, int( id ), S, t, q );
 		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
 		float sw = dot( q, pivot ) < 0.0 ? - w : w;
 		br += sw * q;
@@ -204,6 +203,68 @@ void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bo
 	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
 	N = gcsNormalMatrix( rot, K, renorm );
 }
+`;
+
+/**
+ * The node pass's fragment shader: texel i of the target is texel i % GCS_NODE_TEXELS of node
+ * i / GCS_NODE_TEXELS (instance k's node s is node k·sections + s): the rows of [M | T], then the
+ * rows of N, the first with w = 1 where normals renormalise.
+ */
+const NODE_PASS_FRAGMENT = /* glsl */ `
+uniform int gcsNodeCount;
+uniform int gcsSectionCount;
+uniform int gcsJointStride;
+uniform int gcsTargetWidth;
+${NODE_MATHS}
+void main() {
+	int i = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
+	int node = i / ${GPU_TEXELS_PER_NODE}, c = i - node * ${GPU_TEXELS_PER_NODE};
+	if ( node >= gcsNodeCount ) { gl_FragColor = vec4( 0.0 ); return; }
+	int instance = node / gcsSectionCount;
+	mat3 M, N; vec3 T; bool renorm;
+	gcsSectionBlend( instance * gcsJointStride, node - instance * gcsSectionCount, M, T, N, renorm );
+	if ( c < 3 ) gl_FragColor = vec4( M[ 0 ][ c ], M[ 1 ][ c ], M[ 2 ][ c ], T[ c ] );
+	else gl_FragColor = vec4( N[ 0 ][ c - 3 ], N[ 1 ][ c - 3 ], N[ 2 ][ c - 3 ], c == 3 && renorm ? 1.0 : 0.0 );
+}
+`;
+
+/** A triangle covering the target: one fragment per texel. */
+const NODE_PASS_VERTEX = /* glsl */ `
+void main() {
+	vec2 p = vec2( float( ( gl_VertexID << 1 ) & 2 ), float( gl_VertexID & 2 ) );
+	gl_Position = vec4( p * 2.0 - 1.0, 0.0, 1.0 );
+}
+`;
+
+/** The node pass's shaders for a section table of `slots` joints per section (GpuSections.tableSlots). */
+export function nodePassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
+  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
+  return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
+}
+
+const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
+
+/** The vertex stage's declarations: the node texture (written by the node pass) and how normals turn. */
+const NODE_PARS = /* glsl */ `
+uniform highp sampler2D gcsNodes;${COMMON_PARS}
+// Node s of this instance: x ↦ M x + T, its normal matrix N and whether normals renormalise.
+void gcsNode( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+	int i = gcsBase + s * ${GPU_TEXELS_PER_NODE};
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	int w = textureSize( gcsNodes, 0 ).x;
+	vec4 r0 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	i += 1; vec4 r1 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	i += 1; vec4 r2 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	i += 1; vec4 n0 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	i += 1; vec4 n1 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	i += 1; vec4 n2 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	M = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	T = vec3( r0.w, r1.w, r2.w );
+	N = transpose( mat3( n0.xyz, n1.xyz, n2.xyz ) );
+	renorm = n0.w > 0.5;
+}
 // A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
 // sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else
 // are normalised (a vanished one keeps its rest direction); unblended ones are normalised only when
@@ -217,7 +278,7 @@ vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const i
 }
 `;
 
-/** Per vertex, once: its (blended) section transform and normal matrix. */
+/** Per vertex, once: its (blended) node transform and normal matrix, read from the node texture. */
 const JOINT_BASE = /* glsl */ `
 	mat3 gcsM, gcsN;
 	vec3 gcsT;
@@ -226,10 +287,10 @@ const JOINT_BASE = /* glsl */ `
 		#ifdef GCS_SMOOTH
 		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sb = int( ${BLEND_ATTRIBUTE}.y + 0.5 );
 		int sc = int( ${BLEND_THIRD_ATTRIBUTE}.x + 0.5 );
-		gcsSectionBlend( sa, gcsM, gcsT, gcsN, gcsNormalise );
+		gcsNode( sa, gcsM, gcsT, gcsN, gcsNormalise );
 		if ( sb != sa ) {
 			mat3 mb, nb; vec3 tb; bool rb;
-			gcsSectionBlend( sb, mb, tb, nb, rb );
+			gcsNode( sb, mb, tb, nb, rb );
 			float f = ${BLEND_ATTRIBUTE}.z;
 			bool ra = gcsNormalise;
 			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
@@ -240,7 +301,7 @@ const JOINT_BASE = /* glsl */ `
 			if ( sc != sa ) {
 				// A three-joint lattice cell: + g·(C − A); the least pairwise trace decides the fix.
 				mat3 mc, nc; vec3 tc; bool rc;
-				gcsSectionBlend( sc, mc, tc, nc, rc );
+				gcsNode( sc, mc, tc, nc, rc );
 				float g = ${BLEND_THIRD_ATTRIBUTE}.y;
 				gcsM += g * ( mc - ma );
 				gcsT += g * ( tc - ta );
@@ -256,7 +317,7 @@ const JOINT_BASE = /* glsl */ `
 			gcsNormalise = true;
 		}
 		#else
-		gcsSectionBlend( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
+		gcsNode( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
 		#endif
 	}
 `;
@@ -272,26 +333,24 @@ const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', 
 /**
  * The vertex shader of a three.js built-in material (or any shader written with its chunks) with
  * three's skinning chunks replaced by GCS's: path 'sections', the section transforms come from the
- * `gcsSections` texture; path 'joints', each vertex's section is blended from the joint poses in
- * `gcsJoints` and the static table `gcsTable` (`slots` joints per section: GpuSections.tableSlots).
- * Morph targets still apply first (three's order), then the section transform; normals and
- * tangents turn with the normal matrix. Throws GcsError 'INVALID_ARGUMENT' when the shader lacks
- * the chunks (a ShaderMaterial written without them).
+ * `gcsSections` texture; path 'joints', each vertex reads its nodes' transforms from the `gcsNodes`
+ * texture the node pass wrote (node-pass.ts) and blends them. Morph targets still apply first
+ * (three's order), then the transform; normals and tangents turn with the normal matrix. Where a
+ * material compiles `skinbase_vertex` out (MeshBasicMaterial keeps it under
+ * `USE_ENVMAP || USE_SKINNING`), the transform is read in `skinning_vertex` instead. Throws GcsError
+ * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
  */
-export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): string {
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections'): string {
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
   if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
-  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
   const joints = path === 'joints';
+  const base = joints ? JOINT_BASE : BASE;
   let out = source
-    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? JOINT_PARS : PARS}`)
-    .replace(HOOKS[1], joints ? JOINT_BASE : BASE)
-    .replace(HOOKS[2], joints ? JOINT_POSITION : POSITION);
+    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? NODE_PARS : PARS}`)
+    .replace(HOOKS[1], `#define GCS_BASE\n${base}`)
+    .replace(HOOKS[2], `#ifndef GCS_BASE\n${base}\n#endif\n${joints ? JOINT_POSITION : POSITION}`);
   // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
   out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
-  const table = joints ? `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n` : '';
-  const defines = `${smooth ? '#define GCS_SMOOTH\n' : ''}${table}`;
-  return `${defines}${out}`;
+  return `${smooth ? '#define GCS_SMOOTH\n' : ''}${out}`;
 }
-

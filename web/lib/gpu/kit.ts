@@ -13,6 +13,14 @@ export interface GpuMaterials {
   /** customDepthMaterial / customDistanceMaterial for the shadow passes, or null where the material casts its own (node materials). */
   depth: THREE.Material | null;
   distance: THREE.Material | null;
+  /**
+   * Before each draw of the skin (shadow or colour pass), with the renderer drawing it: runs what
+   * must run once per frame before the vertex stage (the node pass). Returns why this renderer
+   * cannot, or null.
+   */
+  beforeDraw?(renderer: unknown): string | null;
+  /** Frees what beforeDraw needs (the node pass's target). */
+  dispose?(): void;
 }
 
 export interface GpuMaterialKit {
@@ -45,4 +53,5 @@ export function disposeGpuMaterials(m: GpuMaterials): void {
   for (const x of Array.isArray(m.material) ? m.material : [m.material]) x.dispose();
   m.depth?.dispose();
   m.distance?.dispose();
+  m.dispose?.();
 }

@@ -8,6 +8,13 @@ import { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION } from '../index.js';
 export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION };
 
 /**
+ * Texels per node in the node pass's output (joint-level path, WebGLRenderer): the rows of the
+ * node's affine 3×4 [M | T], then the rows of its normal matrix N, the first with w = 1 where
+ * normals renormalise (a non-uniform scale), else 0.
+ */
+export const GPU_TEXELS_PER_NODE = 6;
+
+/**
  * What the GPU gets per frame: 'joints' (joint poses, O(joints); weights criterion only) or
  * 'sections' (section transforms, O(sections); any criterion).
  */

@@ -44,6 +44,8 @@ export class GpuSections {
   readonly tableSlots: TableSlots;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
+  /** Counts update() calls: what a node pass computed from is told apart from what it must recompute. */
+  version = 0;
   /** Velocity: the per-frame texels as the previous frame drew them (see previousTexture). */
   private previous: { texture: THREE.DataTexture; drawn: Float32Array; frameId: number } | null = null;
 
@@ -117,6 +119,7 @@ export class GpuSections {
   /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
   update(): void {
     this.transforms.compute();
+    this.version++;
     const texels = this.transforms.texels; // re-created after memory growth
     const image = this.texture.image as { data: Float32Array };
     if (image.data !== texels) image.data = texels;
