@@ -6,7 +6,7 @@
 import { GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_NODE, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
+  GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -113,6 +113,18 @@ const POSITION = /* glsl */ `
 // pass (node-pass.ts: a fragment per output texel, all instances of a crowd in one draw); the vertex
 // stage reads the result (NODE_PARS) and blends.
 
+/** The rotation matrix of a quaternion: the node pass and the vertex stage both build one. */
+const ROTATION = /* glsl */ `
+// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
+mat3 gcsRotation( const in vec4 q, const in float k2 ) {
+	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
+		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
+		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
+}
+`;
+
 /** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
 const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
@@ -129,46 +141,40 @@ void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out ve
 	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 	t = vec3( r0.w, r1.w, r2.w );
 }
-// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
-mat3 gcsRotation( const in vec4 q, const in float k2 ) {
-	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
-		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
-		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
-}
-// The CPU's normalMatrix: r when k is a positive uniform scale (up to 1e-4), else r · cof(k) scaled
-// to entries ≤ 1 (renormalise), r alone when k has collapsed.
-mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
+${ROTATION}
+// The CPU's normalMatrix as one texel (x, y, 0, flag), from which the vertex stage takes
+// N = cof(M·x)·y, M = R·K (cof(R) = R): R·cof(K/s) = R when K is a positive uniform scale s·I (up to
+// 1e-4): (1/s, 1, 0, 0); else R·cof(K/kbig)/big, its entries ≤ 1 and normals renormalised:
+// (1/kbig, 1/big, 0, −1). A collapsed K (rank ≤ 1) gives N = 0: the normal keeps its rest
+// direction (the CPU keeps it rotated; no direction survives such a scale).
+vec4 gcsNormalTexel( const in mat3 k ) {
 	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
 	bool uniformScale = s > 0.0;
 	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
 		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
-	renorm = ! uniformScale;
-	if ( uniformScale ) return r;
+	if ( uniformScale ) return vec4( 1.0 / s, 1.0, 0.0, 0.0 );
 	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
 	float kbig = max( max( m.x, m.y ), m.z );
-	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return r;
+	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
 	mat3 a = k / kbig;
 	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
 	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
 	float big = max( max( m.x, m.y ), m.z );
-	if ( ! ( big > ${f(COLLAPSED)} ) ) return r;
-	return r * ( c / big );
+	if ( ! ( big > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
+	return vec4( 1.0 / kbig, 1.0 / big, 0.0, - 1.0 );
 }
-// Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
-// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first,
-// or with a centre of rotation the blend's M about it. \`base\`: the instance's first joint texel.
-// GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
-void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+// Section s's transform x ↦ M x + T and its normal texel N (gcsNormalTexel): a rigid core is S_j;
+// otherwise the dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly,
+// applied first, or with a centre of rotation the blend's M about it. \`base\`: the instance's first
+// joint texel. GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
+void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
 	int row = GCS_TABLE_TEXELS * s;
 	vec4 joints = gcsTexel( gcsTable, row ), weights = gcsTexel( gcsTable, row + 1 );
 	mat3 S; vec3 t; vec4 q;
 	gcsJoint( base, int( joints.x ), S, t, q );
 	if ( joints.y < 0.0 ) {
 		M = S; T = t;
-		mat3 r = gcsRotation( q, 2.0 );
-		N = gcsNormalMatrix( r, transpose( r ) * S, renorm );
+		N = gcsNormalTexel( transpose( gcsRotation( q, 2.0 ) ) * S );
 		return;
 	}
 	#if GCS_TABLE_SLOTS > 4
@@ -197,34 +203,37 @@ void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T,
 	}
 	float inv2 = 1.0 / dot( br, br );
 	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
-	mat3 rot = gcsRotation( br, 2.0 * inv2 );
-	M = rot * K;
+	M = gcsRotation( br, 2.0 * inv2 ) * K;
 	// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
 	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
-	N = gcsNormalMatrix( rot, K, renorm );
+	N = gcsNormalTexel( K );
 }
 `;
 
 /**
- * The node pass's fragment shader: texel i of the target is texel i % GCS_NODE_TEXELS of node
- * i / GCS_NODE_TEXELS (instance k's node s is node k·sections + s): the rows of [M | T], then the
- * rows of N, the first with w = 1 where normals renormalise.
+ * The node pass's fragment shader: one fragment per node (instance k's node s is node k·sections +
+ * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
  */
 const NODE_PASS_FRAGMENT = /* glsl */ `
 uniform int gcsNodeCount;
 uniform int gcsSectionCount;
 uniform int gcsJointStride;
 uniform int gcsTargetWidth;
+layout( location = 0 ) out highp vec4 gcsRow0;
+layout( location = 1 ) out highp vec4 gcsRow1;
+layout( location = 2 ) out highp vec4 gcsRow2;
+layout( location = 3 ) out highp vec4 gcsNormal;
 ${NODE_MATHS}
 void main() {
-	int i = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
-	int node = i / ${GPU_TEXELS_PER_NODE}, c = i - node * ${GPU_TEXELS_PER_NODE};
-	if ( node >= gcsNodeCount ) { gl_FragColor = vec4( 0.0 ); return; }
+	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
+	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
 	int instance = node / gcsSectionCount;
-	mat3 M, N; vec3 T; bool renorm;
-	gcsSectionBlend( instance * gcsJointStride, node - instance * gcsSectionCount, M, T, N, renorm );
-	if ( c < 3 ) gl_FragColor = vec4( M[ 0 ][ c ], M[ 1 ][ c ], M[ 2 ][ c ], T[ c ] );
-	else gl_FragColor = vec4( N[ 0 ][ c - 3 ], N[ 1 ][ c - 3 ], N[ 2 ][ c - 3 ], c == 3 && renorm ? 1.0 : 0.0 );
+	mat3 M; vec3 T; vec4 N;
+	gcsSectionBlend( instance * gcsJointStride, node - instance * gcsSectionCount, M, T, N );
+	gcsNormal = N;
+	gcsRow0 = vec4( M[ 0 ][ 0 ], M[ 1 ][ 0 ], M[ 2 ][ 0 ], T.x );
+	gcsRow1 = vec4( M[ 0 ][ 1 ], M[ 1 ][ 1 ], M[ 2 ][ 1 ], T.y );
+	gcsRow2 = vec4( M[ 0 ][ 2 ], M[ 1 ][ 2 ], M[ 2 ][ 2 ], T.z );
 }
 `;
 
@@ -236,34 +245,32 @@ void main() {
 }
 `;
 
-/** The node pass's shaders for a section table of `slots` joints per section (GpuSections.tableSlots). */
+const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
+
+/** The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots). */
 export function nodePassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
   if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
 }
 
-const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
-
-/** The vertex stage's declarations: the node texture (written by the node pass) and how normals turn. */
+/** The vertex stage's declarations: the node textures (written by the node pass) and how normals turn. */
 const NODE_PARS = /* glsl */ `
-uniform highp sampler2D gcsNodes;${COMMON_PARS}
-// Node s of this instance: x ↦ M x + T, its normal matrix N and whether normals renormalise.
+${Array.from({ length: GPU_NODE_TEXTURES }, (_, t) => `uniform highp sampler2D gcsNodes${t};`).join('\n')}${COMMON_PARS}
+// Node s of this instance: x ↦ M x + T, its normal matrix N (from gcsNormalTexel's texel)
+// and whether normals renormalise.
 void gcsNode( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
-	int i = gcsBase + s * ${GPU_TEXELS_PER_NODE};
+	int i = gcsBase + s;
 	#ifdef USE_INSTANCING
 	i += gl_InstanceID * gcsStride;
 	#endif
-	int w = textureSize( gcsNodes, 0 ).x;
-	vec4 r0 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
-	i += 1; vec4 r1 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
-	i += 1; vec4 r2 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
-	i += 1; vec4 n0 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
-	i += 1; vec4 n1 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
-	i += 1; vec4 n2 = texelFetch( gcsNodes, ivec2( i % w, i / w ), 0 );
+	int w = textureSize( gcsNodes0, 0 ).x, y = i / w;
+	ivec2 at = ivec2( i - y * w, y );
+	vec4 r0 = texelFetch( gcsNodes0, at, 0 ), r1 = texelFetch( gcsNodes1, at, 0 ), r2 = texelFetch( gcsNodes2, at, 0 ), n = texelFetch( gcsNodes3, at, 0 );
 	M = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 	T = vec3( r0.w, r1.w, r2.w );
-	N = transpose( mat3( n0.xyz, n1.xyz, n2.xyz ) );
-	renorm = n0.w > 0.5;
+	renorm = n.w < 0.0;
+	mat3 a = M * n.x;
+	N = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
 }
 // A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
 // sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else

@@ -8,11 +8,12 @@ import { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION } from '../index.js';
 export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION };
 
 /**
- * Texels per node in the node pass's output (joint-level path, WebGLRenderer): the rows of the
- * node's affine 3×4 [M | T], then the rows of its normal matrix N, the first with w = 1 where
- * normals renormalise (a non-uniform scale), else 0.
+ * Textures the node pass writes (joint-level path, WebGLRenderer), one texel per node in each:
+ * the three rows of the node's affine 3×4 [M | T], then its normal texel (x, y, 0, flag), from
+ * which the vertex stage takes the normal matrix N = cof(M·x)·y (the rotation where the scale is
+ * uniform: x = 1/s, y = 1; flag −1 where normals renormalise, else 0).
  */
-export const GPU_TEXELS_PER_NODE = 6;
+export const GPU_NODE_TEXTURES = 4;
 
 /**
  * What the GPU gets per frame: 'joints' (joint poses, O(joints); weights criterion only) or

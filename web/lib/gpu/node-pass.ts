@@ -11,19 +11,17 @@
  */
 import * as THREE from 'three';
 import { nodePassShaders } from './glsl.js';
-import { GPU_TEXELS_PER_NODE } from './layout.js';
+import { GPU_NODE_TEXTURES } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
-/** The widest row of the node texture: WebGL2's guaranteed 2048, rounded down to whole nodes. */
-const MAX_WIDTH = Math.floor(2048 / GPU_TEXELS_PER_NODE) * GPU_TEXELS_PER_NODE;
+/** The widest row of the node textures: WebGL2's guaranteed 2048. */
+const MAX_WIDTH = 2048;
 
 /** The extension float render targets need in WebGL2 (RGBA32F colour attachments). */
 export const FLOAT_TARGET_EXTENSION = 'EXT_color_buffer_float';
 
-/** What the vertex stage reads: the node texture, instance 0's first node texel, texels per instance. */
-export interface NodeUniforms extends GcsUniforms {
-  gcsNodes: { value: THREE.Texture };
-}
+/** What the vertex stage reads: the node textures (gcsNodes0 … gcsNodes3), instance 0's first node, nodes per instance. */
+export type NodeUniforms = GcsUniforms;
 
 type Renderer = THREE.WebGLRenderer;
 
@@ -39,28 +37,30 @@ export class NodePass {
 
   constructor(readonly sections: GpuSections) {
     const deformer = sections.deformer, S = deformer.sectionCount, N = sections.instanceCount;
-    const texels = N * S * GPU_TEXELS_PER_NODE;
-    const width = Math.min(MAX_WIDTH, texels), height = Math.ceil(texels / width);
+    const nodes = N * S;
+    const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
+    // One texel per node in each of four float targets: the node pass computes a node once and writes it whole.
     this.target = new THREE.WebGLRenderTarget(width, height, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
-      depthBuffer: false, stencilBuffer: false, generateMipmaps: false,
+      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
     });
     const u = sections.uniforms;
     this.material = new THREE.ShaderMaterial({
       ...nodePassShaders(sections.tableSlots),
       uniforms: {
         gcsJoints: u.gcsJoints!, gcsTable: u.gcsTable!,
-        gcsNodeCount: { value: N * S }, gcsSectionCount: { value: S },
+        gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: width },
       },
-      depthTest: false, depthWrite: false, blending: THREE.NoBlending,
+      depthTest: false, depthWrite: false, blending: THREE.NoBlending, glslVersion: THREE.GLSL3,
     });
     // Three vertices, no attributes read (gl_VertexID places them): one triangle over the target.
     this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
     const quad = new THREE.Mesh(this.geometry, this.material);
     quad.frustumCulled = false;
     this.scene.add(quad);
-    this.uniforms = { gcsNodes: { value: this.target.texture }, gcsBase: { value: 0 }, gcsStride: { value: S * GPU_TEXELS_PER_NODE } };
+    this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S } };
+    this.target.textures.forEach((texture, t) => { this.uniforms[`gcsNodes${t}`] = { value: texture }; });
   }
 
   /** Why `renderer` cannot run the node pass (no float render targets), or null. */
