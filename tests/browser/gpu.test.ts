@@ -154,3 +154,37 @@ describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (Ces
     });
   }
 });
+
+// Every built-in material on the GPU backend (WebGLRenderer, GLSL kit), with shadows (depth and
+// distance materials): the same picture as the CPU backend, on the default (joint-level) path.
+// A shader that fails to compile moves the skin to the CPU backend with a note: never nothing drawn in silence.
+describe.skipIf(!!reason || !!noCesium)('every built-in material, shadows included (CesiumMan)', () => {
+  const TYPES = ['MeshBasicMaterial', 'MeshLambertMaterial', 'MeshPhongMaterial', 'MeshStandardMaterial', 'MeshPhysicalMaterial', 'MeshToonMaterial', 'MeshMatcapMaterial', 'MeshNormalMaterial'];
+  interface M { type: string; backend: string; path: string; note: string; pixelDiff: number; coverage: number; shadow: number; posed: number }
+  const run = (broken: boolean, types = TYPES) => fixture.page.evaluate(([m, t, b]) => (window as unknown as { __gpu: { materials(a: string, b: number, c: string[], d?: string, e?: boolean): Promise<M[]> } })
+    .__gpu.materials(m as string, 0.9, t as string[], undefined, b as boolean), [`/@fs${CESIUM}`, types, broken] as const);
+
+  test('GPU backend = CPU backend for each, its shadows too', async () => {
+    for (const r of await run(false)) {
+      console.log(`${r.type}: ${r.backend}/${r.path}; GPU vs CPU ${(100 * r.pixelDiff).toFixed(3)} % of pixels differ; character ${(100 * r.coverage).toFixed(1)} %, its shadows ${(100 * r.shadow).toFixed(1)} %; posed vs bind pose ${(100 * r.posed).toFixed(1)} %`);
+      expect(r.backend, `${r.type}: ${r.note}`).toBe('gpu');
+      expect(r.path).toBe('joints');
+      expect(r.coverage).toBeGreaterThan(0.02);
+      expect(r.shadow).toBeGreaterThan(0.002); // the shadow passes ran with the patched depth / distance materials
+      expect(r.posed).toBeGreaterThan(0.01);
+      expect(r.pixelDiff, r.type).toBeLessThan(PIXEL_TOLERANCE);
+    }
+    expect(fixture.errors).toEqual([]);
+  });
+
+  test('a patched shader that does not compile: the skin falls back to the CPU backend with a note, and draws', async () => {
+    const before = fixture.errors.length;
+    const [r] = await run(true, ['MeshStandardMaterial']);
+    console.log(`broken shader: ${r.backend}; note: ${r.note}; the next frame vs the CPU backend ${(100 * r.pixelDiff).toFixed(3)} %`);
+    expect(r.backend).toBe('cpu');
+    expect(r.note).toMatch(/did not compile/);
+    expect(r.pixelDiff).toBeLessThan(PIXEL_TOLERANCE);
+    const added = fixture.errors.splice(before);
+    expect(added.some((e) => /Shader Error/.test(e))).toBe(true); // three.js's own report, as it comes
+  });
+});

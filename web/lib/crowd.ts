@@ -141,6 +141,13 @@ export class GcsCrowd {
     this.mesh.onBeforeShadow = (renderer, _object, _camera, _shadowCamera, drawn, drawnMaterial) => {
       if (!this.rendererError) this.checkRenderer(renderer, drawn, drawnMaterial);
     };
+    // A crowd has no CPU backend: a shader that failed to compile stops it with a note (update() throws it).
+    const compiled = (renderer: unknown, drawn: THREE.BufferGeometry, drawnMaterial: THREE.Material) => {
+      const why = this.rendererError ? null : this.materials.compileError?.(renderer, drawnMaterial);
+      if (why) this.stop(drawn, why);
+    };
+    this.mesh.onAfterRender = (renderer, _scene, _camera, drawn, drawnMaterial) => compiled(renderer, drawn, drawnMaterial);
+    this.mesh.onAfterShadow = (renderer, _object, _camera, _shadowCamera, drawn, drawnMaterial) => compiled(renderer, drawn, drawnMaterial);
     this.mesh.castShadow = source.castShadow;
     this.mesh.receiveShadow = source.receiveShadow;
     this.mesh.frustumCulled = false;
@@ -163,7 +170,11 @@ export class GcsCrowd {
       const noPass = this.materials.beforeDraw?.(renderer) ?? null;
       if (noPass) why = `${noPass}: build the crowd with gpuPath: 'sections'`;
     }
-    if (!why) return;
+    if (why) this.stop(geometry, why);
+  }
+
+  /** Stops drawing with one warning; the next update() throws why. */
+  private stop(geometry: THREE.BufferGeometry, why: string): void {
     geometry.setDrawRange(0, 0);
     this.rendererError = new GcsError('INVALID_ARGUMENT', `GcsCrowd (${this.kit.entry}): ${why}`);
     console.warn(`gcs-skin: ${this.rendererError.message}`);

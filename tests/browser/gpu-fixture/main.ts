@@ -299,7 +299,119 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   return result;
 }
 
-declare global {
-  interface Window { __gpu: { check: typeof check; crowd: typeof crowd } }
+export interface MaterialResult {
+  type: string; backend: string; path: string; note: string;
+  /** share of pixels differing between the GPU and CPU backends' pictures (character, its shadows on the ground) */
+  pixelDiff: number;
+  /** share of pixels the character covers, and that its shadows darken on the ground (GPU picture) */
+  coverage: number; shadow: number;
+  /** share of pixels differing from the character drawn in its bind pose on the GPU backend: the pose reaches the picture */
+  posed: number;
 }
-window.__gpu = { check, crowd };
+
+const MATERIALS = {
+  MeshBasicMaterial: () => new THREE.MeshBasicMaterial({ color: 0xd08050 }),
+  MeshLambertMaterial: () => new THREE.MeshLambertMaterial({ color: 0xd08050 }),
+  MeshPhongMaterial: () => new THREE.MeshPhongMaterial({ color: 0xd08050, shininess: 60 }),
+  MeshStandardMaterial: () => new THREE.MeshStandardMaterial({ color: 0xd08050, roughness: 0.5 }),
+  MeshPhysicalMaterial: () => new THREE.MeshPhysicalMaterial({ color: 0xd08050, roughness: 0.4, clearcoat: 0.5 }),
+  MeshToonMaterial: () => new THREE.MeshToonMaterial({ color: 0xd08050 }),
+  MeshMatcapMaterial: () => new THREE.MeshMatcapMaterial({ color: 0xd08050, matcap: matcapTexture() }),
+  MeshNormalMaterial: () => new THREE.MeshNormalMaterial(),
+} as const;
+
+/** A matcap whose colour follows the normal's direction, so that normals show in the picture. */
+function matcapTexture(): THREE.DataTexture {
+  const n = 64, data = new Uint8Array(4 * n * n);
+  for (let y = 0; y < n; y++) for (let x = 0; x < n; x++) data.set([255 * x / n, 255 * y / n, 128, 255], 4 * (y * n + x));
+  const t = new THREE.DataTexture(data, n, n);
+  t.needsUpdate = true;
+  return t;
+}
+
+/**
+ * Every built-in material on the GPU backend (GLSL kit, WebGLRenderer) against the CPU backend:
+ * the character wears it, casts shadows from a directional light (MeshDepthMaterial) and a point
+ * light (MeshDistanceMaterial) onto a ground that receives them, posed at `time`.
+ * `broken`: the material's own onBeforeCompile declares a uniform the GCS patch declares too, so
+ * only the patched shader fails to compile.
+ */
+async function materials(model: string, time: number, types: string[], clipName?: string, broken = false): Promise<MaterialResult[]> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const { scene, camera } = stage(root, W, H);
+  const box = new THREE.Box3().setFromObject(root), size = box.getSize(new THREE.Vector3()).length();
+  const ground = new THREE.Mesh(new THREE.PlaneGeometry(size * 4, size * 4), new THREE.MeshLambertMaterial({ color: 0x808080 }));
+  ground.rotation.x = -Math.PI / 2;
+  ground.position.y = box.min.y;
+  ground.receiveShadow = true;
+  scene.add(ground);
+  const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+  sun.position.copy(box.getCenter(new THREE.Vector3())).add(new THREE.Vector3(size, size * 2, size * 0.5));
+  sun.target.position.copy(box.getCenter(new THREE.Vector3()));
+  sun.castShadow = true;
+  Object.assign(sun.shadow.camera, { left: -size, right: size, top: size, bottom: -size, near: size / 100, far: size * 6 });
+  sun.shadow.mapSize.set(1024, 1024);
+  const lamp = new THREE.PointLight(0xffffff, 3, 0, 0);
+  lamp.position.copy(box.getCenter(new THREE.Vector3())).add(new THREE.Vector3(-size * 0.6, size * 0.5, size * 0.3));
+  lamp.castShadow = true;
+  scene.add(sun, sun.target, lamp);
+  renderer.shadowMap.enabled = true;
+  const sources: THREE.SkinnedMesh[] = [];
+  root.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) sources.push(o as THREE.SkinnedMesh); });
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
+  const read = (): Uint8Array => {
+    renderer.setClearColor(0x000000, 1);
+    renderer.render(scene, camera);
+    const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return out;
+  };
+  const results: MaterialResult[] = [];
+  for (const type of types) {
+    for (const s of sources) {
+      s.castShadow = true;
+      s.material = MATERIALS[type as keyof typeof MATERIALS]();
+      if (broken) s.material.onBeforeCompile = (shader) => { shader.vertexShader = `uniform float gcsBase;\n${shader.vertexShader}`; };
+    }
+    mixer.setTime(0);
+    mixer.stopAllAction();
+    root.updateMatrixWorld(true);
+    const character = new GcsCharacter(gcs, root, { backend: 'gpu' });
+    character.update();
+    const bind = read();
+    mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
+    mixer.setTime(time);
+    character.update();
+    const gpu = read();
+    const backend = character.backend, path = character.skins[0].gpuPath ?? 'none';
+    const note = character.skins.map((k) => k.backendNote).filter(Boolean).join('; ');
+    const again = read(); // after a failed compile this is the CPU backend's frame
+    character.rebuild(undefined, { backend: 'cpu' });
+    character.update();
+    const cpu = read();
+    let covered = 0, shadow = 0;
+    ground.visible = false;
+    const alone = read();
+    ground.visible = true;
+    for (const s of sources) s.visible = false; // the ground with no character: where the shadows fall
+    for (const m of character.meshes) m.visible = false;
+    const empty = read();
+    for (const m of character.meshes) m.visible = true;
+    for (const s of sources) s.visible = true;
+    for (let i = 0; i < W * H; i++) {
+      if (alone[4 * i] + alone[4 * i + 1] + alone[4 * i + 2] > 0) covered++;
+      else if (empty[4 * i] - gpu[4 * i] > 24) shadow++;
+    }
+    results.push({ type, backend, path, note, pixelDiff: differing(broken ? again : gpu, cpu), coverage: covered / (W * H), shadow: shadow / (W * H), posed: differing(gpu, bind) });
+    character.dispose();
+  }
+  renderer.shadowMap.enabled = false;
+  return results;
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials } }
+}
+window.__gpu = { check, crowd, materials };

@@ -19,6 +19,11 @@ export interface GpuMaterials {
    * cannot, or null.
    */
   beforeDraw?(renderer: unknown): string | null;
+  /**
+   * After a draw of the skin with `material`: why its patched shader failed to compile or link
+   * (the GPU backend then falls back, rather than draw nothing), or null.
+   */
+  compileError?(renderer: unknown, material: THREE.Material): string | null;
   /** Frees what beforeDraw needs (the node pass's target). */
   dispose?(): void;
 }

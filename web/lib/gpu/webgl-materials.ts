@@ -60,6 +60,20 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
   return { depth: gcsMaterial(depth, uniforms, smooth, path), distance: gcsMaterial(distance, uniforms, smooth, path) };
 }
 
+/**
+ * Why the program WebGLRenderer built for `material` did not compile or link (three.js's own
+ * check, `renderer.debug.checkShaderErrors`, on by default), or null: a patched shader that fails
+ * draws nothing, and the skin must not stay so in silence.
+ */
+function compileError(renderer: unknown, material: THREE.Material): string | null {
+  const r = renderer as { isWebGLRenderer?: boolean; properties?: { get(m: object): { currentProgram?: { diagnostics?: { runnable: boolean; vertexShader: { log: string }; programLog: string } } } } };
+  if (!r?.isWebGLRenderer || !material.userData.gcsUniforms) return null;
+  const diagnostics = r.properties?.get(material).currentProgram?.diagnostics;
+  if (!diagnostics || diagnostics.runnable) return null;
+  const log = (diagnostics.vertexShader.log || diagnostics.programLog).split('\n')[0].trim();
+  return `${material.type}'s GCS shader did not compile on this WebGLRenderer${log ? ` (${log})` : ''}`;
+}
+
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
 export const glslKit: GpuMaterialKit = {
   entry: 'gcs-skin/three',
@@ -72,9 +86,9 @@ export const glslKit: GpuMaterialKit = {
     const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
     const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path);
-    if (!pass) return { material, depth: shadow.depth, distance: shadow.distance };
+    if (!pass) return { material, depth: shadow.depth, distance: shadow.distance, compileError };
     return {
-      material, depth: shadow.depth, distance: shadow.distance,
+      material, depth: shadow.depth, distance: shadow.distance, compileError,
       beforeDraw(renderer: unknown): string | null {
         const why = NodePass.unsupported(renderer);
         if (!why && (renderer as { isWebGLRenderer?: boolean })?.isWebGLRenderer) pass.render(renderer as THREE.WebGLRenderer);

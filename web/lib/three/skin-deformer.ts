@@ -120,6 +120,13 @@ export class SkinDeformer {
     mesh.onBeforeShadow = (renderer, _object, _camera, _shadowCamera, geometry, material) => {
       if (this.gpu) this.checkRenderer(renderer, geometry, material);
     };
+    // A GPU material whose shader failed to compile drew nothing: the next frame runs on the CPU backend.
+    mesh.onAfterRender = (renderer, _scene, _camera, _geometry, material) => {
+      if (this.gpu) this.checkCompiled(renderer, material);
+    };
+    mesh.onAfterShadow = (renderer, _object, _camera, _shadowCamera, _geometry, material) => {
+      if (this.gpu) this.checkCompiled(renderer, material);
+    };
     mesh.name = source.name;
     mesh.castShadow = source.castShadow;
     mesh.receiveShadow = source.receiveShadow;
@@ -185,6 +192,15 @@ export class SkinDeformer {
     const next = this.prepare(this.method, why ? { backend: 'cpu' } : { gpuPath: 'sections' });
     next.note = why ?? `${noPass}: this skin runs the section-level path (gpuPath 'sections')`;
     this.commit(next, true); // the old geometry is being drawn: freed at the next update()
+  }
+
+  /** After a GPU draw: a shader that did not compile moves the skin to the CPU backend (backendNote says why). */
+  private checkCompiled(renderer: unknown, material: THREE.Material): void {
+    const why = this.gpu!.materials.compileError?.(renderer, material);
+    if (!why) return;
+    const next = this.prepare(this.method, { backend: 'cpu' });
+    next.note = why;
+    this.commit(next, true);
   }
 
   /** @internal Shows a prepared build; the previous deformer and geometry are freed (the geometry at the next update() when `duringDraw`). */
