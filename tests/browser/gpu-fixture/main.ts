@@ -123,6 +123,15 @@ export interface CheckResult {
   secondSet: number;
 }
 
+/** The scene drawn on black, read back as RGBA bytes. */
+function picture(scene: THREE.Scene, camera: THREE.Camera): Uint8Array {
+  renderer.setClearColor(0x000000, 1);
+  renderer.render(scene, camera);
+  const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
+  gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
+  return out;
+}
+
 /** Share of pixels of which a channel differs by more than 16 (of 255). */
 function differing(a: Uint8Array, b: Uint8Array): number {
   let n = 0;
@@ -157,12 +166,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   const pixels = (backend: Backend): Uint8Array => {
     if (character.backend !== backend) character.rebuild(undefined, { backend });
     character.update();
-    renderer.setClearColor(0x000000, 1);
-    renderer.render(scene, camera);
-    const gl = renderer.getContext();
-    const out = new Uint8Array(4 * W * H);
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
-    return out;
+    return picture(scene, camera);
   };
   let first: Uint8Array | null = null;
   let scaled: THREE.Object3D | undefined;
@@ -276,13 +280,7 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   mixer.setTime(times[0]);
   const character = new GcsCharacter(gcs, root, { backend: 'cpu' });
   character.update();
-  const read = (): Uint8Array => {
-    renderer.setClearColor(0x000000, 1);
-    renderer.render(scene, camera);
-    const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
-    return out;
-  };
+  const read = (): Uint8Array => picture(scene, camera);
   const cpu = read();
   for (const m of character.meshes) m.visible = false;
   c.mesh.count = 1;
@@ -361,13 +359,7 @@ async function materials(model: string, time: number, types: string[], clipName?
   root.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) sources.push(o as THREE.SkinnedMesh); });
   const mixer = new THREE.AnimationMixer(root);
   mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
-  const read = (): Uint8Array => {
-    renderer.setClearColor(0x000000, 1);
-    renderer.render(scene, camera);
-    const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
-    return out;
-  };
+  const read = (): Uint8Array => picture(scene, camera);
   const results: MaterialResult[] = [];
   for (const type of types) {
     for (const s of sources) {
