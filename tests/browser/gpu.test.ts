@@ -41,12 +41,12 @@ interface Result {
 
 type Path = 'joints' | 'sections';
 
-async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path, boneScale?: number[], centres = false): Promise<Result> {
-  return fixture.page.evaluate(([m, s, t, c, p, b, k]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
-    .__gpu.check(m as string, { smooth: s, centres: k }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale, centres] as const);
+async function check(model: string, smooth: boolean, times: number[], clip: string | undefined, path: Path, boneScale?: number[], centres = false, method = 'gcs'): Promise<Result> {
+  return fixture.page.evaluate(([m, s, t, c, p, b, k, x]) => (window as unknown as { __gpu: { check(a: string, b: object, c: number[], d?: string, e?: string, f?: number[]): Promise<Result> } })
+    .__gpu.check(m as string, { smooth: s, centres: k, method: x }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale, centres, method] as const);
 }
 
-function expectEqual(r: Result, label: string, path: Path): void {
+function expectEqual(r: Result, label: string, path: Path, method = 'gcs'): void {
   console.log(`${label}: ${r.skins} skin(s), ${r.vertices} vertices, ${r.frames} frames; GPU − CPU positions ≤ ${r.positionError.toExponential(2)} of the height ` +
     `(the frames move the skin up to ${r.motion.toFixed(3)} of it), normals ≤ ${r.normalError.toExponential(2)} (as written: ${r.normalErrorRaw.toExponential(2)}); pixels differing ${r.pixelDiff.map((x) => (100 * x).toFixed(3) + ' %').join(', ')} (character covers ${(100 * r.coverage).toFixed(1)} %; ${(100 * r.pixelMotion).toFixed(1)} % change between frames)`);
   expect(r.extColorBufferFloat).toBe(true);
@@ -55,7 +55,7 @@ function expectEqual(r: Result, label: string, path: Path): void {
   expect(r.motion).toBeGreaterThan(0.05); // the frames bend the character: a comparison in the bind pose would prove nothing
   expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
   expect(r.normalError).toBeLessThan(NORMAL_TOLERANCE);
-  if (path === 'joints') expect(r.normalErrorRaw).toBeLessThan(JOINT_NORMAL_TOLERANCE);
+  if (path === 'joints') expect(r.normalErrorRaw, method).toBeLessThan(JOINT_NORMAL_TOLERANCE);
   expect(r.coverage).toBeGreaterThan(0.02);
   expect(r.pixelMotion).toBeGreaterThan(0.005); // the GPU picture follows the animation
   for (const d of r.pixelDiff) expect(d).toBeLessThan(PIXEL_TOLERANCE);
@@ -186,5 +186,36 @@ describe.skipIf(!!reason || !!noCesium)('every built-in material, shadows includ
     expect(r.pixelDiff).toBeLessThan(PIXEL_TOLERANCE);
     const added = fixture.errors.splice(before);
     expect(added.some((e) => /Shader Error/.test(e))).toBe(true); // three.js's own report, as it comes
+  });
+});
+
+// LBS and DQS on the GPU backend (WebGLRenderer): each vertex blends its own joints from the joint
+// poses; what the shader computes equals the CPU's LBS and DQS on the same frames.
+describe.skipIf(!!reason)('LBS and DQS on the GPU backend = on the CPU', () => {
+  for (const method of ['lbs', 'dqs'] as const) {
+    test(`default human, ${method}`, async () => {
+      expectEqual(await check('human', false, [0.15, 0.45, 0.8], 'run', 'joints', undefined, false, method), `human ${method}`, 'joints', method);
+    });
+    test(`default human, ${method}, hips scaled (1.3, 0.7, 1.1)`, async () => {
+      const r = await check('human', false, [0.15, 0.45], 'run', 'joints', [1.3, 0.7, 1.1], false, method);
+      expect(r.anisotropy).toBeGreaterThan(1.5);
+      expectEqual(r, `human ${method} scaled`, 'joints', method);
+    });
+    for (const m of SHARED) {
+      const path = join(MODELS_DIR, m.file);
+      test.skipIf(!existsSync(path))(`${m.file}, ${method}`, async () => {
+        expectEqual(await check(`/@fs${path}`, false, m.times, m.clip, 'joints', undefined, false, method), `${m.file} ${method}`, 'joints', method);
+      });
+    }
+  }
+  test.skipIf(!!noCesium)('8 influences per vertex (CesiumMan spread onto 5–8 joints), lbs and dqs', async () => {
+    const file = join(ROOT, 'build', 'test-models', 'cesium-8.glb');
+    mkdirSync(join(ROOT, 'build', 'test-models'), { recursive: true });
+    await eightInfluenceGlb(CESIUM, file);
+    for (const method of ['lbs', 'dqs'] as const) {
+      const r = await check(`/@fs${file}`, false, [0.3, 0.9], undefined, 'joints', undefined, false, method);
+      expect(r.tableSlots).toEqual([8]);
+      expectEqual(r, `CesiumMan 8 influences ${method}`, 'joints', method);
+    }
   });
 });

@@ -10,6 +10,7 @@ import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib
 import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend } from '../../../web/lib/three.js';
 import { GcsCrowd } from '../../../web/lib/crowd.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
+import type { GpuMethod, TableSlots } from '../../../web/lib/gpu/layout.js';
 import { firstFour } from '../../helpers/influences.js';
 import { load, stage } from '../fixture-scene.js';
 
@@ -47,18 +48,18 @@ void main() { gl_FragColor = vOut; }`;
  * float32. `uniforms`: what its material's vertex stage reads (joint-level path: the node texture,
  * written by the node pass when the mesh was last drawn).
  */
-function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath): { positions: Float32Array; normals: Float32Array } {
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath, method: GpuMethod = 'gcs', slots: TableSlots = 4): { positions: Float32Array; normals: Float32Array } {
   const src = mesh.geometry;
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
   const points = new THREE.BufferGeometry(); // not indexed: gl_VertexID is the vertex
-  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend', 'gcsBlendThird']) {
+  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend', 'gcsBlendThird', 'gcsInfluences0', 'gcsWeights0', 'gcsInfluences1', 'gcsWeights1']) {
     const a = src.getAttribute(name);
     if (a) points.setAttribute(name, a);
   }
   const material = new THREE.ShaderMaterial({
     uniforms: { ...(uniforms as Record<string, THREE.IUniform>), readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
-    vertexShader: patchVertexShader(READ_VERTEX, smooth, path),
+    vertexShader: patchVertexShader(READ_VERTEX, smooth, path, method, slots),
     fragmentShader: READ_FRAGMENT,
   });
   const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
@@ -145,15 +146,16 @@ function differing(a: Uint8Array, b: Uint8Array): number {
  * first bone's scale multiplied by it on every frame (a non-uniform scale puts a different scale
  * part K_j in every skin matrix below it).
  */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto',
+async function check(model: string, options: GcsOptions & { method?: GpuMethod }, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto',
   boneScale?: [number, number, number]): Promise<CheckResult> {
+  const { method = 'gcs', ...gcsOptions } = options;
   const gcs = await gcsReady;
   const { root, clips } = await load(model);
   const { scene, camera } = stage(root, W, H); // framed from the bind pose
   const mixer = new THREE.AnimationMixer(root);
   const clip = clips.find((c) => c.name === clipName) ?? clips[0];
   mixer.clipAction(clip).play();
-  const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+  const character = new GcsCharacter(gcs, root, { method, gcs: gcsOptions, backend: 'gpu', gpuPath });
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
     extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1,
@@ -182,7 +184,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     character.skins.forEach((skin, k) => {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
-      const gpuOut = readBack(mesh, vertexUniforms(mesh), sections.smooth, sections.path);
+      const gpuOut = readBack(mesh, vertexUniforms(mesh), sections.smooth, sections.path, sections.method, sections.tableSlots);
       const d = skin.deformer as GcsDeformer;
       const S = (skin as unknown as { skin: Float32Array }).skin;
       d.deform(S); // the same frame on the CPU

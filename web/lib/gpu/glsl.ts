@@ -6,7 +6,7 @@
 import { GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
+  GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, type GpuMethod, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -113,6 +113,21 @@ const POSITION = /* glsl */ `
 // pass (node-pass.ts: a fragment per output texel, all instances of a crowd in one draw); the vertex
 // stage reads the result (NODE_PARS) and blends.
 
+/** How the joint-level path turns a normal or tangent with a normal matrix N. */
+const TURN_JOINT = /* glsl */ `
+// A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
+// sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else
+// are normalised (a vanished one keeps its rest direction); unblended ones are normalised only when
+// the scale asks for it.
+vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool almostEqual, const in bool normalise ) {
+	vec3 n = N * v;
+	if ( almostEqual ) return n;
+	if ( near ) { float e = dot( n, n ) - 1.0; return n * ( 1.0 + e * ( ${f(LENGTH_FIX[0])} + ${f(LENGTH_FIX[1])} * e ) ); }
+	if ( normalise ) { float l = length( n ); return l > 0.0 ? n / l : v; }
+	return n;
+}
+`;
+
 /** The rotation matrix of a quaternion: the node pass and the vertex stage both build one. */
 const ROTATION = /* glsl */ `
 // The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
@@ -128,7 +143,6 @@ mat3 gcsRotation( const in vec4 q, const in float k2 ) {
 /** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
 const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
-uniform highp sampler2D gcsTable;
 vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
 	int w = textureSize( t, 0 ).x;
 	return texelFetch( t, ivec2( i % w, i / w ), 0 );
@@ -163,13 +177,13 @@ vec4 gcsNormalTexel( const in mat3 k ) {
 	if ( ! ( big > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
 	return vec4( 1.0 / kbig, 1.0 / big, 0.0, - 1.0 );
 }
-// Section s's transform x ↦ M x + T and its normal texel N (gcsNormalTexel): a rigid core is S_j;
-// otherwise the dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly,
-// applied first, or with a centre of rotation the blend's M about it. \`base\`: the instance's first
-// joint texel. GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
-void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
-	int row = GCS_TABLE_TEXELS * s;
-	vec4 joints = gcsTexel( gcsTable, row ), weights = gcsTexel( gcsTable, row + 1 );
+// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
+// weights, weights1; a slot of weight 0 adds nothing) into x ↦ M x + T and the normal texel N
+// (gcsNormalTexel): K_j = R_jᵀ S_j blended linearly, applied first; with a centre of rotation
+// (w = 1; w = 0: none) the blend's M about it. One joint alone (joints.y < 0) is S_j itself.
+// \`base\`: the instance's first joint texel. The CPU's blendPoses, step for step.
+void gcsBlend( const in int base, const in vec4 joints, const in vec4 weights, const in vec4 joints1, const in vec4 weights1,
+	const in vec4 centre, out mat3 M, out vec3 T, out vec4 N ) {
 	mat3 S; vec3 t; vec4 q;
 	gcsJoint( base, int( joints.x ), S, t, q );
 	if ( joints.y < 0.0 ) {
@@ -177,14 +191,9 @@ void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T,
 		N = gcsNormalTexel( transpose( gcsRotation( q, 2.0 ) ) * S );
 		return;
 	}
-	#if GCS_TABLE_SLOTS > 4
-	vec4 joints1 = gcsTexel( gcsTable, row + 2 ), weights1 = gcsTexel( gcsTable, row + 3 );
-	#endif
 	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
 	mat3 K = mat3( 0.0 );
-	// The centre of rotation p (w = 1; w = 0: none) and Σ w_i (S_i p − p), where LBS moves it.
-	vec4 centre = gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 );
-	vec3 moved = vec3( 0.0 );
+	vec3 moved = vec3( 0.0 ); // Σ w_i (S_i p − p): where LBS moves the centre p
 	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
 		#if GCS_TABLE_SLOTS > 4
 		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
@@ -192,7 +201,7 @@ void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T,
 		#else
 		float id = joints[ k ], w = weights[ k ];
 		#endif
-		if ( id < 0.0 ) break;
+		if ( ! ( w > 0.0 ) ) continue;
 		if ( k > 0 ) gcsJoint( base, int( id ), S, t, q );
 		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
 		float sw = dot( q, pivot ) < 0.0 ? - w : w;
@@ -223,7 +232,18 @@ layout( location = 0 ) out highp vec4 gcsRow0;
 layout( location = 1 ) out highp vec4 gcsRow1;
 layout( location = 2 ) out highp vec4 gcsRow2;
 layout( location = 3 ) out highp vec4 gcsNormal;
+uniform highp sampler2D gcsTable;
 ${NODE_MATHS}
+// Section s: its joints, weights and centre of rotation from the static table (GCS_TABLE_TEXELS per
+// section: per 4 slots a texel of joints, −1 past the last, then one of weights; last, the centre).
+void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
+	int row = GCS_TABLE_TEXELS * s;
+	vec4 joints1 = vec4( - 1.0 ), weights1 = vec4( 0.0 );
+	#if GCS_TABLE_SLOTS > 4
+	joints1 = gcsTexel( gcsTable, row + 2 ); weights1 = gcsTexel( gcsTable, row + 3 );
+	#endif
+	gcsBlend( base, gcsTexel( gcsTable, row ), gcsTexel( gcsTable, row + 1 ), joints1, weights1, gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 ), M, T, N );
+}
 void main() {
 	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
 	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
@@ -272,18 +292,7 @@ void gcsNode( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renor
 	mat3 a = M * n.x;
 	N = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
 }
-// A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
-// sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else
-// are normalised (a vanished one keeps its rest direction); unblended ones are normalised only when
-// the scale asks for it.
-vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const in bool almostEqual, const in bool normalise ) {
-	vec3 n = N * v;
-	if ( almostEqual ) return n;
-	if ( near ) { float e = dot( n, n ) - 1.0; return n * ( 1.0 + e * ( ${f(LENGTH_FIX[0])} + ${f(LENGTH_FIX[1])} * e ) ); }
-	if ( normalise ) { float l = length( n ); return l > 0.0 ? n / l : v; }
-	return n;
-}
-`;
+${TURN_JOINT}`;
 
 /** Per vertex, once: its (blended) node transform and normal matrix, read from the node texture. */
 const JOINT_BASE = /* glsl */ `
@@ -335,6 +344,92 @@ const JOINT_POSITION = /* glsl */ `
 	transformed = gcsM * transformed + gcsT;
 `;
 
+// ------------------------------------------------------------ LBS and DQS per vertex (backend 'gpu', method 'lbs' | 'dqs')
+// Each vertex blends its own joints (≤ 4, or 8 with GCS_TABLE_SLOTS 8) at its own weights, read
+// from attributes: the rig's weights as the core normalises them, joint −1 where the weight is 0.
+
+/** Declarations: the joint poses (per frame) and the vertex's influences. */
+const SKIN_PARS = /* glsl */ `
+uniform int gcsBase;
+uniform int gcsStride;
+attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
+#if GCS_TABLE_SLOTS > 4
+attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
+#endif
+${NODE_MATHS}${TURN_JOINT}
+int gcsFirstJoint() {
+	int i = gcsBase;
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	return i;
+}
+`;
+
+/** The second set of influences, or none. */
+const SECOND_SET = /* glsl */ `
+		vec4 gcsJ1 = vec4( - 1.0 ), gcsW1 = vec4( 0.0 );
+		#if GCS_TABLE_SLOTS > 4
+		gcsJ1 = ${INFLUENCE_ATTRIBUTES[1]}; gcsW1 = ${WEIGHT_ATTRIBUTES[1]};
+		#endif
+`;
+
+/** LBS (as three.js and the CPU's LBS): M = Σ w_j S_j; normals by M, then unit length. */
+const LBS_BASE = /* glsl */ `
+	mat3 gcsM;
+	vec3 gcsT;
+	vec4 gcsRest;
+	{${SECOND_SET}
+		int base = gcsFirstJoint();
+		vec4 r0 = vec4( 0.0 ), r1 = vec4( 0.0 ), r2 = vec4( 0.0 );
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+			#if GCS_TABLE_SLOTS > 4
+			float id = k < 4 ? ${INFLUENCE_ATTRIBUTES[0]}[ k ] : gcsJ1[ k - 4 ], w = k < 4 ? ${WEIGHT_ATTRIBUTES[0]}[ k ] : gcsW1[ k - 4 ];
+			#else
+			float id = ${INFLUENCE_ATTRIBUTES[0]}[ k ], w = ${WEIGHT_ATTRIBUTES[0]}[ k ];
+			#endif
+			if ( ! ( w > 0.0 ) ) continue;
+			int i = base + int( id ) * ${GPU_TEXELS_PER_JOINT};
+			r0 += w * gcsTexel( gcsJoints, i ); r1 += w * gcsTexel( gcsJoints, i + 1 ); r2 += w * gcsTexel( gcsJoints, i + 2 );
+		}
+		gcsM = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+		gcsT = vec3( r0.w, r1.w, r2.w );
+		// Where the blend has collapsed (bones scaled to 0): the first influence's rotation.
+		gcsRest = gcsTexel( gcsJoints, base + int( ${INFLUENCE_ATTRIBUTES[0]}.x ) * ${GPU_TEXELS_PER_JOINT} + 3 );
+	}
+`;
+
+const LBS_NORMAL = turned((v) => `gcsTurnLbs( ${v}, gcsM, gcsRest )`);
+
+const LBS_TURN = /* glsl */ `
+vec3 gcsTurnLbs( const in vec3 v, const in mat3 M, const in vec4 q ) {
+	vec3 n = M * v;
+	float len2 = dot( n, n );
+	if ( len2 > 1e-24 && len2 < 1e24 ) return n * ( 1.0 / sqrt( len2 ) );
+	n = gcsRotation( q, 2.0 ) * v;
+	float l = length( n );
+	return l > 0.0 ? n / l : v;
+}
+`;
+
+/** DQS (the CPU's dqsVertices): the node maths on the vertex's own joints and weights, no centre. */
+const DQS_BASE = /* glsl */ `
+	mat3 gcsM, gcsN;
+	vec3 gcsT;
+	bool gcsNormalise;
+	{${SECOND_SET}
+		vec4 n;
+		gcsBlend( gcsFirstJoint(), ${INFLUENCE_ATTRIBUTES[0]}, ${WEIGHT_ATTRIBUTES[0]}, gcsJ1, gcsW1, vec4( 0.0 ), gcsM, gcsT, n );
+		mat3 a = gcsM * n.x;
+		gcsN = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
+		gcsNormalise = n.w < 0.0;
+	}
+`;
+
+const DQS_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, false, false, gcsNormalise )`);
+
 const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', '#include <skinning_vertex>'] as const;
 
 /**
@@ -347,17 +442,21 @@ const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', 
  * `USE_ENVMAP || USE_SKINNING`), the transform is read in `skinning_vertex` instead. Throws GcsError
  * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
  */
-export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections'): string {
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): string {
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
   if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
+  if (method !== 'gcs' && method !== 'lbs' && method !== 'dqs') throw new GcsError('INVALID_ARGUMENT', `the GPU backend runs 'gcs', 'lbs' or 'dqs'; got '${String(method)}'`);
   const joints = path === 'joints';
-  const base = joints ? JOINT_BASE : BASE;
+  const [pars, base, position, normal] = method === 'lbs' ? [`${SKIN_PARS}${LBS_TURN}`, LBS_BASE, JOINT_POSITION, LBS_NORMAL]
+    : method === 'dqs' ? [SKIN_PARS, DQS_BASE, JOINT_POSITION, DQS_NORMAL]
+    : joints ? [NODE_PARS, JOINT_BASE, JOINT_POSITION, JOINT_NORMAL] : [PARS, BASE, POSITION, NORMAL];
   let out = source
-    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? NODE_PARS : PARS}`)
+    .replace(HOOKS[0], `${HOOKS[0]}\n${pars}`)
     .replace(HOOKS[1], `#define GCS_BASE\n${base}`)
-    .replace(HOOKS[2], `#ifndef GCS_BASE\n${base}\n#endif\n${joints ? JOINT_POSITION : POSITION}`);
+    .replace(HOOKS[2], `#ifndef GCS_BASE\n${base}\n#endif\n${position}`);
   // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
-  out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
-  return `${smooth ? '#define GCS_SMOOTH\n' : ''}${out}`;
+  out = out.replace('#include <skinnormal_vertex>', normal);
+  const defines = method === 'gcs' ? '' : tableDefines(slots);
+  return `${smooth && method === 'gcs' ? '#define GCS_SMOOTH\n' : ''}${defines}${out}`;
 }

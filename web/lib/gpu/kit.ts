@@ -31,6 +31,8 @@ export interface GpuMaterials {
 export interface GpuMaterialKit {
   /** The package entry that draws with this kit (named in notes and errors). */
   readonly entry: string;
+  /** The methods its GPU backend runs ('gcs'; the GLSL kit also 'lbs' and 'dqs'). */
+  readonly methods: ReadonlySet<string>;
   /** Why `material` cannot draw GCS through this kit, or null when it can. */
   support(material: THREE.Material): string | null;
   /**

@@ -33,6 +33,16 @@ export type TableSlots = 4 | 8;
  */
 export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2 + 1;
 
+/** What the GPU backend runs per vertex: GCS (nodes), or LBS / DQS of the vertex's own joints. */
+export type GpuMethod = 'gcs' | 'lbs' | 'dqs';
+
+/**
+ * LBS and DQS on the GPU: per vertex its joints (−1 where the weight is 0) and weights, as the core
+ * normalises them; the second of each only on rigs with up to 8 influences per vertex.
+ */
+export const INFLUENCE_ATTRIBUTES = ['gcsInfluences0', 'gcsInfluences1'] as const;
+export const WEIGHT_ATTRIBUTES = ['gcsWeights0', 'gcsWeights1'] as const;
+
 /** Per-vertex attribute, plain mode: the vertex's section (a float). */
 export const SECTION_ATTRIBUTE = 'gcsSection';
 /** Per-vertex attribute, smooth mode: (section, other section, factor towards the other). */

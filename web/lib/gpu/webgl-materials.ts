@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { patchVertexShader } from './glsl.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
-import type { GpuPath } from './layout.js';
+import type { GpuMethod, GpuPath, TableSlots } from './layout.js';
 import { NodePass } from './node-pass.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
@@ -24,7 +24,7 @@ export function gpuMaterialSupport(material: THREE.Material): string | null {
  * (NodePass.uniforms: each node's transform, computed once per frame from the joint poses). The
  * source's own onBeforeCompile, if any, runs first.
  */
-export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): M {
+export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): M {
   const reason = gpuMaterialSupport(source);
   if (reason) throw new GcsError('INVALID_ARGUMENT', reason);
   const material = source.clone() as M;
@@ -33,9 +33,9 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
   material.onBeforeCompile = (shader, renderer) => {
     own.call(source, shader, renderer);
     for (const [name, u] of Object.entries(uniforms)) if (u) shader.uniforms[name] = u;
-    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path);
+    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path, method, slots);
   };
-  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}-${path}`;
+  material.customProgramCacheKey = () => `${ownKey}|gcs-${method === 'gcs' ? `${smooth ? 'smooth' : 'plain'}-${path}` : `${method}-${slots}`}`;
   material.name = source.name;
   material.userData.gcsSource = source;
   material.userData.gcsUniforms = uniforms; // what its vertex stage reads (tests read the shader's output with them)
@@ -46,7 +46,7 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
  */
-export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections'): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
+export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };
@@ -57,7 +57,7 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
       m.alphaMap = s.alphaMap ?? null;
     }
   }
-  return { depth: gcsMaterial(depth, uniforms, smooth, path), distance: gcsMaterial(distance, uniforms, smooth, path) };
+  return { depth: gcsMaterial(depth, uniforms, smooth, path, method, slots), distance: gcsMaterial(distance, uniforms, smooth, path, method, slots) };
 }
 
 /**
@@ -77,15 +77,16 @@ function compileError(renderer: unknown, material: THREE.Material): string | nul
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
 export const glslKit: GpuMaterialKit = {
   entry: 'gcs-skin/three',
+  methods: new Set(['gcs', 'lbs', 'dqs']),
   support: gpuMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
-    const { smooth, path } = sections;
-    // Joint-level: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
-    const pass = path === 'joints' ? new NodePass(sections) : null;
+    const { smooth, path, method, tableSlots } = sections;
+    // GCS, joint-level: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
+    const pass = method === 'gcs' && path === 'joints' ? new NodePass(sections) : null;
     const uniforms = pass ? pass.uniforms : sections.uniforms;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path);
+    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, method, tableSlots);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
-    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path);
+    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, method, tableSlots);
     if (!pass) return { material, depth: shadow.depth, distance: shadow.distance, compileError };
     return {
       material, depth: shadow.depth, distance: shadow.distance, compileError,
