@@ -147,11 +147,23 @@ vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
 	int w = textureSize( t, 0 ).x;
 	return texelFetch( t, ivec2( i % w, i / w ), 0 );
 }
-// Joint j's pose (its texels from \`base\`, the instance's first): S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+// The texel after \`at\` in a texture \`w\` wide (one division per joint, not per texel).
+ivec2 gcsNextTexel( const in ivec2 at, const in int w ) {
+	return at.x + 1 < w ? ivec2( at.x + 1, at.y ) : ivec2( 0, at.y + 1 );
+}
+// Joint j's texels (from \`base\`, the instance's first): the rows of S_j (translation in w) and its rotation quaternion.
+void gcsJointTexels( const in int base, const in int j, out vec4 r0, out vec4 r1, out vec4 r2, out vec4 q ) {
+	int i = base + j * ${GPU_TEXELS_PER_JOINT}, w = textureSize( gcsJoints, 0 ).x, y = i / w;
+	ivec2 at = ivec2( i - y * w, y );
+	r0 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	r1 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	r2 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	q = texelFetch( gcsJoints, at, 0 );
+}
+// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
 void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out vec4 q ) {
-	int i = base + j * ${GPU_TEXELS_PER_JOINT};
-	vec4 r0 = gcsTexel( gcsJoints, i ), r1 = gcsTexel( gcsJoints, i + 1 ), r2 = gcsTexel( gcsJoints, i + 2 );
-	q = gcsTexel( gcsJoints, i + 3 );
+	vec4 r0, r1, r2;
+	gcsJointTexels( base, j, r0, r1, r2, q );
 	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 	t = vec3( r0.w, r1.w, r2.w );
 }
@@ -380,7 +392,7 @@ const SECOND_SET = /* glsl */ `
 const LBS_BASE = /* glsl */ `
 	mat3 gcsM;
 	vec3 gcsT;
-	vec4 gcsRest;
+	vec4 gcsRest = vec4( 0.0, 0.0, 0.0, 1.0 );
 	{${SECOND_SET}
 		int base = gcsFirstJoint();
 		vec4 r0 = vec4( 0.0 ), r1 = vec4( 0.0 ), r2 = vec4( 0.0 );
@@ -391,13 +403,13 @@ const LBS_BASE = /* glsl */ `
 			float id = ${INFLUENCE_ATTRIBUTES[0]}[ k ], w = ${WEIGHT_ATTRIBUTES[0]}[ k ];
 			#endif
 			if ( ! ( w > 0.0 ) ) continue;
-			int i = base + int( id ) * ${GPU_TEXELS_PER_JOINT};
-			r0 += w * gcsTexel( gcsJoints, i ); r1 += w * gcsTexel( gcsJoints, i + 1 ); r2 += w * gcsTexel( gcsJoints, i + 2 );
+			vec4 a0, a1, a2, q;
+			gcsJointTexels( base, int( id ), a0, a1, a2, q );
+			r0 += w * a0; r1 += w * a1; r2 += w * a2;
+			if ( k == 0 ) gcsRest = q; // where the blend collapses (bones scaled to 0): the first influence's rotation
 		}
 		gcsM = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 		gcsT = vec3( r0.w, r1.w, r2.w );
-		// Where the blend has collapsed (bones scaled to 0): the first influence's rotation.
-		gcsRest = gcsTexel( gcsJoints, base + int( ${INFLUENCE_ATTRIBUTES[0]}.x ) * ${GPU_TEXELS_PER_JOINT} + 3 );
 	}
 `;
 
