@@ -36,7 +36,8 @@ if (!existsSync(chromiumPath)) {
 }
 const server = await createServer({
   configFile: join(root, 'web/demo/vite.config.ts'), logLevel: 'error',
-  server: { host: '127.0.0.1', port: 0, fs: { allow: [root, models] } },
+  // No hot reload: an edited source must not reload the page mid-run.
+  server: { host: '127.0.0.1', port: 0, fs: { allow: [root, models] }, hmr: false, watch: null },
 });
 await server.listen();
 const { port } = server.httpServer.address();

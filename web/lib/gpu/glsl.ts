@@ -198,11 +198,15 @@ void gcsBlend( const in int base, const in vec4 joints, const in vec4 weights, c
 	const in vec4 centre, out mat3 M, out vec3 T, out vec4 N ) {
 	mat3 S; vec3 t; vec4 q;
 	gcsJoint( base, int( joints.x ), S, t, q );
+	#ifndef GCS_PER_VERTEX
+	// (Per vertex, DQS, a vertex of one joint takes the blend of one: the same up to rounding, and a
+	// shader with one path costs less where every path runs.)
 	if ( joints.y < 0.0 ) {
 		M = S; T = t;
 		N = gcsNormalTexel( transpose( gcsRotation( q, 2.0 ) ) * S );
 		return;
 	}
+	#endif
 	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
 	mat3 K = mat3( 0.0 );
 	vec3 moved = vec3( 0.0 ); // Σ w_i (S_i p − p): where LBS moves the centre p
@@ -362,6 +366,7 @@ const JOINT_POSITION = /* glsl */ `
 
 /** Declarations: the joint poses (per frame) and the vertex's influences. */
 const SKIN_PARS = /* glsl */ `
+#define GCS_PER_VERTEX
 uniform int gcsBase;
 uniform int gcsStride;
 attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
