@@ -3,9 +3,11 @@
 // positions within 1e-5 of the character's height on the same frames — the default criterion,
 // plain and smooth, on the default human and on CesiumMan and Soldier from ../shared/models (skipped
 // with the reason printed when absent), on both GPU paths: 'joints' (the default for this
-// criterion: the shader blends every section from the joint poses) and 'sections' (section
-// transforms computed in wasm) — and the character drawn by its own patched material looks the
-// same as on the CPU backend. With 8 influences per vertex (CesiumMan's weights spread onto 5–8
+// criterion: a node pass blends every node from the joint poses once per frame, and the vertex
+// stage reads its nodes) and 'sections' (section transforms computed in wasm) — and the character
+// drawn by its own patched material looks the same as on the CPU backend. LBS and DQS on the GPU
+// backend equal the CPU's LBS and DQS; every built-in material, shadows included, draws as on the
+// CPU backend; a patched shader that does not compile falls back to the CPU with a note. With 8 influences per vertex (CesiumMan's weights spread onto 5–8
 // joints, written with JOINTS_1/WEIGHTS_1, tests/helpers/influences-glb.ts; the CPU result is checked
 // against an 8-influence reference in tests/lib/influences.test.ts): both paths again, the joint
 // table at 8 joints per section, and a crowd (each instance's shader output and its picture).
