@@ -221,3 +221,22 @@ describe.skipIf(!!reason)('LBS and DQS on the GPU backend = on the CPU', () => {
     }
   });
 });
+
+describe.skipIf(!!reason || !!noCesium)('the node pass: once per frame; without float render targets, the section-level path', () => {
+  test('CesiumMan with shadows: one pass per frame; EXT_color_buffer_float absent: the skin on the section-level path with a note, a crowd stopped', async () => {
+    interface P { renders: number[]; fallbackPath: string; fallbackNote: string; fallbackDiff: number; crowdError: string }
+    const r = await fixture.page.evaluate((m) => (window as unknown as { __gpu: { nodePass(a: string, b: number): Promise<P> } }).__gpu.nodePass(m, 0.9), `/@fs${CESIUM}`);
+    console.log(`render() calls per frame: ${r.renders.join(', ')} (first frame, drawn again, next frame); no float targets: ${r.fallbackPath} (${r.fallbackNote}), ` +
+      `${(100 * r.fallbackDiff).toFixed(3)} % of pixels differ from the CPU backend; crowd: ${r.crowdError}`);
+    // The frame's own render() plus one node pass, before the shadow map; the same pose drawn again: no pass.
+    expect(r.renders).toEqual([2, 1, 2]);
+    expect(r.fallbackPath).toBe('sections');
+    expect(r.fallbackNote).toMatch(/EXT_color_buffer_float/);
+    expect(r.fallbackDiff).toBeLessThan(PIXEL_TOLERANCE);
+    expect(r.crowdError).toMatch(/^INVALID_ARGUMENT: .*EXT_color_buffer_float.*gpuPath: 'sections'/);
+    const warned = fixture.errors.filter((e) => /EXT_color_buffer_float/.test(e));
+    fixture.errors.splice(0, fixture.errors.length, ...fixture.errors.filter((e) => !/EXT_color_buffer_float/.test(e)));
+    expect(fixture.errors).toEqual([]);
+    console.log(`warnings: ${warned.length}`);
+  });
+});

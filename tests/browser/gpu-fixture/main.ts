@@ -405,7 +405,68 @@ async function materials(model: string, time: number, types: string[], clipName?
   return results;
 }
 
-declare global {
-  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials } }
+export interface PassResult {
+  /** renderer.render calls (three.js's info.render.frame: the node pass is one) for: the first frame, the same frame drawn again, the next frame */
+  renders: number[];
+  /** with float render targets stubbed away: the skin's path and note after its first draw, and its picture against the CPU backend's */
+  fallbackPath: string; fallbackNote: string; fallbackDiff: number;
+  /** the crowd's next update() after a draw without float render targets */
+  crowdError: string;
 }
-window.__gpu = { check, crowd, materials };
+
+/**
+ * The node pass runs once per frame (at the skin's first draw after update(), shadows on), and a
+ * renderer without float render targets (EXT_color_buffer_float stubbed away) moves a skin to the
+ * section-level path with a note, and stops a crowd with a GcsError.
+ */
+async function nodePass(model: string, time: number): Promise<PassResult> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const { scene, camera } = stage(root, W, H);
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips[0]).play();
+  mixer.setTime(time);
+  renderer.shadowMap.enabled = true;
+  scene.traverse((o) => { if ((o as THREE.DirectionalLight).isDirectionalLight) (o as THREE.DirectionalLight).castShadow = true; });
+  let source: THREE.SkinnedMesh | undefined;
+  root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+  source!.castShadow = true;
+  const character = new GcsCharacter(gcs, root, { backend: 'gpu' });
+  const info = renderer.info.render;
+  const count = (draw: () => void): number => { const before = info.frame; draw(); return info.frame - before; };
+  const renders = [
+    count(() => { character.update(); picture(scene, camera); }),
+    count(() => picture(scene, camera)),
+    count(() => { mixer.setTime(time + 0.1); character.update(); picture(scene, camera); }),
+  ];
+  character.dispose();
+  const has = renderer.extensions.has.bind(renderer.extensions);
+  renderer.extensions.has = (name: string) => name !== 'EXT_color_buffer_float' && has(name);
+  const stubbed = new GcsCharacter(gcs, root, { backend: 'gpu' });
+  stubbed.update();
+  picture(scene, camera); // the first draw finds no float targets
+  const skin = stubbed.skins[0];
+  const fallbackPath = skin.gpuPath ?? 'none', fallbackNote = skin.backendNote;
+  stubbed.update();
+  const gpu = picture(scene, camera);
+  stubbed.rebuild(undefined, { backend: 'cpu' });
+  stubbed.update();
+  const fallbackDiff = differing(gpu, picture(scene, camera));
+  stubbed.dispose();
+  const c = new GcsCrowd(gcs, source!, 2);
+  c.update();
+  const alone = new THREE.Scene();
+  alone.add(c.mesh);
+  picture(alone, camera);
+  let crowdError = '';
+  try { c.update(); } catch (e) { crowdError = `${(e as { code?: string }).code}: ${(e as Error).message}`; }
+  c.dispose();
+  renderer.extensions.has = has;
+  renderer.shadowMap.enabled = false;
+  return { renders, fallbackPath, fallbackNote, fallbackDiff, crowdError };
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials; nodePass: typeof nodePass } }
+}
+window.__gpu = { check, crowd, materials, nodePass };
