@@ -1,9 +1,9 @@
 // The joint-level GPU path's math, pinned in node (weights criterion): the per-frame joint poses
 // (gcs_gcs_compute_joint_poses, JointPoses: the rows of S_j and its rotation quaternion) and the
 // static per-section table (gcs_gcs_section_influences), evaluated in plain JavaScript exactly as
-// the vertex shader does it (web/lib/gpu.ts, JOINT_PARS / JOINT_BASE: each section's dual-quaternion
-// blend of its joints, the scale parts blended linearly and applied first, the CPU's normal matrix
-// and its smooth-mode length fix), give gcs_deformer_deform's positions (within 1e-6 of the height)
+// the node pass and the vertex stage do it (web/lib/gpu/glsl.ts: each node's dual-quaternion blend
+// of its joints, the scale parts blended linearly and applied first, written to float32 texels with
+// its normal texel; per vertex, the normal matrix N = cof(M·x)·y and the smooth-mode length fix), give gcs_deformer_deform's positions (within 1e-6 of the height)
 // and normals (within 1e-5, not renormalised) — on the default human's walk and run and on
 // CesiumMan and Soldier (../shared/models, skipped with the reason printed when absent), plain and
 // smooth, with the skin matrices as they are, ×100 (Mixamo's centimetre rigs) and under a
@@ -35,31 +35,47 @@ function quatRows(x: number, y: number, z: number, w: number): number[] {
     2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)];
 }
 
-/** The CPU's normalMatrix (transform.h) for rotation rows r and scale part k (row-major 3×3). */
-function normalMatrix(r: number[], k: number[]): { n: number[]; renorm: boolean } {
-  const s = (k[0] + k[4] + k[8]) / 3;
-  let uniform = s > 0;
-  for (let i = 0; i < 9 && uniform; i++) if (Math.abs(k[i] - (i % 4 === 0 ? s : 0)) > 1e-4 * s) uniform = false;
-  if (uniform) return { n: r, renorm: false };
-  let kbig = 0;
-  for (const v of k) kbig = Math.max(kbig, Math.abs(v));
-  if (!(kbig > 1e-30)) return { n: r, renorm: true };
-  const a = k.map((v) => v / kbig);
+/** The cofactor matrix of a row-major 3×3 (cof(A) = det(A)·A⁻ᵀ: what turns normals). */
+function cofactor(a: ArrayLike<number>): number[] {
   const cof = new Array<number>(9);
   for (let i = 0; i < 3; i++)
     for (let j = 0; j < 3; j++) {
       const i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
       cof[3 * i + j] = a[3 * i1 + j1] * a[3 * i2 + j2] - a[3 * i1 + j2] * a[3 * i2 + j1];
     }
-  let big = 0;
-  for (const v of cof) big = Math.max(big, Math.abs(v));
-  if (!(big > 1e-30)) return { n: r, renorm: true };
-  const n = new Array<number>(9).fill(0);
-  for (let i = 0; i < 3; i++) for (let j = 0; j < 3; j++) for (let m = 0; m < 3; m++) n[3 * i + j] += r[3 * i + m] * cof[3 * m + j] / big;
-  return { n, renorm: true };
+  return cof;
 }
 
-/** The shader's section blend from the joint texels of one instance (at texel `base`) and the static table. */
+/**
+ * The node pass's normal texel (glsl.ts gcsNormalTexel) for scale part k (row-major): (x, y) with
+ * N = cof(M·x)·y, and whether normals renormalise — the CPU's normalMatrix (transform.h): R where k
+ * is a positive uniform scale s (x = 1/s, y = 1), else R·cof(k/kbig)/big (x = 1/kbig, y = 1/big).
+ */
+function normalTexel(k: number[]): { x: number; y: number; renorm: boolean } {
+  const s = (k[0] + k[4] + k[8]) / 3;
+  let uniform = s > 0;
+  for (let i = 0; i < 9 && uniform; i++) if (Math.abs(k[i] - (i % 4 === 0 ? s : 0)) > 1e-4 * s) uniform = false;
+  if (uniform) return { x: 1 / s, y: 1, renorm: false };
+  let kbig = 0;
+  for (const v of k) kbig = Math.max(kbig, Math.abs(v));
+  if (!(kbig > 1e-30)) return { x: 0, y: 0, renorm: true };
+  let big = 0;
+  for (const v of cofactor(k.map((v) => v / kbig))) big = Math.max(big, Math.abs(v));
+  if (!(big > 1e-30)) return { x: 0, y: 0, renorm: true };
+  return { x: 1 / kbig, y: 1 / big, renorm: true };
+}
+
+/**
+ * A node as the vertex stage reads it back from the node pass's float targets: [M | T] and the
+ * normal texel rounded to float32, then N = cof(M·x)·y.
+ */
+function nodeAsRead(p: Float64Array, k: number[]): Blend {
+  const rows = Float32Array.from(p), t = normalTexel(k), x = Math.fround(t.x), y = Math.fround(t.y);
+  const a = [0, 1, 2, 4, 5, 6, 8, 9, 10].map((i) => rows[i] * x);
+  return { p: Float64Array.from(rows), n: Float64Array.from(cofactor(a).map((v) => v * y)), renorm: t.renorm };
+}
+
+/** The node pass's section blend from the joint texels of one instance (at texel `base`) and the static table, as the vertex stage reads it. */
 function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s: number): Blend {
   const at = (j: number) => (base + j * GPU_TEXELS_PER_JOINT) * 4;
   const joint = (i: number) => table[12 * s + i], weight = (i: number) => table[12 * s + 4 + i];
@@ -73,8 +89,7 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
   if (joint(1) < 0) { // a rigid core: S_j itself
     const o = at(joint(0));
     const r = quatRows(poses[o + 12], poses[o + 13], poses[o + 14], poses[o + 15]);
-    const nm = normalMatrix(r, scaleOf(o, r));
-    return { p: Float64Array.from(poses.subarray(o, o + 12)), n: Float64Array.from(nm.n), renorm: nm.renorm };
+    return nodeAsRead(Float64Array.from(poses.subarray(o, o + 12)), scaleOf(o, r));
   }
   const o0 = at(joint(0));
   const pivot = [poses[o0 + 12], poses[o0 + 13], poses[o0 + 14], poses[o0 + 15]];
@@ -108,8 +123,7 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
     // With a centre: M p + T = Σ w_i S_i p (the blend's rotation about p, p moved by LBS).
     p[4 * i + 3] = centre[3] > 0.5 ? moved[i] - (p[4 * i] * centre[0] + p[4 * i + 1] * centre[1] + p[4 * i + 2] * centre[2] - centre[i]) : tv[i];
   }
-  const nm = normalMatrix(rot, k);
-  return { p, n: Float64Array.from(nm.n), renorm: nm.renorm };
+  return nodeAsRead(p, k);
 }
 
 /** Every vertex as the shader moves it: plain, or smooth (lerp of two sections, the CPU's normal length fix: none

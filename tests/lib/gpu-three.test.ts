@@ -42,8 +42,12 @@ describe('GPU backend (three.js adapter)', () => {
           const out = patchVertexShader(src, smooth, path);
           expect(out).not.toContain('#include <skinning_vertex>');
           expect(out).not.toContain('#include <skinbase_vertex>');
-          expect(out).toContain(path === 'joints' ? 'gcsSectionBlend' : 'gcsRows');
-          expect(out).not.toContain(path === 'joints' ? 'gcsRows' : 'gcsSectionBlend');
+          // The joint-level vertex stage reads node transforms (the node pass blends them once per frame).
+          expect(out).toContain(path === 'joints' ? 'gcsNode(' : 'gcsRows');
+          expect(out).not.toContain(path === 'joints' ? 'gcsRows' : 'gcsNode(');
+          expect(out).not.toContain('gcsSectionBlend');
+          // Where skinbase_vertex is compiled out (MeshBasicMaterial without an env map), skinning_vertex reads the transform.
+          expect(out).toMatch(/#ifndef GCS_BASE[\s\S]*#endif[\s\S]*transformed = /);
           expect(out.startsWith('#define GCS_SMOOTH')).toBe(smooth);
         }
       }
@@ -153,10 +157,20 @@ describe('GPU backend (three.js adapter)', () => {
 
   test('falls back to the CPU with a reason, and rebuilds switch backends', () => {
     const { group, mesh } = walking(0.2);
-    const character = new GcsCharacter(gcs, group, { backend: 'gpu', method: 'dqs' });
+    // LBS and DQS run on the GPU too (each vertex blends its own joints); the classic model resamples the mesh: CPU only.
+    const character = new GcsCharacter(gcs, group, { backend: 'gpu', method: 'classic' });
     const skin = character.skins[0];
     expect(skin.backend).toBe('cpu');
-    expect(skin.backendNote).toMatch(/GCS/);
+    expect(skin.backendNote).toMatch(/'classic' runs on the CPU/);
+    for (const method of ['lbs', 'dqs'] as const) {
+      character.rebuild(method, { backend: 'gpu' });
+      expect(skin.backend).toBe('gpu');
+      expect(skin.backendNote).toBe('');
+      expect(skin.mesh.geometry.getAttribute('gcsInfluences0')).toBeDefined();
+      expect(skin.mesh.geometry.getAttribute('gcsBlend')).toBeUndefined();
+      expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain(`gcs-${method}-4`);
+      expect(skin.bytesPerFrame).toBe(skin.deformer.jointCount * 64); // the joint poses only
+    }
     character.rebuild('gcs', { gcs: { smooth: true } });
     expect(skin.backend).toBe('gpu');
     expect(skin.mesh.geometry.getAttribute('gcsBlend')).toBeDefined();

@@ -53,8 +53,10 @@ function afterFrames(start: Promise<unknown>, frame: () => number): Promise<void
 // ---------------------------------------------------------------------------------------------
 // Testing hook
 
-// ?crowd=N: the crowd mode (web/demo/crowd.ts) instead of the comparison views.
-const ready = crowdRequested()
+// ?crowd=N: the crowd mode (web/demo/crowd.ts) instead of the comparison views; ?bench=gpu the GPU cost bench (bench-gpu.ts).
+const ready = new URLSearchParams(location.search).get('bench') === 'gpu'
+  ? import('./bench-gpu.js').then((m) => m.startBench()).catch((e) => showMessage(`The GPU bench could not run: ${describeError(e)}`))
+  : crowdRequested()
   ? startCrowd().catch((e) => showMessage(`The crowd could not start: ${describeError(e)}`))
   : jointRequested() ? startJointMode().catch((e) => showMessage(`The joint close-up could not start: ${describeError(e)}`))
   : afterFrames(init().catch((e) => showMessage(`The demo could not start: ${describeError(e)}`)), () => state.frameCount);

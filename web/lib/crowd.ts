@@ -137,6 +137,17 @@ export class GcsCrowd {
     this.mesh.onBeforeRender = (renderer, _scene, _camera, drawn, drawnMaterial) => {
       if (!this.rendererError) this.checkRenderer(renderer, drawn, drawnMaterial);
     };
+    // Shadow maps are drawn before the scene: the node pass runs at the first of either.
+    this.mesh.onBeforeShadow = (renderer, _object, _camera, _shadowCamera, drawn, drawnMaterial) => {
+      if (!this.rendererError) this.checkRenderer(renderer, drawn, drawnMaterial);
+    };
+    // A crowd has no CPU backend: a shader that failed to compile stops it with a note (update() throws it).
+    const compiled = (renderer: unknown, drawn: THREE.BufferGeometry, drawnMaterial: THREE.Material) => {
+      const why = this.rendererError ? null : this.materials.compileError?.(renderer, drawnMaterial);
+      if (why) this.stop(drawn, why);
+    };
+    this.mesh.onAfterRender = (renderer, _scene, _camera, drawn, drawnMaterial) => compiled(renderer, drawn, drawnMaterial);
+    this.mesh.onAfterShadow = (renderer, _object, _camera, _shadowCamera, drawn, drawnMaterial) => compiled(renderer, drawn, drawnMaterial);
     this.mesh.castShadow = source.castShadow;
     this.mesh.receiveShadow = source.receiveShadow;
     this.mesh.frustumCulled = false;
@@ -153,8 +164,17 @@ export class GcsCrowd {
    * warning says why, and the next update() throws GcsError 'INVALID_ARGUMENT' naming the fix.
    */
   private checkRenderer(renderer: unknown, geometry: THREE.BufferGeometry, material: THREE.Material): void {
-    const why = this.kit.mismatch(renderer, material);
-    if (!why) return;
+    let why = this.kit.mismatch(renderer, material);
+    if (!why) {
+      // The joint-level path's node pass, once per frame for every instance; it needs float render targets.
+      const noPass = this.materials.beforeDraw?.(renderer) ?? null;
+      if (noPass) why = `${noPass}: build the crowd with gpuPath: 'sections'`;
+    }
+    if (why) this.stop(geometry, why);
+  }
+
+  /** Stops drawing with one warning; the next update() throws why. */
+  private stop(geometry: THREE.BufferGeometry, why: string): void {
     geometry.setDrawRange(0, 0);
     this.rendererError = new GcsError('INVALID_ARGUMENT', `GcsCrowd (${this.kit.entry}): ${why}`);
     console.warn(`gcs-skin: ${this.rendererError.message}`);

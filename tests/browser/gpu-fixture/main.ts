@@ -10,7 +10,7 @@ import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib
 import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend } from '../../../web/lib/three.js';
 import { GcsCrowd } from '../../../web/lib/crowd.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
-import type { TableSlots } from '../../../web/lib/gpu/layout.js';
+import type { GpuMethod, TableSlots } from '../../../web/lib/gpu/layout.js';
 import { firstFour } from '../../helpers/influences.js';
 import { load, stage } from '../fixture-scene.js';
 
@@ -43,19 +43,23 @@ const READ_FRAGMENT = /* glsl */ `
 varying vec4 vOut;
 void main() { gl_FragColor = vOut; }`;
 
-/** What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals, float32. */
-function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath, slots: TableSlots): { positions: Float32Array; normals: Float32Array } {
+/**
+ * What the vertex shader computes for every vertex of a GPU-backend mesh: positions and normals,
+ * float32. `uniforms`: what its material's vertex stage reads (joint-level path: the node texture,
+ * written by the node pass when the mesh was last drawn).
+ */
+function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | undefined>, smooth: boolean, path: GpuPath, method: GpuMethod = 'gcs', slots: TableSlots = 4): { positions: Float32Array; normals: Float32Array } {
   const src = mesh.geometry;
   const V = src.getAttribute('position').count;
   const rw = 1024, rh = Math.ceil(V / rw);
   const points = new THREE.BufferGeometry(); // not indexed: gl_VertexID is the vertex
-  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend', 'gcsBlendThird']) {
+  for (const name of ['position', 'normal', 'gcsSection', 'gcsBlend', 'gcsBlendThird', 'gcsInfluences0', 'gcsWeights0', 'gcsInfluences1', 'gcsWeights1']) {
     const a = src.getAttribute(name);
     if (a) points.setAttribute(name, a);
   }
   const material = new THREE.ShaderMaterial({
     uniforms: { ...(uniforms as Record<string, THREE.IUniform>), readWidth: { value: rw }, readHeight: { value: rh }, readWhat: { value: 0 } },
-    vertexShader: patchVertexShader(READ_VERTEX, smooth, path, slots),
+    vertexShader: patchVertexShader(READ_VERTEX, smooth, path, method, slots),
     fragmentShader: READ_FRAGMENT,
   });
   const target = new THREE.WebGLRenderTarget(rw, rh, { type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: false });
@@ -80,6 +84,12 @@ function readBack(mesh: THREE.Mesh, uniforms: Record<string, THREE.IUniform | un
   target.dispose();
   material.dispose();
   return out;
+}
+
+/** The uniforms a GPU-backend mesh's patched material reads in its vertex stage. */
+function vertexUniforms(mesh: THREE.Mesh): Record<string, THREE.IUniform | undefined> {
+  const material = (Array.isArray(mesh.material) ? mesh.material[0] : mesh.material) as THREE.Material;
+  return material.userData.gcsUniforms as Record<string, THREE.IUniform | undefined>;
 }
 
 export interface CheckResult {
@@ -114,6 +124,15 @@ export interface CheckResult {
   secondSet: number;
 }
 
+/** The scene drawn on black, read back as RGBA bytes. */
+function picture(scene: THREE.Scene, camera: THREE.Camera): Uint8Array {
+  renderer.setClearColor(0x000000, 1);
+  renderer.render(scene, camera);
+  const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
+  gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
+  return out;
+}
+
 /** Share of pixels of which a channel differs by more than 16 (of 255). */
 function differing(a: Uint8Array, b: Uint8Array): number {
   let n = 0;
@@ -127,15 +146,16 @@ function differing(a: Uint8Array, b: Uint8Array): number {
  * first bone's scale multiplied by it on every frame (a non-uniform scale puts a different scale
  * part K_j in every skin matrix below it).
  */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto',
+async function check(model: string, options: GcsOptions & { method?: GpuMethod }, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto',
   boneScale?: [number, number, number]): Promise<CheckResult> {
+  const { method = 'gcs', ...gcsOptions } = options;
   const gcs = await gcsReady;
   const { root, clips } = await load(model);
   const { scene, camera } = stage(root, W, H); // framed from the bind pose
   const mixer = new THREE.AnimationMixer(root);
   const clip = clips.find((c) => c.name === clipName) ?? clips[0];
   mixer.clipAction(clip).play();
-  const character = new GcsCharacter(gcs, root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+  const character = new GcsCharacter(gcs, root, { method, gcs: gcsOptions, backend: 'gpu', gpuPath });
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
     extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1,
@@ -148,12 +168,7 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
   const pixels = (backend: Backend): Uint8Array => {
     if (character.backend !== backend) character.rebuild(undefined, { backend });
     character.update();
-    renderer.setClearColor(0x000000, 1);
-    renderer.render(scene, camera);
-    const gl = renderer.getContext();
-    const out = new Uint8Array(4 * W * H);
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
-    return out;
+    return picture(scene, camera);
   };
   let first: Uint8Array | null = null;
   let scaled: THREE.Object3D | undefined;
@@ -165,10 +180,11 @@ async function check(model: string, gcsOptions: GcsOptions, times: number[], cli
     if (boneScale) scaled!.scale.multiply(new THREE.Vector3(...boneScale));
     if (character.backend !== 'gpu') character.rebuild(undefined, { backend: 'gpu' });
     character.update();
+    renderer.render(scene, camera); // the joint-level path's node pass runs before the first draw
     character.skins.forEach((skin, k) => {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
-      const gpuOut = readBack(mesh, sections.uniforms, sections.smooth, sections.path, sections.tableSlots);
+      const gpuOut = readBack(mesh, vertexUniforms(mesh), sections.smooth, sections.path, sections.method, sections.tableSlots);
       const d = skin.deformer as GcsDeformer;
       const S = (skin as unknown as { skin: Float32Array }).skin;
       d.deform(S); // the same frame on the CPU
@@ -245,11 +261,16 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
     writeSkinMatrices(source!, c.skins, c.offsetOf(i), tmp);
   });
   c.update();
+  const drawn = new THREE.Scene(); // one draw runs the node pass (joint-level path) for every instance
+  drawn.add(c.mesh);
+  renderer.render(drawn, camera);
+  drawn.remove(c.mesh);
   const sections = c.sections, height = c.rig.height;
   const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, positionError: 0, pixelDiff: 1, coverage: 0 };
-  const base = sections.uniforms.gcsBase.value, stride = sections.uniforms.gcsStride.value;
+  const uniforms = vertexUniforms(c.mesh);
+  const base = uniforms.gcsBase!.value as number, stride = uniforms.gcsStride!.value as number;
   times.forEach((_, i) => {
-    const gpuOut = readBack(c.mesh, { ...sections.uniforms, gcsBase: { value: base + i * stride } }, sections.smooth, sections.path, sections.tableSlots);
+    const gpuOut = readBack(c.mesh, { ...uniforms, gcsBase: { value: base + i * stride } }, sections.smooth, sections.path);
     c.deformer.deform(c.skins.subarray(c.offsetOf(i), c.offsetOf(i) + 16 * c.jointCount));
     const cpu = c.deformer.positions;
     for (let v = 0; v < c.deformer.vertexCount; v++) {
@@ -261,13 +282,7 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   mixer.setTime(times[0]);
   const character = new GcsCharacter(gcs, root, { backend: 'cpu' });
   character.update();
-  const read = (): Uint8Array => {
-    renderer.setClearColor(0x000000, 1);
-    renderer.render(scene, camera);
-    const out = new Uint8Array(4 * W * H), gl = renderer.getContext();
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, out);
-    return out;
-  };
+  const read = (): Uint8Array => picture(scene, camera);
   const cpu = read();
   for (const m of character.meshes) m.visible = false;
   c.mesh.count = 1;
@@ -284,7 +299,174 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   return result;
 }
 
-declare global {
-  interface Window { __gpu: { check: typeof check; crowd: typeof crowd } }
+export interface MaterialResult {
+  type: string; backend: string; path: string; note: string;
+  /** share of pixels differing between the GPU and CPU backends' pictures (character, its shadows on the ground) */
+  pixelDiff: number;
+  /** share of pixels the character covers, and that its shadows darken on the ground (GPU picture) */
+  coverage: number; shadow: number;
+  /** share of pixels differing from the character drawn in its bind pose on the GPU backend: the pose reaches the picture */
+  posed: number;
 }
-window.__gpu = { check, crowd };
+
+const MATERIALS = {
+  MeshBasicMaterial: () => new THREE.MeshBasicMaterial({ color: 0xd08050 }),
+  MeshLambertMaterial: () => new THREE.MeshLambertMaterial({ color: 0xd08050 }),
+  MeshPhongMaterial: () => new THREE.MeshPhongMaterial({ color: 0xd08050, shininess: 60 }),
+  MeshStandardMaterial: () => new THREE.MeshStandardMaterial({ color: 0xd08050, roughness: 0.5 }),
+  MeshPhysicalMaterial: () => new THREE.MeshPhysicalMaterial({ color: 0xd08050, roughness: 0.4, clearcoat: 0.5 }),
+  MeshToonMaterial: () => new THREE.MeshToonMaterial({ color: 0xd08050 }),
+  MeshMatcapMaterial: () => new THREE.MeshMatcapMaterial({ color: 0xd08050, matcap: matcapTexture() }),
+  MeshNormalMaterial: () => new THREE.MeshNormalMaterial(),
+} as const;
+
+/** A matcap whose colour follows the normal's direction, so that normals show in the picture. */
+function matcapTexture(): THREE.DataTexture {
+  const n = 64, data = new Uint8Array(4 * n * n);
+  for (let y = 0; y < n; y++) for (let x = 0; x < n; x++) data.set([255 * x / n, 255 * y / n, 128, 255], 4 * (y * n + x));
+  const t = new THREE.DataTexture(data, n, n);
+  t.needsUpdate = true;
+  return t;
+}
+
+/**
+ * Every built-in material on the GPU backend (GLSL kit, WebGLRenderer) against the CPU backend:
+ * the character wears it, casts shadows from a directional light (MeshDepthMaterial) and a point
+ * light (MeshDistanceMaterial) onto a ground that receives them, posed at `time`.
+ * `broken`: the material's own onBeforeCompile declares a uniform the GCS patch declares too, so
+ * only the patched shader fails to compile.
+ */
+async function materials(model: string, time: number, types: string[], clipName?: string, broken = false): Promise<MaterialResult[]> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const { scene, camera } = stage(root, W, H);
+  const box = new THREE.Box3().setFromObject(root), size = box.getSize(new THREE.Vector3()).length();
+  const ground = new THREE.Mesh(new THREE.PlaneGeometry(size * 4, size * 4), new THREE.MeshLambertMaterial({ color: 0x808080 }));
+  ground.rotation.x = -Math.PI / 2;
+  ground.position.y = box.min.y;
+  ground.receiveShadow = true;
+  scene.add(ground);
+  const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+  sun.position.copy(box.getCenter(new THREE.Vector3())).add(new THREE.Vector3(size, size * 2, size * 0.5));
+  sun.target.position.copy(box.getCenter(new THREE.Vector3()));
+  sun.castShadow = true;
+  Object.assign(sun.shadow.camera, { left: -size, right: size, top: size, bottom: -size, near: size / 100, far: size * 6 });
+  sun.shadow.mapSize.set(1024, 1024);
+  const lamp = new THREE.PointLight(0xffffff, 3, 0, 0);
+  lamp.position.copy(box.getCenter(new THREE.Vector3())).add(new THREE.Vector3(-size * 0.6, size * 0.5, size * 0.3));
+  lamp.castShadow = true;
+  scene.add(sun, sun.target, lamp);
+  renderer.shadowMap.enabled = true;
+  const sources: THREE.SkinnedMesh[] = [];
+  root.traverse((o) => { if ((o as THREE.SkinnedMesh).isSkinnedMesh) sources.push(o as THREE.SkinnedMesh); });
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
+  const read = (): Uint8Array => picture(scene, camera);
+  const results: MaterialResult[] = [];
+  for (const type of types) {
+    for (const s of sources) {
+      s.castShadow = true;
+      s.material = MATERIALS[type as keyof typeof MATERIALS]();
+      if (broken) s.material.onBeforeCompile = (shader) => { shader.vertexShader = `uniform float gcsBase;\n${shader.vertexShader}`; };
+    }
+    mixer.setTime(0);
+    mixer.stopAllAction();
+    root.updateMatrixWorld(true);
+    const character = new GcsCharacter(gcs, root, { backend: 'gpu' });
+    character.update();
+    const bind = read();
+    mixer.clipAction(clips.find((c) => c.name === clipName) ?? clips[0]).play();
+    mixer.setTime(time);
+    character.update();
+    const gpu = read();
+    const backend = character.backend, path = character.skins[0].gpuPath ?? 'none';
+    const note = character.skins.map((k) => k.backendNote).filter(Boolean).join('; ');
+    const again = read(); // after a failed compile this is the CPU backend's frame
+    character.rebuild(undefined, { backend: 'cpu' });
+    character.update();
+    const cpu = read();
+    let covered = 0, shadow = 0;
+    ground.visible = false;
+    const alone = read();
+    ground.visible = true;
+    for (const s of sources) s.visible = false; // the ground with no character: where the shadows fall
+    for (const m of character.meshes) m.visible = false;
+    const empty = read();
+    for (const m of character.meshes) m.visible = true;
+    for (const s of sources) s.visible = true;
+    for (let i = 0; i < W * H; i++) {
+      if (alone[4 * i] + alone[4 * i + 1] + alone[4 * i + 2] > 0) covered++;
+      else if (empty[4 * i] - gpu[4 * i] > 24) shadow++;
+    }
+    results.push({ type, backend, path, note, pixelDiff: differing(broken ? again : gpu, cpu), coverage: covered / (W * H), shadow: shadow / (W * H), posed: differing(gpu, bind) });
+    character.dispose();
+  }
+  renderer.shadowMap.enabled = false;
+  return results;
+}
+
+export interface PassResult {
+  /** renderer.render calls (three.js's info.render.frame: the node pass is one) for: the first frame, the same frame drawn again, the next frame */
+  renders: number[];
+  /** with float render targets stubbed away: the skin's path and note after its first draw, and its picture against the CPU backend's */
+  fallbackPath: string; fallbackNote: string; fallbackDiff: number;
+  /** the crowd's next update() after a draw without float render targets */
+  crowdError: string;
+}
+
+/**
+ * The node pass runs once per frame (at the skin's first draw after update(), shadows on), and a
+ * renderer without float render targets (EXT_color_buffer_float stubbed away) moves a skin to the
+ * section-level path with a note, and stops a crowd with a GcsError.
+ */
+async function nodePass(model: string, time: number): Promise<PassResult> {
+  const gcs = await gcsReady;
+  const { root, clips } = await load(model);
+  const { scene, camera } = stage(root, W, H);
+  const mixer = new THREE.AnimationMixer(root);
+  mixer.clipAction(clips[0]).play();
+  mixer.setTime(time);
+  renderer.shadowMap.enabled = true;
+  scene.traverse((o) => { if ((o as THREE.DirectionalLight).isDirectionalLight) (o as THREE.DirectionalLight).castShadow = true; });
+  let source: THREE.SkinnedMesh | undefined;
+  root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
+  source!.castShadow = true;
+  const character = new GcsCharacter(gcs, root, { backend: 'gpu' });
+  const info = renderer.info.render;
+  const count = (draw: () => void): number => { const before = info.frame; draw(); return info.frame - before; };
+  const renders = [
+    count(() => { character.update(); picture(scene, camera); }),
+    count(() => picture(scene, camera)),
+    count(() => { mixer.setTime(time + 0.1); character.update(); picture(scene, camera); }),
+  ];
+  character.dispose();
+  const has = renderer.extensions.has.bind(renderer.extensions);
+  renderer.extensions.has = (name: string) => name !== 'EXT_color_buffer_float' && has(name);
+  const stubbed = new GcsCharacter(gcs, root, { backend: 'gpu' });
+  stubbed.update();
+  picture(scene, camera); // the first draw finds no float targets
+  const skin = stubbed.skins[0];
+  const fallbackPath = skin.gpuPath ?? 'none', fallbackNote = skin.backendNote;
+  stubbed.update();
+  const gpu = picture(scene, camera);
+  stubbed.rebuild(undefined, { backend: 'cpu' });
+  stubbed.update();
+  const fallbackDiff = differing(gpu, picture(scene, camera));
+  stubbed.dispose();
+  const c = new GcsCrowd(gcs, source!, 2);
+  c.update();
+  const alone = new THREE.Scene();
+  alone.add(c.mesh);
+  picture(alone, camera);
+  let crowdError = '';
+  try { c.update(); } catch (e) { crowdError = `${(e as { code?: string }).code}: ${(e as Error).message}`; }
+  c.dispose();
+  renderer.extensions.has = has;
+  renderer.shadowMap.enabled = false;
+  return { renders, fallbackPath, fallbackNote, fallbackDiff, crowdError };
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials; nodePass: typeof nodePass } }
+}
+window.__gpu = { check, crowd, materials, nodePass };

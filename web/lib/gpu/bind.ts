@@ -4,7 +4,8 @@
  * per-vertex section data, and the source's other attributes carried in that order.
  */
 import * as THREE from 'three';
-import type { Deformer, GcsDeformer } from '../index.js';
+import type { Deformer, GcsDeformer, RigInput } from '../index.js';
+import { INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES } from './layout.js';
 import { sectionAttributes } from './sections.js';
 
 /** Identity skin matrices (the bind pose) for `jointCount` joints, J × 16 floats. */
@@ -27,13 +28,14 @@ export interface BindGeometryOptions {
  * tangents and morph targets as asked) remapped to the output order. Groups and draw range are
  * the caller's (they depend on the triangle order).
  */
-export function bindGeometry(deformer: GcsDeformer, jointCount: number, source: THREE.BufferGeometry, options: BindGeometryOptions): THREE.BufferGeometry {
+export function bindGeometry(deformer: Deformer, jointCount: number, source: THREE.BufferGeometry, options: BindGeometryOptions,
+  perVertex: readonly VertexAttribute[] = sectionAttributes(deformer as GcsDeformer)): THREE.BufferGeometry {
   const geometry = new THREE.BufferGeometry();
   geometry.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
   deformer.deform(identitySkin(jointCount));
   geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions.slice(), 3));
   geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals.slice(), 3));
-  for (const { name, attribute } of sectionAttributes(deformer)) geometry.setAttribute(name, attribute);
+  for (const { name, attribute } of perVertex) geometry.setAttribute(name, attribute);
   if (!deformer.keepsVertices) return geometry;
   for (const [key, attr] of Object.entries(source.attributes))
     if (!SKINNING_ATTRIBUTES.has(key) || (key === 'tangent' && options.tangents)) geometry.setAttribute(key, remapAttribute(attr, deformer));
@@ -45,6 +47,44 @@ export function bindGeometry(deformer: GcsDeformer, jointCount: number, source: 
     geometry.morphTargetsRelative = source.morphTargetsRelative;
   }
   return geometry;
+}
+
+/** A static per-vertex attribute of the GPU backend's geometry, by name. */
+export interface VertexAttribute { name: string; attribute: THREE.BufferAttribute }
+
+/**
+ * LBS and DQS on the GPU: each output vertex's joints and weights as the core holds them (the
+ * rig's weights divided by their largest, then by their sum, in float32, as gcs_rig_create does),
+ * the joints of weight 0 as −1 after the others; 4 per vertex, 8 where the rig has a second set.
+ */
+export function influenceAttributes(input: RigInput, sourceVertex: Uint32Array): { attributes: VertexAttribute[]; slots: 4 | 8 } {
+  const k = input.influences ?? 4, slots = k > 4 ? 8 : 4, n = sourceVertex.length;
+  const ids = [new Float32Array(4 * n), new Float32Array(4 * n)], weights = [new Float32Array(4 * n), new Float32Array(4 * n)];
+  const w = new Float32Array(8), j = new Float32Array(8);
+  const f = Math.fround;
+  for (let o = 0; o < n; o++) {
+    const v = sourceVertex[o];
+    let big = 0;
+    w.fill(0);
+    for (let i = 0; i < k; i++) { w[i] = input.weights[k * v + i]; j[i] = input.joints[k * v + i]; big = Math.max(big, w[i]); }
+    let sum = 0;
+    for (let i = 0; i < 8; i++) { w[i] = f(w[i] / big); sum = f(sum + w[i]); }
+    let slot = 0;
+    for (let pass = 0; pass < 2; pass++) // the weighted joints first, in their order; then the empty slots
+      for (let i = 0; i < slots; i++) {
+        if ((w[i] > 0) !== (pass === 0)) continue;
+        const set = slot >> 2, at = 4 * o + (slot & 3);
+        ids[set][at] = w[i] > 0 ? j[i] : -1;
+        weights[set][at] = w[i] > 0 ? f(w[i] / sum) : 0;
+        slot++;
+      }
+  }
+  const attributes: VertexAttribute[] = [];
+  for (let set = 0; set < slots / 4; set++) {
+    attributes.push({ name: INFLUENCE_ATTRIBUTES[set], attribute: new THREE.BufferAttribute(ids[set], 4) });
+    attributes.push({ name: WEIGHT_ATTRIBUTES[set], attribute: new THREE.BufferAttribute(weights[set], 4) });
+  }
+  return { attributes, slots };
 }
 
 export type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;

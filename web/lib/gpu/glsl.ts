@@ -6,7 +6,7 @@
 import { GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type GpuPath, type TableSlots,
+  GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, type GpuMethod, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -109,101 +109,12 @@ const POSITION = /* glsl */ `
 
 // ------------------------------------------------------------ the joint-level path (weights criterion)
 // Matrices are GLSL's (column-major); the math is GcsDeformerImpl::sectionTransformsWeights,
-// blendPoses and normalMatrix (wasm/src), step for step.
+// blendPoses and normalMatrix (wasm/src), step for step. It runs once per node and frame in the node
+// pass (node-pass.ts: a fragment per output texel, all instances of a crowd in one draw); the vertex
+// stage reads the result (NODE_PARS) and blends.
 
-/** Declarations: joint poses (per frame), the section table (static), the per-section blend. */
-const JOINT_PARS = /* glsl */ `
-uniform highp sampler2D gcsJoints;
-uniform highp sampler2D gcsTable;${COMMON_PARS}
-vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
-	int w = textureSize( t, 0 ).x;
-	return texelFetch( t, ivec2( i % w, i / w ), 0 );
-}
-// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
-void gcsJoint( const in int j, out mat3 s, out vec3 t, out vec4 q ) {
-	int i = gcsBase + j * ${GPU_TEXELS_PER_JOINT};
-	#ifdef USE_INSTANCING
-	i += gl_InstanceID * gcsStride;
-	#endif
-	vec4 r0 = gcsTexel( gcsJoints, i ), r1 = gcsTexel( gcsJoints, i + 1 ), r2 = gcsTexel( gcsJoints, i + 2 );
-	q = gcsTexel( gcsJoints, i + 3 );
-	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
-	t = vec3( r0.w, r1.w, r2.w );
-}
-// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
-mat3 gcsRotation( const in vec4 q, const in float k2 ) {
-	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
-		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
-		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
-}
-// The CPU's normalMatrix: r when k is a positive uniform scale (up to 1e-4), else r · cof(k) scaled
-// to entries ≤ 1 (renormalise), r alone when k has collapsed.
-mat3 gcsNormalMatrix( const in mat3 r, const in mat3 k, out bool renorm ) {
-	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
-	bool uniformScale = s > 0.0;
-	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
-		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
-	renorm = ! uniformScale;
-	if ( uniformScale ) return r;
-	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
-	float kbig = max( max( m.x, m.y ), m.z );
-	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return r;
-	mat3 a = k / kbig;
-	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
-	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
-	float big = max( max( m.x, m.y ), m.z );
-	if ( ! ( big > ${f(COLLAPSED)} ) ) return r;
-	return r * ( c / big );
-}
-// Section s's transform x ↦ M x + T and its normal matrix N: a rigid core is S_j; otherwise the
-// dual-quaternion blend of its joints at its weights, K_j = R_jᵀ S_j blended linearly, applied first,
-// or with a centre of rotation the blend's M about it.
-// GCS_TABLE_SLOTS (4 or 8) joints per section: slots 4..7 in the table's third and fourth texels.
-void gcsSectionBlend( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
-	int row = GCS_TABLE_TEXELS * s;
-	vec4 joints = gcsTexel( gcsTable, row ), weights = gcsTexel( gcsTable, row + 1 );
-	mat3 S; vec3 t; vec4 q;
-	gcsJoint( int( joints.x ), S, t, q );
-	if ( joints.y < 0.0 ) {
-		M = S; T = t;
-		mat3 r = gcsRotation( q, 2.0 );
-		N = gcsNormalMatrix( r, transpose( r ) * S, renorm );
-		return;
-	}
-	#if GCS_TABLE_SLOTS > 4
-	vec4 joints1 = gcsTexel( gcsTable, row + 2 ), weights1 = gcsTexel( gcsTable, row + 3 );
-	#endif
-	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
-	mat3 K = mat3( 0.0 );
-	// The centre of rotation p (w = 1; w = 0: none) and Σ w_i (S_i p − p), where LBS moves it.
-	vec4 centre = gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 );
-	vec3 moved = vec3( 0.0 );
-	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
-		#if GCS_TABLE_SLOTS > 4
-		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
-		float w = k < 4 ? weights[ k ] : weights1[ k - 4 ];
-		#else
-		float id = joints[ k ], w = weights[ k ];
-		#endif
-		if ( id < 0.0 ) break;
-		if ( k > 0 ) gcsJoint( int( id ), S, t, q );
-		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
-		float sw = dot( q, pivot ) < 0.0 ? - w : w;
-		br += sw * q;
-		bd += sw * d;
-		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
-		moved += w * ( S * centre.xyz + t - centre.xyz );
-	}
-	float inv2 = 1.0 / dot( br, br );
-	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
-	mat3 rot = gcsRotation( br, 2.0 * inv2 );
-	M = rot * K;
-	// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
-	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
-	N = gcsNormalMatrix( rot, K, renorm );
-}
+/** How the joint-level path turns a normal or tangent with a normal matrix N. */
+const TURN_JOINT = /* glsl */ `
 // A normal or tangent as the CPU turns it: blended (smooth) normals are left as they are when both
 // sides are rotations less than 2.8° apart, get the cubic length fix when less than 35° apart, else
 // are normalised (a vanished one keeps its rest direction); unblended ones are normalised only when
@@ -217,7 +128,189 @@ vec3 gcsTurnJoint( const in vec3 v, const in mat3 N, const in bool near, const i
 }
 `;
 
-/** Per vertex, once: its (blended) section transform and normal matrix. */
+/** The rotation matrix of a quaternion: the node pass and the vertex stage both build one. */
+const ROTATION = /* glsl */ `
+// The rotation matrix of a quaternion scaled by k2 = 2 / |q|² (1 for a unit quaternion: k2 = 2).
+mat3 gcsRotation( const in vec4 q, const in float k2 ) {
+	float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z, xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+	float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+	return mat3( 1.0 - k2 * ( yy + zz ), k2 * ( xy + wz ), k2 * ( xz - wy ),
+		k2 * ( xy - wz ), 1.0 - k2 * ( xx + zz ), k2 * ( yz + wx ),
+		k2 * ( xz + wy ), k2 * ( yz - wx ), 1.0 - k2 * ( xx + yy ) );
+}
+`;
+
+/** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
+const NODE_MATHS = /* glsl */ `
+uniform highp sampler2D gcsJoints;
+vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
+	int w = textureSize( t, 0 ).x;
+	return texelFetch( t, ivec2( i % w, i / w ), 0 );
+}
+// The texel after \`at\` in a texture \`w\` wide (one division per joint, not per texel).
+ivec2 gcsNextTexel( const in ivec2 at, const in int w ) {
+	return at.x + 1 < w ? ivec2( at.x + 1, at.y ) : ivec2( 0, at.y + 1 );
+}
+// Joint j's texels (from \`base\`, the instance's first): the rows of S_j (translation in w) and its rotation quaternion.
+void gcsJointTexels( const in int base, const in int j, out vec4 r0, out vec4 r1, out vec4 r2, out vec4 q ) {
+	int i = base + j * ${GPU_TEXELS_PER_JOINT}, w = textureSize( gcsJoints, 0 ).x, y = i / w;
+	ivec2 at = ivec2( i - y * w, y );
+	r0 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	r1 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	r2 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
+	q = texelFetch( gcsJoints, at, 0 );
+}
+// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out vec4 q ) {
+	vec4 r0, r1, r2;
+	gcsJointTexels( base, j, r0, r1, r2, q );
+	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	t = vec3( r0.w, r1.w, r2.w );
+}
+${ROTATION}
+// The CPU's normalMatrix as one texel (x, y, 0, flag), from which the vertex stage takes
+// N = cof(M·x)·y, M = R·K (cof(R) = R): R·cof(K/s) = R when K is a positive uniform scale s·I (up to
+// 1e-4): (1/s, 1, 0, 0); else R·cof(K/kbig)/big, its entries ≤ 1 and normals renormalised:
+// (1/kbig, 1/big, 0, −1). A collapsed K (rank ≤ 1) gives N = 0: the normal keeps its rest
+// direction (the CPU keeps it rotated; no direction survives such a scale).
+vec4 gcsNormalTexel( const in mat3 k ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	bool uniformScale = s > 0.0;
+	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
+		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
+	if ( uniformScale ) return vec4( 1.0 / s, 1.0, 0.0, 0.0 );
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
+	mat3 a = k / kbig;
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	if ( ! ( big > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
+	return vec4( 1.0 / kbig, 1.0 / big, 0.0, - 1.0 );
+}
+// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
+// weights, weights1; a slot of weight 0 adds nothing) into x ↦ M x + T and the normal texel N
+// (gcsNormalTexel): K_j = R_jᵀ S_j blended linearly, applied first; with a centre of rotation
+// (w = 1; w = 0: none) the blend's M about it. One joint alone (joints.y < 0) is S_j itself.
+// \`base\`: the instance's first joint texel. The CPU's blendPoses, step for step.
+void gcsBlend( const in int base, const in vec4 joints, const in vec4 weights, const in vec4 joints1, const in vec4 weights1,
+	const in vec4 centre, out mat3 M, out vec3 T, out vec4 N ) {
+	mat3 S; vec3 t; vec4 q;
+	gcsJoint( base, int( joints.x ), S, t, q );
+	#ifndef GCS_PER_VERTEX
+	// (Per vertex, DQS, a vertex of one joint takes the blend of one: the same up to rounding, and a
+	// shader with one path costs less where every path runs.)
+	if ( joints.y < 0.0 ) {
+		M = S; T = t;
+		N = gcsNormalTexel( transpose( gcsRotation( q, 2.0 ) ) * S );
+		return;
+	}
+	#endif
+	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
+	mat3 K = mat3( 0.0 );
+	vec3 moved = vec3( 0.0 ); // Σ w_i (S_i p − p): where LBS moves the centre p
+	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+		#if GCS_TABLE_SLOTS > 4
+		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
+		float w = k < 4 ? weights[ k ] : weights1[ k - 4 ];
+		#else
+		float id = joints[ k ], w = weights[ k ];
+		#endif
+		if ( ! ( w > 0.0 ) ) continue;
+		if ( k > 0 ) gcsJoint( base, int( id ), S, t, q );
+		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+		float sw = dot( q, pivot ) < 0.0 ? - w : w;
+		br += sw * q;
+		bd += sw * d;
+		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
+		moved += w * ( S * centre.xyz + t - centre.xyz );
+	}
+	float inv2 = 1.0 / dot( br, br );
+	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
+	M = gcsRotation( br, 2.0 * inv2 ) * K;
+	// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
+	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
+	N = gcsNormalTexel( K );
+}
+`;
+
+/**
+ * The node pass's fragment shader: one fragment per node (instance k's node s is node k·sections +
+ * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
+ */
+const NODE_PASS_FRAGMENT = /* glsl */ `
+uniform int gcsNodeCount;
+uniform int gcsSectionCount;
+uniform int gcsJointStride;
+uniform int gcsTargetWidth;
+layout( location = 0 ) out highp vec4 gcsRow0;
+layout( location = 1 ) out highp vec4 gcsRow1;
+layout( location = 2 ) out highp vec4 gcsRow2;
+layout( location = 3 ) out highp vec4 gcsNormal;
+uniform highp sampler2D gcsTable;
+${NODE_MATHS}
+// Section s: its joints, weights and centre of rotation from the static table (GCS_TABLE_TEXELS per
+// section: per 4 slots a texel of joints, −1 past the last, then one of weights; last, the centre).
+void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
+	int row = GCS_TABLE_TEXELS * s;
+	vec4 joints1 = vec4( - 1.0 ), weights1 = vec4( 0.0 );
+	#if GCS_TABLE_SLOTS > 4
+	joints1 = gcsTexel( gcsTable, row + 2 ); weights1 = gcsTexel( gcsTable, row + 3 );
+	#endif
+	gcsBlend( base, gcsTexel( gcsTable, row ), gcsTexel( gcsTable, row + 1 ), joints1, weights1, gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 ), M, T, N );
+}
+void main() {
+	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
+	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
+	int instance = node / gcsSectionCount;
+	mat3 M; vec3 T; vec4 N;
+	gcsSectionBlend( instance * gcsJointStride, node - instance * gcsSectionCount, M, T, N );
+	gcsNormal = N;
+	gcsRow0 = vec4( M[ 0 ][ 0 ], M[ 1 ][ 0 ], M[ 2 ][ 0 ], T.x );
+	gcsRow1 = vec4( M[ 0 ][ 1 ], M[ 1 ][ 1 ], M[ 2 ][ 1 ], T.y );
+	gcsRow2 = vec4( M[ 0 ][ 2 ], M[ 1 ][ 2 ], M[ 2 ][ 2 ], T.z );
+}
+`;
+
+/** A triangle covering the target: one fragment per texel. */
+const NODE_PASS_VERTEX = /* glsl */ `
+void main() {
+	vec2 p = vec2( float( ( gl_VertexID << 1 ) & 2 ), float( gl_VertexID & 2 ) );
+	gl_Position = vec4( p * 2.0 - 1.0, 0.0, 1.0 );
+}
+`;
+
+const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
+
+/** The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots). */
+export function nodePassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
+  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
+  return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
+}
+
+/** The vertex stage's declarations: the node textures (written by the node pass) and how normals turn. */
+const NODE_PARS = /* glsl */ `
+${Array.from({ length: GPU_NODE_TEXTURES }, (_, t) => `uniform highp sampler2D gcsNodes${t};`).join('\n')}${COMMON_PARS}
+// Node s of this instance: x ↦ M x + T, its normal matrix N (from gcsNormalTexel's texel)
+// and whether normals renormalise.
+void gcsNode( const in int s, out mat3 M, out vec3 T, out mat3 N, out bool renorm ) {
+	int i = gcsBase + s;
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	int w = textureSize( gcsNodes0, 0 ).x, y = i / w;
+	ivec2 at = ivec2( i - y * w, y );
+	vec4 r0 = texelFetch( gcsNodes0, at, 0 ), r1 = texelFetch( gcsNodes1, at, 0 ), r2 = texelFetch( gcsNodes2, at, 0 ), n = texelFetch( gcsNodes3, at, 0 );
+	M = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	T = vec3( r0.w, r1.w, r2.w );
+	renorm = n.w < 0.0;
+	mat3 a = M * n.x;
+	N = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
+}
+${TURN_JOINT}`;
+
+/** Per vertex, once: its (blended) node transform and normal matrix, read from the node texture. */
 const JOINT_BASE = /* glsl */ `
 	mat3 gcsM, gcsN;
 	vec3 gcsT;
@@ -226,10 +319,10 @@ const JOINT_BASE = /* glsl */ `
 		#ifdef GCS_SMOOTH
 		int sa = int( ${BLEND_ATTRIBUTE}.x + 0.5 ), sb = int( ${BLEND_ATTRIBUTE}.y + 0.5 );
 		int sc = int( ${BLEND_THIRD_ATTRIBUTE}.x + 0.5 );
-		gcsSectionBlend( sa, gcsM, gcsT, gcsN, gcsNormalise );
+		gcsNode( sa, gcsM, gcsT, gcsN, gcsNormalise );
 		if ( sb != sa ) {
 			mat3 mb, nb; vec3 tb; bool rb;
-			gcsSectionBlend( sb, mb, tb, nb, rb );
+			gcsNode( sb, mb, tb, nb, rb );
 			float f = ${BLEND_ATTRIBUTE}.z;
 			bool ra = gcsNormalise;
 			float trace = dot( gcsN[ 0 ], nb[ 0 ] ) + dot( gcsN[ 1 ], nb[ 1 ] ) + dot( gcsN[ 2 ], nb[ 2 ] );
@@ -240,7 +333,7 @@ const JOINT_BASE = /* glsl */ `
 			if ( sc != sa ) {
 				// A three-joint lattice cell: + g·(C − A); the least pairwise trace decides the fix.
 				mat3 mc, nc; vec3 tc; bool rc;
-				gcsSectionBlend( sc, mc, tc, nc, rc );
+				gcsNode( sc, mc, tc, nc, rc );
 				float g = ${BLEND_THIRD_ATTRIBUTE}.y;
 				gcsM += g * ( mc - ma );
 				gcsT += g * ( tc - ta );
@@ -256,7 +349,7 @@ const JOINT_BASE = /* glsl */ `
 			gcsNormalise = true;
 		}
 		#else
-		gcsSectionBlend( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
+		gcsNode( int( ${SECTION_ATTRIBUTE} + 0.5 ), gcsM, gcsT, gcsN, gcsNormalise );
 		#endif
 	}
 `;
@@ -267,31 +360,120 @@ const JOINT_POSITION = /* glsl */ `
 	transformed = gcsM * transformed + gcsT;
 `;
 
+// ------------------------------------------------------------ LBS and DQS per vertex (backend 'gpu', method 'lbs' | 'dqs')
+// Each vertex blends its own joints (≤ 4, or 8 with GCS_TABLE_SLOTS 8) at its own weights, read
+// from attributes: the rig's weights as the core normalises them, joint −1 where the weight is 0.
+
+/** Declarations: the joint poses (per frame) and the vertex's influences. */
+const SKIN_PARS = /* glsl */ `
+#define GCS_PER_VERTEX
+uniform int gcsBase;
+uniform int gcsStride;
+attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
+#if GCS_TABLE_SLOTS > 4
+attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
+#endif
+${NODE_MATHS}${TURN_JOINT}
+int gcsFirstJoint() {
+	int i = gcsBase;
+	#ifdef USE_INSTANCING
+	i += gl_InstanceID * gcsStride;
+	#endif
+	return i;
+}
+`;
+
+/** The second set of influences, or none. */
+const SECOND_SET = /* glsl */ `
+		vec4 gcsJ1 = vec4( - 1.0 ), gcsW1 = vec4( 0.0 );
+		#if GCS_TABLE_SLOTS > 4
+		gcsJ1 = ${INFLUENCE_ATTRIBUTES[1]}; gcsW1 = ${WEIGHT_ATTRIBUTES[1]};
+		#endif
+`;
+
+/** LBS (as three.js and the CPU's LBS): M = Σ w_j S_j; normals by M, then unit length. */
+const LBS_BASE = /* glsl */ `
+	mat3 gcsM;
+	vec3 gcsT;
+	vec4 gcsRest = vec4( 0.0, 0.0, 0.0, 1.0 );
+	{${SECOND_SET}
+		int base = gcsFirstJoint();
+		vec4 r0 = vec4( 0.0 ), r1 = vec4( 0.0 ), r2 = vec4( 0.0 );
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+			#if GCS_TABLE_SLOTS > 4
+			float id = k < 4 ? ${INFLUENCE_ATTRIBUTES[0]}[ k ] : gcsJ1[ k - 4 ], w = k < 4 ? ${WEIGHT_ATTRIBUTES[0]}[ k ] : gcsW1[ k - 4 ];
+			#else
+			float id = ${INFLUENCE_ATTRIBUTES[0]}[ k ], w = ${WEIGHT_ATTRIBUTES[0]}[ k ];
+			#endif
+			if ( ! ( w > 0.0 ) ) continue;
+			vec4 a0, a1, a2, q;
+			gcsJointTexels( base, int( id ), a0, a1, a2, q );
+			r0 += w * a0; r1 += w * a1; r2 += w * a2;
+			if ( k == 0 ) gcsRest = q; // where the blend collapses (bones scaled to 0): the first influence's rotation
+		}
+		gcsM = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+		gcsT = vec3( r0.w, r1.w, r2.w );
+	}
+`;
+
+const LBS_NORMAL = turned((v) => `gcsTurnLbs( ${v}, gcsM, gcsRest )`);
+
+const LBS_TURN = /* glsl */ `
+vec3 gcsTurnLbs( const in vec3 v, const in mat3 M, const in vec4 q ) {
+	vec3 n = M * v;
+	float len2 = dot( n, n );
+	if ( len2 > 1e-24 && len2 < 1e24 ) return n * ( 1.0 / sqrt( len2 ) );
+	n = gcsRotation( q, 2.0 ) * v;
+	float l = length( n );
+	return l > 0.0 ? n / l : v;
+}
+`;
+
+/** DQS (the CPU's dqsVertices): the node maths on the vertex's own joints and weights, no centre. */
+const DQS_BASE = /* glsl */ `
+	mat3 gcsM, gcsN;
+	vec3 gcsT;
+	bool gcsNormalise;
+	{${SECOND_SET}
+		vec4 n;
+		gcsBlend( gcsFirstJoint(), ${INFLUENCE_ATTRIBUTES[0]}, ${WEIGHT_ATTRIBUTES[0]}, gcsJ1, gcsW1, vec4( 0.0 ), gcsM, gcsT, n );
+		mat3 a = gcsM * n.x;
+		gcsN = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
+		gcsNormalise = n.w < 0.0;
+	}
+`;
+
+const DQS_NORMAL = turned((v) => `gcsTurnJoint( ${v}, gcsN, false, false, gcsNormalise )`);
+
 const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', '#include <skinning_vertex>'] as const;
 
 /**
  * The vertex shader of a three.js built-in material (or any shader written with its chunks) with
  * three's skinning chunks replaced by GCS's: path 'sections', the section transforms come from the
- * `gcsSections` texture; path 'joints', each vertex's section is blended from the joint poses in
- * `gcsJoints` and the static table `gcsTable` (`slots` joints per section: GpuSections.tableSlots).
- * Morph targets still apply first (three's order), then the section transform; normals and
- * tangents turn with the normal matrix. Throws GcsError 'INVALID_ARGUMENT' when the shader lacks
- * the chunks (a ShaderMaterial written without them).
+ * `gcsSections` texture; path 'joints', each vertex reads its nodes' transforms from the `gcsNodes`
+ * texture the node pass wrote (node-pass.ts) and blends them. Morph targets still apply first
+ * (three's order), then the transform; normals and tangents turn with the normal matrix. Where a
+ * material compiles `skinbase_vertex` out (MeshBasicMaterial keeps it under
+ * `USE_ENVMAP || USE_SKINNING`), the transform is read in `skinning_vertex` instead. Throws GcsError
+ * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
  */
-export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): string {
+export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): string {
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
   if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
-  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
+  if (method !== 'gcs' && method !== 'lbs' && method !== 'dqs') throw new GcsError('INVALID_ARGUMENT', `the GPU backend runs 'gcs', 'lbs' or 'dqs'; got '${String(method)}'`);
   const joints = path === 'joints';
+  const [pars, base, position, normal] = method === 'lbs' ? [`${SKIN_PARS}${LBS_TURN}`, LBS_BASE, JOINT_POSITION, LBS_NORMAL]
+    : method === 'dqs' ? [SKIN_PARS, DQS_BASE, JOINT_POSITION, DQS_NORMAL]
+    : joints ? [NODE_PARS, JOINT_BASE, JOINT_POSITION, JOINT_NORMAL] : [PARS, BASE, POSITION, NORMAL];
   let out = source
-    .replace(HOOKS[0], `${HOOKS[0]}\n${joints ? JOINT_PARS : PARS}`)
-    .replace(HOOKS[1], joints ? JOINT_BASE : BASE)
-    .replace(HOOKS[2], joints ? JOINT_POSITION : POSITION);
+    .replace(HOOKS[0], `${HOOKS[0]}\n${pars}`)
+    .replace(HOOKS[1], `#define GCS_BASE\n${base}`)
+    .replace(HOOKS[2], `#ifndef GCS_BASE\n${base}\n#endif\n${position}`);
   // Materials that do not compute normals (depth, distance) have no skinnormal chunk.
-  out = out.replace('#include <skinnormal_vertex>', joints ? JOINT_NORMAL : NORMAL);
-  const table = joints ? `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n` : '';
-  const defines = `${smooth ? '#define GCS_SMOOTH\n' : ''}${table}`;
-  return `${defines}${out}`;
+  out = out.replace('#include <skinnormal_vertex>', normal);
+  const defines = method === 'gcs' ? '' : tableDefines(slots);
+  return `${smooth && method === 'gcs' ? '#define GCS_SMOOTH\n' : ''}${defines}${out}`;
 }
-

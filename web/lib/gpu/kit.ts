@@ -13,11 +13,26 @@ export interface GpuMaterials {
   /** customDepthMaterial / customDistanceMaterial for the shadow passes, or null where the material casts its own (node materials). */
   depth: THREE.Material | null;
   distance: THREE.Material | null;
+  /**
+   * Before each draw of the skin (shadow or colour pass), with the renderer drawing it: runs what
+   * must run once per frame before the vertex stage (the node pass). Returns why this renderer
+   * cannot, or null.
+   */
+  beforeDraw?(renderer: unknown): string | null;
+  /**
+   * After a draw of the skin with `material`: why its patched shader failed to compile or link
+   * (the GPU backend then falls back, rather than draw nothing), or null.
+   */
+  compileError?(renderer: unknown, material: THREE.Material): string | null;
+  /** Frees what beforeDraw needs (the node pass's target). */
+  dispose?(): void;
 }
 
 export interface GpuMaterialKit {
   /** The package entry that draws with this kit (named in notes and errors). */
   readonly entry: string;
+  /** The methods its GPU backend runs ('gcs'; the GLSL kit also 'lbs' and 'dqs'). */
+  readonly methods: ReadonlySet<string>;
   /** Why `material` cannot draw GCS through this kit, or null when it can. */
   support(material: THREE.Material): string | null;
   /**
@@ -45,4 +60,5 @@ export function disposeGpuMaterials(m: GpuMaterials): void {
   for (const x of Array.isArray(m.material) ? m.material : [m.material]) x.dispose();
   m.depth?.dispose();
   m.distance?.dispose();
+  m.dispose?.();
 }

@@ -8,6 +8,14 @@ import { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION } from '../index.js';
 export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION };
 
 /**
+ * Textures the node pass writes (joint-level path, WebGLRenderer), one texel per node in each:
+ * the three rows of the node's affine 3×4 [M | T], then its normal texel (x, y, 0, flag), from
+ * which the vertex stage takes the normal matrix N = cof(M·x)·y (the rotation where the scale is
+ * uniform: x = 1/s, y = 1; flag −1 where normals renormalise, else 0).
+ */
+export const GPU_NODE_TEXTURES = 4;
+
+/**
  * What the GPU gets per frame: 'joints' (joint poses, O(joints); weights criterion only) or
  * 'sections' (section transforms, O(sections); any criterion).
  */
@@ -24,6 +32,16 @@ export type TableSlots = 4 | 8;
  * dual-quaternion blend (gcs_gcs_section_centres).
  */
 export const tableTexelsPerSection = (slots: TableSlots): number => slots / 2 + 1;
+
+/** What the GPU backend runs per vertex: GCS (nodes), or LBS / DQS of the vertex's own joints. */
+export type GpuMethod = 'gcs' | 'lbs' | 'dqs';
+
+/**
+ * LBS and DQS on the GPU: per vertex its joints (−1 where the weight is 0) and weights, as the core
+ * normalises them; the second of each only on rigs with up to 8 influences per vertex.
+ */
+export const INFLUENCE_ATTRIBUTES = ['gcsInfluences0', 'gcsInfluences1'] as const;
+export const WEIGHT_ATTRIBUTES = ['gcsWeights0', 'gcsWeights1'] as const;
 
 /** Per-vertex attribute, plain mode: the vertex's section (a float). */
 export const SECTION_ATTRIBUTE = 'gcsSection';

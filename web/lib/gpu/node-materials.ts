@@ -70,6 +70,7 @@ export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
 /** The TSL kit: what gcs-skin/webgpu draws with. */
 export const tslKit: GpuMaterialKit = {
   entry: 'gcs-skin/webgpu',
+  methods: new Set(['gcs']),
   support: nodeMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
     const convert = (m: THREE.Material) => {

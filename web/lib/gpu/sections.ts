@@ -6,7 +6,10 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
-import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuPath, type TableSlots } from './layout.js';
+import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuMethod, type GpuPath, type TableSlots } from './layout.js';
+
+/** LBS / DQS on the GPU: the method and the influences per vertex the shader blends (4, or 8). */
+export interface SkinningOptions { method: 'lbs' | 'dqs'; slots: TableSlots }
 
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
@@ -44,18 +47,31 @@ export class GpuSections {
   readonly tableSlots: TableSlots;
   readonly uniforms: GcsUniforms;
   readonly smooth: boolean;
+  /** Counts update() calls: what a node pass computed from is told apart from what it must recompute. */
+  version = 0;
   /** Velocity: the per-frame texels as the previous frame drew them (see previousTexture). */
   private previous: { texture: THREE.DataTexture; drawn: Float32Array; frameId: number } | null = null;
 
-  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath) {
+  /** What the vertex stage runs: GCS, or LBS / DQS of each vertex's own joints (joint poses only, no table). */
+  readonly method: GpuMethod;
+  /** LBS / DQS: `deformer` is a GCS build of the same rig kept for its joint poses only, freed with this. */
+  private readonly ownsDeformer: boolean;
+
+  constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath, skinning?: SkinningOptions) {
     if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
-    this.path = path ?? (deformer.jointLevel ? 'joints' : 'sections');
+    this.method = skinning?.method ?? 'gcs';
+    this.ownsDeformer = skinning !== undefined;
+    this.path = skinning ? 'joints' : path ?? (deformer.jointLevel ? 'joints' : 'sections');
     this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth) : new SectionTransforms(deformer, instanceCount, maxWidth);
     const t = this.transforms;
     this.texture = floatTexture(t.texels, t.width, t.height);
     const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
     this.tableSlots = 4;
-    if (this.path === 'joints') {
+    if (skinning) {
+      this.tableSlots = skinning.slots;
+      this.table = null;
+      this.uniforms = { gcsJoints: { value: this.texture }, ...base };
+    } else if (this.path === 'joints') {
       this.tableSlots = deformer.sectionInfluenceSlots === 8 ? 8 : 4;
       const table = sectionTable(deformer);
       const texels = table.length / 4, width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
@@ -67,7 +83,7 @@ export class GpuSections {
       this.table = null;
       this.uniforms = { gcsSections: { value: this.texture }, ...base };
     }
-    this.smooth = deformer.blendOther() !== null;
+    this.smooth = !skinning && deformer.blendOther() !== null;
   }
 
   get instanceCount(): number {
@@ -117,6 +133,7 @@ export class GpuSections {
   /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
   update(): void {
     this.transforms.compute();
+    this.version++;
     const texels = this.transforms.texels; // re-created after memory growth
     const image = this.texture.image as { data: Float32Array };
     if (image.data !== texels) image.data = texels;
@@ -128,6 +145,7 @@ export class GpuSections {
     this.previous?.texture.dispose();
     this.table?.dispose();
     this.transforms.dispose();
+    if (this.ownsDeformer) this.deformer.dispose();
   }
 }
 

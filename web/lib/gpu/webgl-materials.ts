@@ -6,7 +6,8 @@ import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { patchVertexShader } from './glsl.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
-import type { GpuPath, TableSlots } from './layout.js';
+import type { GpuMethod, GpuPath, TableSlots } from './layout.js';
+import { NodePass } from './node-pass.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** Why a material cannot draw a GCS mesh on the GPU, or null when it can. */
@@ -19,11 +20,11 @@ export function gpuMaterialSupport(material: THREE.Material): string | null {
 
 /**
  * A clone of `source` (sharing its textures) whose vertex shader applies GCS section transforms
- * read from `uniforms` (path 'sections'), or blends them from the joint poses (path 'joints', with
- * `slots` joints per section in the table: GpuSections.tableSlots). The source's own
- * onBeforeCompile, if any, runs first.
+ * read from `uniforms`: path 'sections', GpuSections.uniforms; path 'joints', the node pass's
+ * (NodePass.uniforms: each node's transform, computed once per frame from the joint poses). The
+ * source's own onBeforeCompile, if any, runs first.
  */
-export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): M {
+export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): M {
   const reason = gpuMaterialSupport(source);
   if (reason) throw new GcsError('INVALID_ARGUMENT', reason);
   const material = source.clone() as M;
@@ -32,11 +33,12 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
   material.onBeforeCompile = (shader, renderer) => {
     own.call(source, shader, renderer);
     for (const [name, u] of Object.entries(uniforms)) if (u) shader.uniforms[name] = u;
-    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path, slots);
+    shader.vertexShader = patchVertexShader(shader.vertexShader, smooth, path, method, slots);
   };
-  material.customProgramCacheKey = () => `${ownKey}|gcs-${smooth ? 'smooth' : 'plain'}-${path}${path === 'joints' ? `-${slots}` : ''}`;
+  material.customProgramCacheKey = () => `${ownKey}|gcs-${method === 'gcs' ? `${smooth ? 'smooth' : 'plain'}-${path}` : `${method}-${slots}`}`;
   material.name = source.name;
   material.userData.gcsSource = source;
+  material.userData.gcsUniforms = uniforms; // what its vertex stage reads (tests read the shader's output with them)
   return material;
 }
 
@@ -44,7 +46,7 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
  */
-export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', slots: TableSlots = 4): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
+export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };
@@ -55,19 +57,46 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
       m.alphaMap = s.alphaMap ?? null;
     }
   }
-  return { depth: gcsMaterial(depth, uniforms, smooth, path, slots), distance: gcsMaterial(distance, uniforms, smooth, path, slots) };
+  return { depth: gcsMaterial(depth, uniforms, smooth, path, method, slots), distance: gcsMaterial(distance, uniforms, smooth, path, method, slots) };
+}
+
+/**
+ * Why the program WebGLRenderer built for `material` did not compile or link (three.js's own
+ * check, `renderer.debug.checkShaderErrors`, on by default), or null: a patched shader that fails
+ * draws nothing, and the skin must not stay so in silence.
+ */
+function compileError(renderer: unknown, material: THREE.Material): string | null {
+  const r = renderer as { isWebGLRenderer?: boolean; properties?: { get(m: object): { currentProgram?: { diagnostics?: { runnable: boolean; vertexShader: { log: string }; programLog: string } } } } };
+  if (!r?.isWebGLRenderer || !material.userData.gcsUniforms) return null;
+  const diagnostics = r.properties?.get(material).currentProgram?.diagnostics;
+  if (!diagnostics || diagnostics.runnable) return null;
+  const log = (diagnostics.vertexShader.log || diagnostics.programLog).split('\n')[0].trim();
+  return `${material.type}'s GCS shader did not compile on this WebGLRenderer${log ? ` (${log})` : ''}`;
 }
 
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
 export const glslKit: GpuMaterialKit = {
   entry: 'gcs-skin/three',
+  methods: new Set(['gcs', 'lbs', 'dqs']),
   support: gpuMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
-    const { uniforms, smooth, path, tableSlots } = sections;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, tableSlots);
+    const { smooth, path, method, tableSlots } = sections;
+    // GCS, joint-level: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
+    const pass = method === 'gcs' && path === 'joints' ? new NodePass(sections) : null;
+    const uniforms = pass ? pass.uniforms : sections.uniforms;
+    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, method, tableSlots);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
-    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, tableSlots);
-    return { material, depth: shadow.depth, distance: shadow.distance };
+    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, method, tableSlots);
+    if (!pass) return { material, depth: shadow.depth, distance: shadow.distance, compileError };
+    return {
+      material, depth: shadow.depth, distance: shadow.distance, compileError,
+      beforeDraw(renderer: unknown): string | null {
+        const why = NodePass.unsupported(renderer);
+        if (!why && (renderer as { isWebGLRenderer?: boolean })?.isWebGLRenderer) pass.render(renderer as THREE.WebGLRenderer);
+        return why;
+      },
+      dispose: () => pass.dispose(),
+    };
   },
   mismatch(renderer: unknown): string | null {
     const r = renderer as { isWebGPURenderer?: boolean; isWebGLRenderer?: boolean };

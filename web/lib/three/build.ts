@@ -5,7 +5,8 @@ import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type Rig } from '../index.js';
 import { transferSurfaceAttributes } from '../surface-attributes.js';
-import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from '../gpu/bind.js';
+import { bindGeometry, identitySkin, influenceAttributes, remapAttribute, SKINNING_ATTRIBUTES, type VertexAttribute } from '../gpu/bind.js';
+import { rigInputFromSkinnedMesh } from './rig-input.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from '../gpu/kit.js';
 import type { GpuPath } from '../gpu/layout.js';
 import { GpuSections } from '../gpu/sections.js';
@@ -36,6 +37,8 @@ export interface GpuBuild {
   sections: GpuSections;
   materials: GpuMaterials;
   raycast: THREE.BufferGeometry;
+  /** LBS / DQS: each vertex's joints and weights (static attributes); null for GCS. */
+  influences: VertexAttribute[] | null;
 }
 
 /** What a build reads of its SkinDeformer (nothing here is changed by a build). */
@@ -76,7 +79,7 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
     const morph = method === 'classic' ? null : morphData(from.source.geometry);
     if (morph) deformer.setMorphTargets(morph.positions, morph.normals);
     if (onGpu) {
-      gpu = prepareGpu(from, deformer as GcsDeformer, gpuPath === 'auto' ? undefined : gpuPath);
+      gpu = prepareGpu(from, deformer, method, gpuPath === 'auto' ? undefined : gpuPath);
       const geometry = makeGeometry(from, deformer, keepsVertices, gpu);
       return { method, gcs: gcsOptions, classic: classicOptions, deformer, geometry, maxDelta: morph?.maxDelta ?? null, gpu, note, backend, gpuPath };
     }
@@ -107,7 +110,7 @@ export function disposeGpu(gpu: GpuBuild): void {
 
 /** Why this build cannot run on the GPU, or ''. */
 function gpuUnsupported(from: BuildSource, method: DeformerKind): string {
-  if (method !== 'gcs') return `the GPU backend runs GCS; '${method}' runs on the CPU`;
+  if (!from.kit.methods.has(method)) return `the GPU backend of ${from.kit.entry} runs ${[...from.kit.methods].map((m) => `'${m}'`).join(', ')}; '${method}' runs on the CPU`;
   for (const m of Array.isArray(from.baseMaterial) ? from.baseMaterial : [from.baseMaterial]) {
     const reason = from.kit.support(m);
     if (reason) return reason;
@@ -115,16 +118,33 @@ function gpuUnsupported(from: BuildSource, method: DeformerKind): string {
   return '';
 }
 
-/** The per-frame texture (joint poses or section transforms) and the GCS materials of a GPU build. */
-function prepareGpu(from: BuildSource, deformer: GcsDeformer, path?: GpuPath): GpuBuild {
-  const sections = new GpuSections(deformer, 1, 2048, path);
+/**
+ * The per-frame texture (joint poses or section transforms) and the GCS materials of a GPU build.
+ * LBS and DQS: the joint poses (of a GCS build of the same rig, kept for them alone) and each
+ * vertex's joints and weights; the vertex stage blends them.
+ */
+function prepareGpu(from: BuildSource, deformer: Deformer, method: DeformerKind, path?: GpuPath): GpuBuild {
+  let sections: GpuSections, influences: VertexAttribute[] | null = null;
+  if (method === 'lbs' || method === 'dqs') {
+    const skin = influenceAttributes(rigInputFromSkinnedMesh(from.source), deformer.sourceVertex!);
+    influences = skin.attributes;
+    const poses = from.rig.buildGcs({ sections: 3, smooth: false });
+    try {
+      sections = new GpuSections(poses, 1, 2048, 'joints', { method, slots: skin.slots });
+    } catch (e) {
+      poses.dispose();
+      throw e;
+    }
+  } else {
+    sections = new GpuSections(deformer as GcsDeformer, 1, 2048, path);
+  }
   const materials = from.kit.build(from.baseMaterial, sections, null);
   const raycast = new THREE.BufferGeometry();
   raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
   raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
   raycast.boundingBox = from.box;
   raycast.boundingSphere = from.sphere;
-  return { sections, materials, raycast };
+  return { sections, materials, raycast, influences };
 }
 
 /** The output geometry of a build: the deformer's buffers (CPU) or the bind pose with section data (GPU), and the source's other attributes. */
@@ -134,7 +154,7 @@ function makeGeometry(from: BuildSource, deformer: Deformer, keepsVertices: bool
   let geometry: THREE.BufferGeometry;
   if (gpu) {
     // The bind pose, uploaded once, with the section data; three.js morphs in the shader, before GCS.
-    geometry = bindGeometry(deformer as GcsDeformer, from.rig.jointCount, src, { tangents: from.options.tangents !== 'drop', morphs: true });
+    geometry = bindGeometry(deformer, from.rig.jointCount, src, { tangents: from.options.tangents !== 'drop', morphs: true }, gpu.influences ?? undefined);
   } else {
     geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));

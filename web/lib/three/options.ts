@@ -37,16 +37,17 @@ export interface SkinDeformerOptions {
    * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the joint
    * poses (weights criterion; about 1 KB) or the section transforms (a few KB), into a float
    * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
-   * see gpuPath). GCS only: other methods, and materials that cannot be
-   * patched (ShaderMaterial, node materials), fall back to 'cpu' — `backend` tells which runs,
-   * `backendNote` why, and one console warning says so. The same happens at the first draw by a
-   * WebGPURenderer, which never runs the patch: gcs-skin/webgpu is the GPU backend for it (TSL).
+   * see gpuPath). GCS, LBS and DQS (gcs-skin/webgpu: GCS): the classic model, materials that cannot
+   * be patched (ShaderMaterial, node materials) and a patched shader that fails to compile fall back
+   * to 'cpu' — `backend` tells which runs, `backendNote` why, and one console warning says so. The
+   * same happens at the first draw by a WebGPURenderer, which never runs the patch: gcs-skin/webgpu
+   * is the GPU backend for it (TSL).
    */
   backend?: Backend;
   /**
    * GPU backend: what wasm hands the GPU per frame. 'auto' (default): 'joints' for the weights
-   * criterion (the joint poses, 64 bytes per joint; the shader blends each section from them and a
-   * static table), 'sections' for 'y' and 'axial' (the section transforms, 48 bytes per section).
+   * criterion (the joint poses, 64 bytes per joint; a node pass blends each section from them and
+   * a static table once per frame, the vertex shader reads the result), 'sections' for 'y' and 'axial' (the section transforms, 48 bytes per section).
    * 'sections' forces the section-level path; 'joints' with 'y' or 'axial' is GcsError
    * 'INVALID_ARGUMENT'.
    */

@@ -116,6 +116,17 @@ export class SkinDeformer {
       if (this.gpu) this.checkRenderer(renderer, geometry, material);
       else if (this.velocity === 'off' && this.kit.drawsVelocity(renderer)) this.velocity = 'wanted';
     };
+    // Shadow maps are drawn before the scene: the GPU backend's once-per-frame work runs at the first of either.
+    mesh.onBeforeShadow = (renderer, _object, _camera, _shadowCamera, geometry, material) => {
+      if (this.gpu) this.checkRenderer(renderer, geometry, material);
+    };
+    // A GPU material whose shader failed to compile drew nothing: the next frame runs on the CPU backend.
+    mesh.onAfterRender = (renderer, _scene, _camera, _geometry, material) => {
+      if (this.gpu) this.checkCompiled(renderer, material);
+    };
+    mesh.onAfterShadow = (renderer, _object, _camera, _shadowCamera, _geometry, material) => {
+      if (this.gpu) this.checkCompiled(renderer, material);
+    };
     mesh.name = source.name;
     mesh.castShadow = source.castShadow;
     mesh.receiveShadow = source.receiveShadow;
@@ -174,11 +185,22 @@ export class SkinDeformer {
    */
   private checkRenderer(renderer: unknown, geometry: THREE.BufferGeometry, material: THREE.Material): void {
     const why = this.kit.mismatch(renderer, material);
-    if (!why) return;
+    // The joint-level path's node pass (once per frame); a renderer without float targets takes the section-level path.
+    const noPass = why ? null : this.gpu!.materials.beforeDraw?.(renderer) ?? null;
+    if (!why && !noPass) return;
     geometry.setDrawRange(0, 0); // this draw: nothing rather than the bind pose
+    const next = this.prepare(this.method, why ? { backend: 'cpu' } : { gpuPath: 'sections' });
+    next.note = why ?? `${noPass}: this skin runs the section-level path (gpuPath 'sections')`;
+    this.commit(next, true); // the old geometry is being drawn: freed at the next update()
+  }
+
+  /** After a GPU draw: a shader that did not compile moves the skin to the CPU backend (backendNote says why). */
+  private checkCompiled(renderer: unknown, material: THREE.Material): void {
+    const why = this.gpu!.materials.compileError?.(renderer, material);
+    if (!why) return;
     const next = this.prepare(this.method, { backend: 'cpu' });
     next.note = why;
-    this.commit(next, true); // the old geometry is being drawn: freed at the next update()
+    this.commit(next, true);
   }
 
   /** @internal Shows a prepared build; the previous deformer and geometry are freed (the geometry at the next update() when `duringDraw`). */
@@ -190,7 +212,7 @@ export class SkinDeformer {
     this.note = next.note;
     if (next.note && !this.warned.has(next.note)) {
       this.warned.add(next.note);
-      console.warn(`gcs-skin: ${next.note}. This skin runs on the CPU backend.`);
+      console.warn(`gcs-skin: ${next.note}.${next.gpu ? '' : ' This skin runs on the CPU backend.'}`);
     }
     const mesh = this.mesh as DeformedMesh;
     const gpuMaterials = next.gpu?.materials;
