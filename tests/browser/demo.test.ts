@@ -267,7 +267,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
         const note = page.locator('.lil-gui .criterion-note');
         await expect(note.isVisible(), `${c.value}: the note on the paper's criteria`).resolves.toBe(paperOnly);
         if (paperOnly) {
-          expect(await note.innerText()).toMatch(/broken.*bound 100 % to one bone.*weights, keeps it rigid.*README/s);
+          expect(await note.innerText()).toMatch(/broken.*bound 100 % to one bone.*weights, keeps it rigid.*docs/method.md/s);
           expect(await note.evaluate((el) => ({ elements: el.children.length, afterMenu: !!el.previousElementSibling?.querySelector('select') })))
             .toEqual({ elements: 0, afterMenu: true });
         }
