@@ -1,3 +1,4 @@
+/** @module @gcs-skin/cli/report */
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--wide] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
 // method, build ms, ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe over the
