@@ -20,6 +20,7 @@ export class CrowdReadout {
   private readonly steadyMs = new SteadyFigure();
   private readonly steadyBytes = new SteadyFigure();
   private due = true; // a rebuild shows its settings at once, its figures when steady
+  private figureShown = false; // until a figure is shown, every frame may bring it (a slow page's deadline)
 
   constructor() {
     this.element.className = 'readout';
@@ -35,6 +36,7 @@ export class CrowdReadout {
     this.steadyMs.reset();
     this.steadyBytes.reset();
     this.due = true;
+    this.figureShown = false;
   }
 
   add(ms: number, bytes: number): void {
@@ -58,9 +60,9 @@ export class CrowdReadout {
     return { ms, bytes };
   }
 
-  /** Whether show() is due at `frame`: right after a rebuild, then every 10th frame. */
+  /** Whether show() is due at `frame`: right after a rebuild, every frame until a figure is shown, then every 10th frame. */
   shows(frame: number): boolean {
-    return this.due || frame % 10 === 1;
+    return this.due || !this.figureShown || frame % 10 === 1;
   }
 
   /** Rewrites the readout (when shows(frame) says so: the text is built only then). */
@@ -72,6 +74,7 @@ export class CrowdReadout {
       figures = 'skinning CPU and uploads per frame: <b>warming up…</b>';
       if (this.steadyMs.overdue) figures += ' <span class="criterion">(no frame drawn yet since the change)</span>';
     } else {
+      this.figureShown = true;
       figures = `skinning CPU <b>${msText(perFrame)} ms</b>/frame (${(perFrame / count * 1000).toFixed(1)} µs per character)` +
         ` · uploaded <b>${fmtBytes(uploaded)}</b>/frame (${fmtBytes(uploaded / count)} per character)`;
       const used = this.steadyMs.used;

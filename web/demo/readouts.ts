@@ -14,7 +14,8 @@ import type { InfluenceCount } from './influences.js';
 export interface Readouts {
   character: string;
   /** ms: NaN while warmingUp (measuring, a few frames after each build). */
-  gcs: { ms: number; warmingUp: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
+  /** final: the cost figures are every round's median, and stay until the next build (cost.ts). */
+  gcs: { ms: number; warmingUp: boolean; final: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
   classic: { ms: number; warmingUp: boolean; vertices: number; triangles: number; contours: number; detailLoss: { rms: number; max: number } } | null;
   lbs: { vertices: number; triangles: number } | null;
   influences: InfluenceCount | null;
@@ -39,7 +40,7 @@ export function collectReadouts(): Readouts {
     const cost = state.frameCost.figures();
     const gcsMs = cost.gcs;
     gcsInfo = {
-      ms: gcsMs, warmingUp: Number.isNaN(gcsMs), sections, adjustedShare: sections ? adjusted / sections : 0, criterion: state.builtCriterion,
+      ms: gcsMs, warmingUp: Number.isNaN(gcsMs), final: state.frameCost.final, sections, adjustedShare: sections ? adjusted / sections : 0, criterion: state.builtCriterion,
       rigidShare: vertices ? rigid / vertices : 0, vertices, triangles: ch.gcs.reduce((n, s) => n + tri(s), 0),
     };
     if (ch.classic.length) {
