@@ -67,6 +67,7 @@ describe.skipIf(!!reason)('the demo, read and used as a person would (headless C
     try {
       const text = await measuredReadouts(page);
       console.log(`readouts (${query || 'human'}):\n${text.split('\n').filter((l) => /ms|influence|resampl|contour|section/.test(l)).join('\n')}`);
+      expect(text, "the readouts were read").toMatch(/deform [<\d.\s]+ ms/);
       expect(text).not.toMatch(/(^|[^\d.])0\.00(?!\d)/m);
       expect(text).not.toMatch(/\b1 (influences|vertices|sections|contours|triangles)\b/);
       const classic = await page.evaluate(() => (window.__demo.readouts() as { classic: { contours: number } | null }).classic);
