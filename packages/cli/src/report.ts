@@ -148,14 +148,7 @@ const roundOrNull = (x: number | null) => (x === null ? null : round(x));
 export async function report(file: string, options: ReportOptions = {}, gcs?: GcsSkin): Promise<Report> {
   const sections = options.sections ?? 6;
   const progress = options.onProgress ?? (() => {});
-  progress(`reading ${file}`);
-  let model;
-  try {
-    model = await loadGltfFile(file);
-  } catch (e) {
-    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
-    throw new ReportError(`cannot read ${file}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
-  }
+  const model = await readModel(file, progress);
   if (!model.skinnedMeshes.length)
     throw new ReportError(`${file} has no skinned mesh (no skin, joints and weights): nothing to deform`, 'NO_SKINNED_MESH');
   let clips = model.clips;
@@ -183,20 +176,24 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
   };
 }
 
+/** `file` read (loadGltfFile); a failure is a ReportError with the GltfError's code, or LOAD_FAILED. */
+async function readModel(file: string, progress: (text: string) => void): ReturnType<typeof loadGltfFile> {
+  progress(`reading ${file}`);
+  try {
+    return await loadGltfFile(file);
+  } catch (e) {
+    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
+    throw new ReportError(`cannot read ${file}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
+  }
+}
+
 /**
  * The animations of `clipsFile` that move the model: each clip keeps the tracks whose node the
  * model has (by name, as three.js's mixer binds them); a clip that moves none of its nodes is left
  * out, and a file none of whose clips does is a ReportError (NO_CLIP) naming both files.
  */
 async function companionClips(clipsFile: string, file: string, meshes: readonly THREE.SkinnedMesh[], progress: (text: string) => void): Promise<THREE.AnimationClip[]> {
-  progress(`reading ${clipsFile}`);
-  let companion;
-  try {
-    companion = await loadGltfFile(clipsFile);
-  } catch (e) {
-    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
-    throw new ReportError(`cannot read ${clipsFile}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
-  }
+  const companion = await readModel(clipsFile, progress);
   const roots = new Set(meshes.map((m) => { let root: THREE.Object3D = m; while (root.parent) root = root.parent; return root; }));
   const hasNode = (name: string) => [...roots].some((root) => !!root.getObjectByName(name));
   // GLTFLoader names a track "<node>.<property>" with the node's name sanitised (no '.'): the node is what precedes the last '.'.
