@@ -21,6 +21,7 @@ import { basename, GltfError, loadDroppedGltf, loadGltfUrl } from './load-gltf.j
 import { disposeObject, normaliseSize, SHIPPED } from './loading.js';
 import { describeError, hideStatus, showMessage, shownMessage, showStatus, clearMessage, yieldToPage } from './page.js';
 import { findJointRig, jointFigures, poseBend, type JointRig } from './joint-pose.js';
+import { noJointMessage } from './joint-text.js';
 
 /** The three views, left to right, and the camera layer of each one's meshes. */
 const VIEWS = [
@@ -198,7 +199,7 @@ function install(name: string, object: THREE.Object3D, normalise: boolean): void
   const labels = rig.hinges.map((h) => h.label);
   jointController = jointController.options(textOptions(labels.length ? labels : ['(none found)'])).name('joint');
   jointController.onChange(() => selectJoint(params.joint));
-  if (!rig.hinges.length) showMessage(`${name}: no knee or elbow found (${rig.notes.join('; ')})`);
+  if (!rig.hinges.length) showMessage(noJointMessage(name, rig.notes));
   selectJoint(labels.find((l) => l.startsWith('left elbow')) ?? labels[0] ?? '');
 }
 
