@@ -12,7 +12,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
 import { initGcsSkin, type GcsSkin } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
-import type { Hinge, JointFigures } from '../lib/measure.js';
+import { jointCentres, type Hinge, type JointFigures } from '../lib/measure.js';
 import { humanFromData } from '../lib/human/index.js';
 import { humanDataInWorker } from './human-data.js';
 import { escapeHtml as esc, textOptions } from './gui-text.js';
@@ -246,7 +246,11 @@ function bend(degrees: number): void {
   updateText();
 }
 
-/** The camera on the joint, from the outer side of the limb (along the hinge axis), a little from the front. */
+/**
+ * The camera on the limb, from the outer side (along the hinge axis), a little from the front:
+ * centred on the joint and far enough back for both of its bones (the thigh and shin, the upper arm
+ * and forearm) at any bend, so the limb fills the view, not whatever lies beside the joint (hair).
+ */
 function frameJoint(): void {
   const hinge = currentHinge();
   if (!shown) return;
@@ -265,7 +269,8 @@ function frameJoint(): void {
   const axis = toWorld(hinge.axis);
   if (axis.dot(side) < 0) axis.negate();
   const direction = axis.addScaledVector(toWorld(shown.rig.frame.forward), 0.35).addScaledVector(toWorld(shown.rig.frame.up), 0.15).normalize();
-  const reach = 0.75 * centre.distanceTo(end); // the bent bone's length, about: the joint fills the view
+  const parent = new THREE.Vector3(...jointCentres(shown.rig.input)[hinge.parent]).applyMatrix4(m);
+  const reach = 1.1 * Math.max(centre.distanceTo(end), centre.distanceTo(parent)); // both bones whole, at any bend
   const aspect = Math.min(1, viewWidth() / window.innerHeight);
   const distance = reach / Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) / aspect;
   controls.target.copy(centre);
