@@ -11,7 +11,11 @@
 //   node scripts/screenshot-demo.mjs --only demo-fox.png → only that one
 //   EXTRA='?criterion=y&colour=1' node scripts/screenshot-demo.mjs → also extra.png
 // A page that shows a message (e.g. the wasm failed to load) or throws is an error: no picture.
-import { mkdirSync } from 'node:fs';
+// Beside each picture, NAME.readouts.json: the figures the picture shows (the page's readouts once
+// its cost figures are final; the crowd's readout), so that tests/pictures.test.ts can hold the
+// pictures to the current build and to docs/figures.json.
+import { mkdirSync, writeFileSync } from 'node:fs';
+import { cpus } from 'node:os';
 import { join, resolve } from 'node:path';
 import { loadDemo, openDemo, option, root, watchErrors } from './demo-browser.mjs';
 
@@ -37,21 +41,35 @@ try {
       // Crowd mode: let every character take a few steps, then hold the pose; the readout refreshes every 10 frames.
       await page.waitForFunction(() => window.__crowd.frame() > 12, null, { timeout: 600000 });
       await page.evaluate(() => window.__crowd.pause());
+      await page.waitForFunction(() => /skinning CPU [<\d.\s]+ ms/.test(window.__crowd.readout()), null, { timeout: 600000 });
       checkErrors(shot.file);
       await page.screenshot({ path: join(outDir, shot.file), timeout: 600000 }); // software rendering of the whole crowd
-      console.log('wrote', join(outDir, shot.file));
+      const crowd = await page.evaluate(() => ({ characters: window.__crowd.count(), backend: window.__crowd.backend(), readout: window.__crowd.readout() }));
+      writeReadouts(shot, { crowd });
       await page.close();
       continue;
     }
-    // A stride of the walk with legs apart, then hold it so every view shows the same pose.
+    // The cost figures final (every round measured), then a stride of the walk with legs apart,
+    // held so every view shows the same pose.
+    await page.waitForFunction(() => { const r = window.__demo.readouts(); return !!r.gcs && r.gcs.final; }, null, { timeout: 120000 });
     await page.waitForFunction(() => window.__demo.time() > 0.9, null, { timeout: 60000 });
     await page.evaluate(() => window.__demo.pause(0.32));
     await page.waitForFunction((f) => window.__demo.frame() > f + 3, await page.evaluate(() => window.__demo.frame()));
     checkErrors(shot.file);
     await page.screenshot({ path: join(outDir, shot.file) });
-    console.log('wrote', join(outDir, shot.file));
+    const readouts = await page.evaluate(() => window.__demo.readouts());
+    const text = await page.locator('#readouts').innerText();
+    writeReadouts(shot, { readouts, text });
     await page.close();
   }
 } finally {
   await close();
+}
+
+/** docs/NAME.readouts.json beside docs/NAME.png: where and when it was taken, and what it shows. */
+function writeReadouts(shot, shown) {
+  const file = join(outDir, shot.file.replace(/\.png$/, '.readouts.json'));
+  const host = `${cpus()[0]?.model.trim() ?? 'unknown CPU'}, ${cpus().length} cores, headless Chromium (SwiftShader)`;
+  writeFileSync(file, `${JSON.stringify({ picture: shot.file, query: shot.query, taken: new Date().toISOString().slice(0, 10), host, ...shown }, null, 2)}\n`);
+  console.log('wrote', join(outDir, shot.file), 'and', file);
 }

@@ -167,7 +167,7 @@ describe.skipIf(!!reason)('the README example in a fresh Vite + TypeScript app (
     writeFileSync(join(app, 'src/reference.ts'), `import { installTestHook } from './test-hook';\n${plain}\n${hook.replace('character }', 'character: null }')}\n`);
     const page = readFileSync(join(app, 'index.html'), 'utf8');
     writeFileSync(join(app, 'reference.html'), page.replace('/src/main.ts', '/src/reference.ts'));
-    const [webgpu] = readmeBlocks('### With WebGPURenderer', 'ts');
+    const [webgpu] = readmeBlocks('# gcs-skin with WebGPURenderer', 'ts', 'docs/webgpu.md');
     writeFileSync(join(app, 'src/webgpu.ts'), `import { installTestHook } from './test-hook';\n${webgpu}\n${hook}\n`);
     writeFileSync(join(app, 'webgpu.html'), page.replace('/src/main.ts', '/src/webgpu.ts'));
 
@@ -336,7 +336,7 @@ test("the README's install lines and example are what the app is made of", () =>
   expect(example).toContain("loadAsync('character.glb')");
   for (const name of ['renderer', 'scene', 'camera', 'gltf', 'mixer', 'character'])
     expect(example, name).toMatch(new RegExp(`^const ${name} = `, 'm'));
-  expect(readmeBlocks('### With WebGPURenderer', 'ts')).toHaveLength(1);
+  expect(readmeBlocks('# gcs-skin with WebGPURenderer', 'ts', 'docs/webgpu.md')).toHaveLength(1);
 });
 
 async function waitForServer(address: string): Promise<void> {

@@ -230,7 +230,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
     await expect(page.locator('.label[data-view=gcs]').innerText()).resolves.toMatch(/12 sections: weight step 1\/20/);
 
     // Drag on the slider track itself: near its left end is few sections.
-    const box = (await sections.locator('.slider').boundingBox())!;
+    const box = (await page.locator('.sections-track').boundingBox())!;
     await page.mouse.click(box.x + 1, box.y + box.height / 2);
     await page.waitForFunction(() => window.__demo.sectionsPerPart() <= 4);
     await page.waitForFunction((n) => window.__demo.sectionCount() < n, before.count);
@@ -267,7 +267,7 @@ describe.skipIf(!!reason)('demo page (headless Chromium)', () => {
         const note = page.locator('.lil-gui .criterion-note');
         await expect(note.isVisible(), `${c.value}: the note on the paper's criteria`).resolves.toBe(paperOnly);
         if (paperOnly) {
-          expect(await note.innerText()).toMatch(/broken.*bound 100 % to one bone.*weights, keeps it rigid.*README/s);
+          expect(await note.innerText()).toMatch(/broken.*bound 100 % to one bone.*weights, keeps it rigid.*docs\/method\.md/s);
           expect(await note.evaluate((el) => ({ elements: el.children.length, afterMenu: !!el.previousElementSibling?.querySelector('select') })))
             .toEqual({ elements: 0, afterMenu: true });
         }

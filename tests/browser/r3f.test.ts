@@ -1,6 +1,7 @@
-// docs/react-three-fiber.md's component, as a reader copies it: its tsx block written to
-// tests/.tmp/r3f/GcsModel.tsx, compiled with `tsc --strict` (jsx react-jsx) beside the page that
-// uses it (tests/browser/r3f-fixture), then served by Vite and drawn in headless Chromium inside
+// docs/react-three-fiber.md's App.tsx, as a reader copies it: its one tsx block (the component and
+// the app around it) written to tests/.tmp/r3f/GcsModel.tsx, compiled with `tsc --strict` (jsx
+// react-jsx) beside the test page that uses its component (tests/browser/r3f-fixture), then served
+// by Vite and drawn in headless Chromium inside
 // <StrictMode>: the character (CesiumMan, ../shared/models) is deformed by GcsCharacter (its
 // SkinnedMesh hidden from the camera: layers 0), animated, with no page error; unmounting gives
 // the SkinnedMesh back (dispose). The docs page's warning holds too: the same component with the
@@ -11,7 +12,7 @@ import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { BrowserContext, Page } from 'playwright-core';
 import type { ViteDevServer } from 'vite';
-import { readmeBlocks } from '../helpers/readme.js';
+import { README_REPOSITORY, readmeBlocks } from '../helpers/readme.js';
 import { analyse, launchChromium, MODELS_DIR, ROOT, skipReason } from './harness.js';
 
 declare global {
@@ -26,8 +27,25 @@ if (noModel) console.log(noModel);
 const TMP = join(ROOT, 'tests/.tmp/r3f');
 const FIXTURE = join(ROOT, 'tests/browser/r3f-fixture');
 
+const PAGE = '# gcs-skin in React Three Fiber';
+
+test('the docs page is one complete App.tsx and the install line it needs', () => {
+  const blocks = readmeBlocks(PAGE, 'tsx', 'docs/react-three-fiber.md');
+  expect(blocks, 'one tsx block: the whole file').toHaveLength(1);
+  const [app] = blocks;
+  // Canvas and Suspense imported, GCS_OPTIONS defined before its first use, an App to render.
+  expect(app).toMatch(/^import \{[^}]*\bSuspense\b[^}]*\} from 'react';$/m);
+  expect(app).toMatch(/^import \{[^}]*\bCanvas\b[^}]*\} from '@react-three\/fiber';$/m);
+  expect(app.indexOf('const GCS_OPTIONS')).toBeGreaterThan(-1);
+  expect(app.indexOf('const GCS_OPTIONS')).toBeLessThan(app.indexOf('GCS_OPTIONS}'));
+  expect(app).toMatch(/^export default function App\(\)/m);
+  const [install] = readmeBlocks(PAGE, 'sh', 'docs/react-three-fiber.md');
+  expect(install).toContain(`git+${README_REPOSITORY}`);
+  expect(install).toMatch(/^npm install .*@react-three\/fiber/m);
+});
+
 beforeAll(() => {
-  const [component] = readmeBlocks('# gcs-skin in React Three Fiber', 'tsx', 'docs/react-three-fiber.md');
+  const [component] = readmeBlocks(PAGE, 'tsx', 'docs/react-three-fiber.md');
   mkdirSync(TMP, { recursive: true });
   writeFileSync(join(TMP, 'GcsModel.tsx'), component);
 });
@@ -90,6 +108,29 @@ describe.skipIf(!!reason || !!noModel)('the docs page component in headless Chro
       await page.evaluate(() => window.__r3f.unmount());
       await page.waitForFunction(() => window.__r3f.layerMasks().every((m) => m !== 0), null, { timeout: 30000 });
       expect(errors).toEqual([]);
+    } finally {
+      await page.close();
+    }
+  }, 180000);
+
+  test('a clip name the file lacks is said in a warning naming its clips, and the first clip plays', async () => {
+    const warnings: string[] = [];
+    const page = await context.newPage();
+    page.on('console', (m) => { if (m.type() === 'warning') warnings.push(m.text()); });
+    await page.setViewportSize({ width: 480, height: 480 });
+    await page.route('**/character.glb', (route) => route.fulfill({ path: model, contentType: 'model/gltf-binary' }));
+    try {
+      await page.goto(`${server.resolvedUrls!.local[0]}?clip=Walk`);
+      await page.waitForFunction(() => window.__r3f?.layerMasks().length > 0 && window.__r3f.frames() > 5, null, { timeout: 120000, polling: 100 });
+      const said = warnings.filter((w) => w.includes('no clip named "Walk"'));
+      console.log(`r3f, clip="Walk" on CesiumMan: ${said[0]}`);
+      expect(said.length).toBeGreaterThan(0);
+      expect(said[0]).toMatch(/its clips: "/);
+      const a = await page.screenshot();
+      const f = await page.evaluate(() => window.__r3f.frames());
+      await page.waitForFunction((n) => window.__r3f.frames() > n + 10, f, { timeout: 60000 });
+      const [stats] = await analyse(page, await page.screenshot(), [region], a);
+      expect(stats.changed, 'the first clip plays').toBeGreaterThan(0.002);
     } finally {
       await page.close();
     }

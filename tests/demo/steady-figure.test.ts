@@ -76,3 +76,36 @@ describe('SteadyFigure', () => {
     expect(f.value()).toBe(2);
   });
 });
+
+describe('SteadyFigure at the deadline on a very slow page', () => {
+  test('one or two frames, all within the dropped ones: a figure from them at 3 s, not "warming up"', () => {
+    let clock = 0;
+    const f = new SteadyFigure(32, 10, 0.2, 3000, () => clock);
+    f.add(900);
+    clock += 1200;
+    f.add(700);
+    clock += 1200;
+    expect(f.value(), 'before the deadline: nothing yet').toBeNaN();
+    clock = 3000;
+    expect(f.frames, 'none counted: both were dropped frames').toBe(0);
+    expect(f.used).toBe(2);
+    expect(f.value()).toBe(800);
+    expect(f.agreed()).toBe(false);
+  });
+
+  test('a single frame by the deadline is the figure', () => {
+    let clock = 0;
+    const f = new SteadyFigure(32, 10, 0.2, 3000, () => clock);
+    f.add(450);
+    clock = 3100;
+    expect(f.value()).toBe(450);
+    expect(f.used).toBe(1);
+  });
+
+  test('no frame at all by the deadline: still NaN', () => {
+    let clock = 0;
+    const f = new SteadyFigure(32, 10, 0.2, 3000, () => clock);
+    clock = 5000;
+    expect(f.value()).toBeNaN();
+  });
+});

@@ -8,6 +8,7 @@ import { CLASSIC_LIMITS, MAX_SECTIONS, MIN_SECTIONS } from '../lib/index.js';
 import { playClip, stepFrame } from './animate.js';
 import { applyMaterials } from './colours.js';
 import { CRITERION_MENU, PAPER_CRITERIA_NOTE } from './criteria.js';
+import { SECTION_STOPS, stopIndex } from './section-stops.js';
 import { textOptions, escapeHtml as esc } from './gui-text.js';
 import { updateLabels } from './labels.js';
 import { onCostChange, setBulge } from './models.js';
@@ -33,6 +34,8 @@ interface ValueCtl<T> extends Ctl { setValue(v: T): this }
 let modelController: OptionsCtl;
 let clipController: OptionsCtl;
 let sectionsController: ValueCtl<number>;
+let sectionsTrack: HTMLInputElement;
+
 let pausedController: ValueCtl<boolean>;
 /** The controls that only apply to the paper's criteria (y, axial). */
 let paperOnlyControllers: Ctl[] = [];
@@ -65,7 +68,11 @@ export function initControls(menu: MenuEntry[], characterActions: CharacterActio
   criterionNote.className = 'criterion-note';
   criterionNote.textContent = PAPER_CRITERIA_NOTE;
   criterion.domElement.after(criterionNote);
-  sectionsController = g.add(params, 'sections', MIN_SECTIONS, MAX_SECTIONS, 1).name('sections').onChange(() => { state.pendingGcs = true; }) as unknown as ValueCtl<number>;
+  // The number box takes any count 3–256; the track under it is stepped (SECTION_STOPS), so that
+  // every count of the useful range sits a finger's width apart (a linear 3–256 track gave them 3 px).
+  sectionsController = g.add(params, 'sections').min(MIN_SECTIONS).step(1).name('sections')
+    .onChange(onSectionsBox) as unknown as ValueCtl<number>;
+  sectionsTrack = addSectionsTrack(sectionsController);
   g.add(params, 'smooth').name('smooth (no steps)').onChange(() => { state.pendingGcs = true; });
   const costShown = { text: 'measuring…' };
   const cost = g.add(costShown, 'text').name('cost / frame').disable();
@@ -127,6 +134,33 @@ export function setPaused(paused: boolean): void {
 
 export function setSections(n: number): void {
   sectionsController.setValue(n);
+}
+
+/** The number box: whole counts within MIN_SECTIONS–MAX_SECTIONS (lil-gui clamps the minimum only: a maximum would add its linear slider). */
+function onSectionsBox(): void {
+  const n = Math.round(Math.min(MAX_SECTIONS, Math.max(MIN_SECTIONS, params.sections)));
+  if (n !== params.sections) {
+    sectionsController.setValue(n);
+    return;
+  }
+  sectionsTrack.value = String(stopIndex(n));
+  state.pendingGcs = true;
+}
+
+/** A full-width stepped range input under the number box; moving it sets the box. */
+function addSectionsTrack(box: ValueCtl<number>): HTMLInputElement {
+  const track = document.createElement('input');
+  track.type = 'range';
+  track.className = 'sections-track';
+  track.min = '0';
+  track.max = String(SECTION_STOPS.length - 1);
+  track.step = '1';
+  track.value = String(stopIndex(params.sections));
+  track.title = 'sections: 3 to 16 one by one, then 20, 24, 32, 48, 64, 96, 128, 192, 256 (type any count 3–256 in the box)';
+  track.setAttribute('aria-label', 'sections');
+  track.addEventListener('input', () => box.setValue(SECTION_STOPS[Number(track.value)]));
+  box.domElement.after(track);
+  return track;
 }
 
 function pauseAndStep(): void {

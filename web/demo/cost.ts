@@ -2,8 +2,10 @@
 // timeInterleaved (gcs-skin/measure) over live poses recorded after each (re)build, the models
 // timed in turn (the GCS on screen, a stepped one of the same sections for comparison, the classic
 // model), so that whatever else the machine does lands on all alike. Done in short slices after
-// frames (the page keeps drawing), the figures stand a few frames after a build and then stay:
-// no figure that drifts with the page's own load, none that inverts by chance (InversionGuard).
+// frames (the page keeps drawing), the first figures stand a few frames after a build; then the
+// same measurement is repeated a few times, a fraction of a second apart, and the figure shown is
+// the median of the rounds (one round taken while the page was busy is outvoted), after which it
+// stays: no figure that drifts with the page's own load, none that inverts by chance (InversionGuard).
 import type { GcsDeformer, GcsOptions } from '../lib/index.js';
 import { median, timeInterleaved } from '../lib/measure.js';
 import { writeSkinMatrices, type SkinDeformer } from '../lib/three.js';
@@ -22,6 +24,9 @@ const RECORD_MS = 300;
 const LATE_MS = 800;
 /** A timed sample lasts at least this: a browser's clock moves in 0.1 ms steps (timeInterleaved's repeat). */
 const SAMPLE_MS = 1;
+/** Rounds of SLICES slices in all (the first included), and the pause before each further one. */
+const ROUNDS = 5;
+const ROUND_GAP_MS = 400;
 
 export interface FrameCostFigures {
   /** ms per frame of the GCS model on screen (every skinned mesh), NaN until measured. */
@@ -62,7 +67,7 @@ export interface CostModels {
   options: GcsOptions;
 }
 
-type Phase = 'idle' | 'recording' | 'measuring' | 'done';
+type Phase = 'idle' | 'recording' | 'measuring' | 'repeating' | 'done';
 
 /** The per-frame cost figures of the models on screen, measured after each build (see the file's head). */
 export class FrameCost {
@@ -75,6 +80,9 @@ export class FrameCost {
   private steps: ((frame: number) => void)[] = [];
   private repeat: number[] = [];
   private slices: number[][] = [];
+  /** rounds[k]: each finished round's median ms of step k. */
+  private rounds: number[][] = [];
+  private roundEndedAt = 0;
   private shown: FrameCostFigures = NONE;
   private readonly guard = new InversionGuard();
   private listener: (figures: FrameCostFigures) => void = () => {};
@@ -96,8 +104,13 @@ export class FrameCost {
     return this.shown;
   }
 
-  /** True once the figures for the models on screen stand. */
+  /** True once figures for the models on screen are shown (the first round); they may still be refined. */
   get settled(): boolean {
+    return this.phase === 'repeating' || this.phase === 'done';
+  }
+
+  /** True once every round is measured: the figures shown are final until the next build. */
+  get final(): boolean {
     return this.phase === 'done';
   }
 
@@ -108,6 +121,7 @@ export class FrameCost {
     this.sources = [...new Set([...models.gcs, ...models.classic].map((s) => s.source))];
     this.poses = [];
     this.slices = [];
+    this.rounds = [];
     this.guard.reset();
     this.framesSinceBuild = 0;
     this.builtAt = this.now();
@@ -126,6 +140,11 @@ export class FrameCost {
   /** After each frame's update(): records a pose, or runs one slice of timing. */
   afterFrame(): void {
     if (this.phase === 'idle' || this.phase === 'done' || !this.models) return;
+    if (this.phase === 'repeating') {
+      if (this.slices[0].length === 0 && this.now() - this.roundEndedAt < ROUND_GAP_MS) return;
+      this.slice();
+      return;
+    }
     this.framesSinceBuild++;
     if (this.phase === 'recording') {
       this.poses.push(this.sources.map((src) => {
@@ -173,21 +192,38 @@ export class FrameCost {
     const t = timeInterleaved(this.poses.length, this.steps, { minSamples: 1, minMs: 0, maxMs: SLICE_MS, warmup: 0, repeat: this.repeat });
     t.forEach((x, k) => this.slices[k].push(x.medianMs));
     if (this.slices[0].length < SLICES) return;
+    const round = this.slices.map((s) => median(s));
+    this.slices = this.steps.map(() => []);
+    if (this.phase === 'repeating') {
+      // A further round: the figures are the rounds' medians (an inverted round is outvoted, not confirmed).
+      this.rounds.push(round);
+      this.roundEndedAt = this.now();
+      const ms = round.map((_, k) => median(this.rounds.map((r) => r[k])));
+      this.publish(this.figuresOf(ms));
+      if (this.rounds.length >= ROUNDS) {
+        this.dropScratch();
+        this.phase = 'done';
+      }
+      return;
+    }
+    const ms = round;
+    const figures = this.figuresOf(ms);
+    if (this.stepped.length > 0 && !this.guard.accept(figures.gcs, figures.stepped)) return; // measure again before showing an inversion
+    this.rounds = [ms];
+    this.roundEndedAt = this.now();
+    this.phase = 'repeating';
+    this.publish(figures);
+  }
+
+  /** The figures from one median ms per step (the GCS on screen, its stepped twin if built, the classic model). */
+  private figuresOf(ms: number[]): FrameCostFigures {
     const m = this.models!;
-    const ms = this.slices.map((s) => median(s));
     const hasStepped = this.stepped.length > 0;
-    const figures: FrameCostFigures = {
+    return {
       gcs: ms[0],
       stepped: hasStepped ? ms[1] : (m.options.criterion ?? 'weights') === 'weights' ? ms[0] : NaN,
       classic: m.classic.length ? ms[hasStepped ? 2 : 1] : NaN,
     };
-    if (hasStepped && !this.guard.accept(figures.gcs, figures.stepped)) {
-      this.slices = this.steps.map(() => []); // measure again before showing an inversion
-      return;
-    }
-    this.dropScratch();
-    this.phase = 'done';
-    this.publish(figures);
   }
 
   private dropScratch(): void {

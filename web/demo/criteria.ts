@@ -1,6 +1,6 @@
 // What the page says about the GCS criteria: the menu, a short name and one line each, and the
-// note shown beside the menu under the paper's criteria (README, "Why the default differs from
-// the paper").
+// note shown beside the menu under the paper's criteria (docs/method.md, section 10: why the default
+// differs from the paper).
 import type { Criterion } from '../lib/index.js';
 
 /** The criterion menu: label → value. */
@@ -21,4 +21,4 @@ export const CRITERION_TEXT: Record<Criterion, { name: string; why: string }> = 
 export const PAPER_CRITERIA_NOTE =
   'Looks broken on real characters? Expected: the paper bins skin by height (Y) or along the bone (axial), ' +
   'not by its weights, so skin bound 100 % to one bone bends with the joint and leaves that bone. ' +
-  'The default, weights, keeps it rigid (README: "Why the default differs from the paper").';
+  'The default, weights, keeps it rigid (docs/method.md, section 10: why the default differs from the paper).';

@@ -1,7 +1,8 @@
 // The crowd page's readout: what runs (characters, renderer, backend, path) at once after a build,
 // and the skinning CPU time and bytes uploaded per frame once steady (SteadyFigure: "warming up…"
-// before, at most 3 s; a figure still varying then says so), with the last frames' samples kept
-// for the test hook's medians.
+// before, at most 3 s, then a figure from whatever frames there are, saying how few and whether
+// they still vary), with the last frames' samples kept for the test hook's medians.
+import { counted, msText } from './figure-text.js';
 import { SteadyFigure } from './steady-figure.js';
 
 const fmtBytes = (b: number) => (b >= 1e6 ? `${(b / 1e6).toFixed(2)} MB` : b >= 1e3 ? `${(b / 1e3).toFixed(1)} KB` : `${b.toFixed(0)} B`);
@@ -19,6 +20,7 @@ export class CrowdReadout {
   private readonly steadyMs = new SteadyFigure();
   private readonly steadyBytes = new SteadyFigure();
   private due = true; // a rebuild shows its settings at once, its figures when steady
+  private figureShown = false; // until a figure is shown, every frame may bring it (a slow page's deadline)
 
   constructor() {
     this.element.className = 'readout';
@@ -34,6 +36,7 @@ export class CrowdReadout {
     this.steadyMs.reset();
     this.steadyBytes.reset();
     this.due = true;
+    this.figureShown = false;
   }
 
   add(ms: number, bytes: number): void {
@@ -57,9 +60,9 @@ export class CrowdReadout {
     return { ms, bytes };
   }
 
-  /** Whether show() is due at `frame`: right after a rebuild, then every 10th frame. */
+  /** Whether show() is due at `frame`: right after a rebuild, every frame until a figure is shown, then every 10th frame. */
   shows(frame: number): boolean {
-    return this.due || frame % 10 === 1;
+    return this.due || !this.figureShown || frame % 10 === 1;
   }
 
   /** Rewrites the readout (when shows(frame) says so: the text is built only then). */
@@ -69,14 +72,16 @@ export class CrowdReadout {
     let figures: string;
     if (Number.isNaN(perFrame) || Number.isNaN(uploaded)) {
       figures = 'skinning CPU and uploads per frame: <b>warming up…</b>';
-      if (this.steadyMs.overdue)
-        figures += ` <span class="criterion">(${this.steadyMs.frames} frames counted so far, 4 needed: ` +
-          `the page draws slowly, and the first ${this.steadyMs.dropped} frames after a change are not counted)</span>`;
+      if (this.steadyMs.overdue) figures += ' <span class="criterion">(no frame drawn yet since the change)</span>';
     } else {
-      figures = `skinning CPU <b>${perFrame.toFixed(2)} ms</b>/frame (${(perFrame / count * 1000).toFixed(1)} µs per character)` +
+      this.figureShown = true;
+      figures = `skinning CPU <b>${msText(perFrame)} ms</b>/frame (${(perFrame / count * 1000).toFixed(1)} µs per character)` +
         ` · uploaded <b>${fmtBytes(uploaded)}</b>/frame (${fmtBytes(uploaded / count)} per character)`;
-      if (!this.steadyMs.agreed() || !this.steadyBytes.agreed())
-        figures += ` <span class="criterion">(over the last ${this.steadyMs.frames} frames: still varying by more than 20 % between them)</span>`;
+      const used = this.steadyMs.used;
+      if (used < 4)
+        figures += ` <span class="criterion">(from ${counted(used, 'frame')} since the change, the first ones included: the page draws slowly)</span>`;
+      else if (!this.steadyMs.agreed() || !this.steadyBytes.agreed())
+        figures += ` <span class="criterion">(over the last ${counted(used, 'frame')}: still varying by more than 20 % between them)</span>`;
     }
     this.element.innerHTML = `${head}<br>${figures}${note ? `<br><span class="criterion">${note}</span>` : ''}`;
   }

@@ -1,8 +1,9 @@
-// The compressed-glTF decoders the page loads at run time (Draco's and Basis Universal's wasm and
-// their JavaScript wrappers, from three's addons), served from the page's own origin: a Vite
-// plugin that serves them under decoders/ in dev and writes them into the build. Never a CDN: the
-// page's Content-Security-Policy allows no other origin. meshopt's decoder is plain JavaScript
-// (its wasm inlined) and is bundled like any module.
+// The compressed-glTF decoders the page loads at run time that no module names (Draco's wasm and
+// its JavaScript wrapper, from three's addons), served from the page's own origin: a Vite plugin
+// that serves them under decoders/ in dev and writes them into the build. Never a CDN: the page's
+// Content-Security-Policy allows no other origin. Basis Universal's transcoder is KTX2Loader's
+// default, which Vite emits itself (new URL(…, import.meta.url)); meshopt's decoder is plain
+// JavaScript (its wasm inlined) and is bundled like any module.
 import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import type { Plugin } from 'vite';
@@ -14,8 +15,6 @@ export const DECODER_FOLDER = 'decoders';
 const FILES: Record<string, string> = {
   'draco/draco_wasm_wrapper.js': 'three/examples/jsm/libs/draco/gltf/draco_wasm_wrapper.js',
   'draco/draco_decoder.wasm': 'three/examples/jsm/libs/draco/gltf/draco_decoder.wasm',
-  'basis/basis_transcoder.js': 'three/examples/jsm/libs/basis/basis_transcoder.js',
-  'basis/basis_transcoder.wasm': 'three/examples/jsm/libs/basis/basis_transcoder.wasm',
 };
 
 export function decoderFiles(): Plugin {

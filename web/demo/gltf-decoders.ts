@@ -1,8 +1,9 @@
 // The decoders of compressed glTF for three's GLTFLoader, as a page that ships such files sets
 // them up (README, "Compressed glTF"): DRACOLoader (KHR_draco_mesh_compression), KTX2Loader
 // (KHR_texture_basisu) and meshopt's MeshoptDecoder (EXT_meshopt_compression). Each is made on the
-// first file that needs it and kept; the Draco and Basis wasm come from the page's own decoders/
-// folder (decoder-files.ts), never another origin.
+// first file that needs it and kept; Draco's wasm comes from the page's own decoders/ folder
+// (decoder-files.ts), Basis's is KTX2Loader's own, which the build emits beside the page's code
+// (KTX2Loader names it with new URL(…, import.meta.url)): never another origin.
 import type * as THREE from 'three';
 import type { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import type { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
@@ -30,7 +31,7 @@ export async function addDecoders(loader: GLTFLoader, used: readonly string[], r
   }
   if (used.includes('KHR_texture_basisu')) {
     ktx2 ??= import('three/addons/loaders/KTX2Loader.js').then(({ KTX2Loader }) =>
-      new KTX2Loader(manager).setTranscoderPath(decoderUrl('basis/')).detectSupport(renderer as THREE.WebGLRenderer));
+      new KTX2Loader(manager).detectSupport(renderer as THREE.WebGLRenderer)); // its default transcoder: bundled, one copy
     loader.setKTX2Loader(await ktx2);
   }
   if (used.includes('EXT_meshopt_compression')) {

@@ -12,7 +12,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import GUI from 'three/addons/libs/lil-gui.module.min.js';
 import { initGcsSkin, type GcsSkin } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
-import type { Hinge, JointFigures } from '../lib/measure.js';
+import { jointCentres, type Hinge, type JointFigures } from '../lib/measure.js';
 import { humanFromData } from '../lib/human/index.js';
 import { humanDataInWorker } from './human-data.js';
 import { escapeHtml as esc, textOptions } from './gui-text.js';
@@ -21,6 +21,7 @@ import { basename, GltfError, loadDroppedGltf, loadGltfUrl } from './load-gltf.j
 import { disposeObject, normaliseSize, SHIPPED } from './loading.js';
 import { describeError, hideStatus, showMessage, shownMessage, showStatus, clearMessage, yieldToPage } from './page.js';
 import { findJointRig, jointFigures, poseBend, type JointRig } from './joint-pose.js';
+import { noJointMessage } from './joint-text.js';
 
 /** The three views, left to right, and the camera layer of each one's meshes. */
 const VIEWS = [
@@ -198,7 +199,7 @@ function install(name: string, object: THREE.Object3D, normalise: boolean): void
   const labels = rig.hinges.map((h) => h.label);
   jointController = jointController.options(textOptions(labels.length ? labels : ['(none found)'])).name('joint');
   jointController.onChange(() => selectJoint(params.joint));
-  if (!rig.hinges.length) showMessage(`${name}: no knee or elbow found (${rig.notes.join('; ')})`);
+  if (!rig.hinges.length) showMessage(noJointMessage(name, rig.notes));
   selectJoint(labels.find((l) => l.startsWith('left elbow')) ?? labels[0] ?? '');
 }
 
@@ -245,7 +246,11 @@ function bend(degrees: number): void {
   updateText();
 }
 
-/** The camera on the joint, from the outer side of the limb (along the hinge axis), a little from the front. */
+/**
+ * The camera on the limb, from the outer side (along the hinge axis), a little from the front:
+ * centred on the joint and far enough back for both of its bones (the thigh and shin, the upper arm
+ * and forearm) at any bend, so the limb fills the view, not whatever lies beside the joint (hair).
+ */
 function frameJoint(): void {
   const hinge = currentHinge();
   if (!shown) return;
@@ -264,7 +269,8 @@ function frameJoint(): void {
   const axis = toWorld(hinge.axis);
   if (axis.dot(side) < 0) axis.negate();
   const direction = axis.addScaledVector(toWorld(shown.rig.frame.forward), 0.35).addScaledVector(toWorld(shown.rig.frame.up), 0.15).normalize();
-  const reach = 0.75 * centre.distanceTo(end); // the bent bone's length, about: the joint fills the view
+  const parent = new THREE.Vector3(...jointCentres(shown.rig.input)[hinge.parent]).applyMatrix4(m);
+  const reach = 1.1 * Math.max(centre.distanceTo(end), centre.distanceTo(parent)); // both bones whole, at any bend
   const aspect = Math.min(1, viewWidth() / window.innerHeight);
   const distance = reach / Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) / aspect;
   controls.target.copy(centre);

@@ -53,9 +53,25 @@ export async function loadDroppedGltf(main: File, companions: readonly File[]): 
 /** A .glb or .gltf on this site (a path relative to the page) or in a data: URI; `name` names it in messages. */
 export async function loadGltfUrl(value: string, name = modelName(value)): Promise<GLTF> {
   const url = siteUrl(value);
-  const bytes = await fetchAtMost(url, MAX_FILE_BYTES, name, `Could not load ${name}`);
+  const what = `Could not load ${name}`;
+  const bytes = await fetchAtMost(url, MAX_FILE_BYTES, name, what).catch((e: unknown) => {
+    throw e instanceof GltfError && /\(HTTP 404\b/.test(e.message) ? notFound(what, url, '') : e;
+  });
+  // A dev server (Vite's included) answers a missing file with its own HTML page, status 200.
+  if (url.protocol !== 'data:' && startsLikeHtml(bytes)) throw notFound(what, url, ': the server sent its HTML page instead');
   if (bytes.byteLength >= MAX_FILE_BYTES) throw tooLarge(name, bytes.byteLength);
   return loadBytes(bytes, name, siteReader(url.protocol === 'data:' ? null : url, name));
+}
+
+/** `what`, the path asked for, and "not found (404)". */
+function notFound(what: string, url: URL, how: string): GltfError {
+  return new GltfError('UNREADABLE', shownName(url.pathname), '', `${what}: ${shownName(decodeURIComponent(url.pathname))} not found (404${how})`);
+}
+
+/** Whether `bytes` begin as an HTML page does (after blanks): "<!doctype" or "<html", any case. */
+export function startsLikeHtml(bytes: Uint8Array): boolean {
+  const head = new TextDecoder().decode(bytes.subarray(0, 64)).trimStart().toLowerCase();
+  return head.startsWith('<!doctype html') || head.startsWith('<html');
 }
 
 async function loadBytes(bytes: Uint8Array, name: string, read: ResourceReader): Promise<GLTF> {

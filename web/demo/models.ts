@@ -1,6 +1,7 @@
 // The two models on screen, built from the GUI's settings: GCS (left) and classic (right), their
 // live rebuilds (asked for by the GUI, done by the frame loop), the muscle bulge (no rebuild), and
 // what the GCS settings cost per frame, measured once the sliders rest.
+import { msText } from './figure-text.js';
 import type * as THREE from 'three';
 import type { ClassicDeformer, ClassicOptions, ClassicReason, GcsOptions } from '../lib/index.js';
 import type { SkinDeformer } from '../lib/three.js';
@@ -140,7 +141,7 @@ export function scheduleCostMeasure(ch: Character): void {
 }
 
 function costText(figures: FrameCostFigures): string {
-  const f = (v: number) => (v < 10 ? v.toFixed(2) : v.toFixed(1));
+  const f = msText;
   return Number.isNaN(figures.gcs) ? 'measuring…'
     : Number.isNaN(figures.stepped) ? `${f(figures.gcs)} ms`
     : `${f(figures.gcs)} ms · stepped ${f(figures.stepped)}`;

@@ -4,6 +4,7 @@ import type { ClassicDeformer, Criterion, GcsDeformer } from '../lib/index.js';
 import type { SkinDeformer } from '../lib/three.js';
 import { rigidVertices } from './colours.js';
 import { CRITERION_TEXT } from './criteria.js';
+import { counted, msText, percentText } from './figure-text.js';
 import { escapeHtml as esc } from './gui-text.js';
 import { viewRects } from './layout.js';
 import { rendererLabel } from './renderer.js';
@@ -13,7 +14,8 @@ import type { InfluenceCount } from './influences.js';
 export interface Readouts {
   character: string;
   /** ms: NaN while warmingUp (measuring, a few frames after each build). */
-  gcs: { ms: number; warmingUp: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
+  /** final: the cost figures are every round's median, and stay until the next build (cost.ts). */
+  gcs: { ms: number; warmingUp: boolean; final: boolean; vertices: number; triangles: number; sections: number; adjustedShare: number; criterion: Criterion; rigidShare: number } | null;
   classic: { ms: number; warmingUp: boolean; vertices: number; triangles: number; contours: number; detailLoss: { rms: number; max: number } } | null;
   lbs: { vertices: number; triangles: number } | null;
   influences: InfluenceCount | null;
@@ -38,7 +40,7 @@ export function collectReadouts(): Readouts {
     const cost = state.frameCost.figures();
     const gcsMs = cost.gcs;
     gcsInfo = {
-      ms: gcsMs, warmingUp: Number.isNaN(gcsMs), sections, adjustedShare: sections ? adjusted / sections : 0, criterion: state.builtCriterion,
+      ms: gcsMs, warmingUp: Number.isNaN(gcsMs), final: state.frameCost.final, sections, adjustedShare: sections ? adjusted / sections : 0, criterion: state.builtCriterion,
       rigidShare: vertices ? rigid / vertices : 0, vertices, triangles: ch.gcs.reduce((n, s) => n + tri(s), 0),
     };
     if (ch.classic.length) {
@@ -62,37 +64,41 @@ export function collectReadouts(): Readouts {
   return { character: ch.name, gcs: gcsInfo, classic: classicInfo, lbs: { vertices: ch.sourceVertices, triangles: ch.sourceTriangles }, influences: ch.influences };
 }
 
-/** "deform 0.21 ms / frame", or "deform measuring…" until the figure stands. */
-const deformTime = (ms: number) => (Number.isNaN(ms) ? 'deform <b>measuring…</b>' : `deform <b>${ms < 10 ? ms.toFixed(2) : ms.toFixed(1)} ms</b> / frame`);
+/** "deform 0.21 ms / frame" ("< 0.01 ms" below the last digit), or "deform measuring…" until the figure stands. */
+const deformTime = (ms: number) => (Number.isNaN(ms) ? 'deform <b>measuring…</b>' : `deform <b>${msText(ms)} ms</b> / frame`);
+/** "<b>1,342</b> sections", "<b>1</b> contour": the count in bold, the word in its number. */
+const bold = (count: number, singular: string, plural?: string) => counted(count, singular, plural).replace(/^(\S+)/, '<b>$1</b>');
 
 export function updateReadouts(): void {
   const r = (lastReadouts = collectReadouts());
-  const n = (v: number) => Math.round(v).toLocaleString('en');
   const rows: Record<ViewKind, string[]> = { gcs: [], classic: [], lbs: [] };
   if (r.gcs) {
-    rows.gcs.push(`${deformTime(r.gcs.ms)} · ${n(r.gcs.vertices)} vertices · ${n(r.gcs.triangles)} triangles`);
-    rows.gcs.push(`<b>${n(r.gcs.sections)}</b> sections` +
+    rows.gcs.push(`${deformTime(r.gcs.ms)} · ${counted(r.gcs.vertices, 'vertex', 'vertices')} · ${counted(r.gcs.triangles, 'triangle')}`);
+    rows.gcs.push(bold(r.gcs.sections, 'section') +
       (r.gcs.criterion === 'weights' ? ` · <b>${(r.gcs.rigidShare * 100).toFixed(0)} %</b> of vertices in rigid cores` : '') +
       ` · <b>${(r.gcs.adjustedShare * 100).toFixed(0)} %</b> adjusted this frame · rest pose exact`);
     const c = CRITERION_TEXT[r.gcs.criterion];
     rows.gcs.push(`<span class="criterion">criterion <b>${esc(c.name)}</b>: ${esc(c.why)}</span>`);
   }
   if (r.classic) {
-    rows.classic.push(`${deformTime(r.classic.ms)} · ${n(r.classic.vertices)} vertices · ${n(r.classic.triangles)} triangles`);
-    rows.classic.push(`<b>${n(r.classic.contours)}</b> contours · resampling detail loss <b>${r.classic.detailLoss.rms.toFixed(2)} %</b> rms, ` +
-      `<b>${r.classic.detailLoss.max.toFixed(2)} %</b> max (of height)`);
+    rows.classic.push(`${deformTime(r.classic.ms)} · ${counted(r.classic.vertices, 'vertex', 'vertices')} · ${counted(r.classic.triangles, 'triangle')}`);
+    // Nothing resampled (every part carried): no contours, no detail lost; say that, not "0 contours · 0.00 %".
+    rows.classic.push(r.classic.contours === 0
+      ? 'nothing resampled: every part is carried, its own skin moved by DQS'
+      : `${bold(r.classic.contours, 'contour')} · resampling detail loss <b>${percentText(r.classic.detailLoss.rms)} %</b> rms, ` +
+        `<b>${percentText(r.classic.detailLoss.max)} %</b> max (of height)`);
   }
   // Which renderer draws, and where each view's skinning runs.
   const backendOf = (list: SkinDeformer[] | undefined) => (list?.length && list.every((s) => s.backend === 'gpu') ? 'GPU' : 'CPU');
   const renderer = rendererLabel(state.renderer);
   if (r.gcs) rows.gcs.push(`<span class="criterion">${renderer} · ${backendOf(state.current?.gcs)} backend</span>`);
   if (r.classic) rows.classic.push(`<span class="criterion">${renderer} · ${backendOf(state.current?.classic)} backend</span>`);
-  if (r.lbs) rows.lbs.push(`skinned on the GPU by three.js · ${n(r.lbs.vertices)} vertices · ${n(r.lbs.triangles)} triangles`);
+  if (r.lbs) rows.lbs.push(`skinned on the GPU by three.js · ${counted(r.lbs.vertices, 'vertex', 'vertices')} · ${counted(r.lbs.triangles, 'triangle')}`);
   // three's skinning reads four influences: say what it drops (the other views use all eight).
   if (r.lbs && r.influences?.overFour)
-    rows.lbs.push(`<span class="warn">drops influences 5–${r.influences.most} of <b>${n(r.influences.overFour)}</b> vertices: three.js skins with 4</span>`);
-  const influences = r.influences ? ` · up to <b>${r.influences.most}</b> influences per vertex` +
-    (r.influences.overFour ? ` (<b>${n(r.influences.overFour)}</b> vertices over 4)` : '') : '';
+    rows.lbs.push(`<span class="warn">drops influences 5–${r.influences.most} of ${bold(r.influences.overFour, 'vertex', 'vertices')}: three.js skins with 4</span>`);
+  const influences = r.influences ? ` · up to ${bold(r.influences.most, 'influence')} per vertex` +
+    (r.influences.overFour ? ` (${counted(r.influences.overFour, 'vertex', 'vertices')} over 4)` : '') : '';
   const clip = state.current?.action ? state.current.action.getClip().name : '';
   let html = '';
   viewRects().forEach((v, i) => {

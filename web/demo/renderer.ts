@@ -2,7 +2,7 @@
 // gcs-skin/three and gcs-skin/crowd) or ?renderer=webgpu (three/webgpu's WebGPURenderer with
 // gcs-skin/webgpu; real WebGPU where the browser has it, else its WebGL2 fallback). The page says
 // which runs; the switch reloads the page with the other one.
-import type * as THREE from 'three';
+import * as THREE from 'three';
 import type { WebGPURenderer } from 'three/webgpu';
 import type GUI from 'three/addons/libs/lil-gui.module.min.js';
 
@@ -21,8 +21,7 @@ export async function createRenderer(kind: RendererKind): Promise<DemoRenderer> 
     await renderer.init();
     return renderer;
   }
-  const { WebGLRenderer } = await import('three');
-  return new WebGLRenderer({ antialias: true });
+  return new THREE.WebGLRenderer({ antialias: true }); // three is in the page's main chunk anyway: no dynamic import
 }
 
 /** e.g. "WebGLRenderer", "WebGPURenderer (WebGPU)", "WebGPURenderer (WebGL2 fallback)". */

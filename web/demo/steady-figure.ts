@@ -3,8 +3,10 @@
 // frames (tens of seconds at a few frames a second); this keeps a window of recent frames instead,
 // drops the first frames after each reset, and reports the window's figure once it has stopped
 // falling (its older and newer halves agree), or once `deadlineMs` have passed since the reset,
-// whatever the frame rate: then from the frames it has (at least 4), and agreed() says whether the
-// halves agree. Until then value() is NaN: the page says "warming up".
+// whatever the frame rate: then from the frames it has (the counted ones when there are 4, else
+// every frame since the reset, the first included: a page drawing one frame a second still gets
+// a figure at the deadline), and agreed() says whether the halves agree. Until then value() is NaN:
+// the page says "warming up".
 // The figure is the mean of the window's middle half: spikes (a garbage collection) drop out, and
 // the browser's coarse clock (0.1 ms steps) averages out where a median would round it.
 export class SteadyFigure {
@@ -12,8 +14,10 @@ export class SteadyFigure {
   private readonly older: Float64Array;
   private readonly newer: Float64Array;
   private readonly whole: Float64Array;
-  /** Samples since the last reset, the dropped ones included. */
+  /** Samples since the last reset, the dropped ones included (the ring keeps them too, for a late figure). */
   private seen = 0;
+  /** Samples in the ring that were not dropped (the most recent ones). */
+  private counted = 0;
   private stored = 0;
   private next = 0;
   private settled = false;
@@ -38,14 +42,19 @@ export class SteadyFigure {
 
   /** Starts over (a model was built: its figures are new). */
   reset(): void {
-    this.seen = this.stored = this.next = 0;
+    this.seen = this.stored = this.next = this.counted = 0;
     this.settled = this.halvesAgree = false;
     this.since = this.now();
   }
 
   /** Frames counted since the reset (the dropped ones not included). */
   get frames(): number {
-    return this.stored;
+    return this.counted;
+  }
+
+  /** Frames the figure was taken from: the counted ones, or at the deadline every frame seen when too few were counted. */
+  get used(): number {
+    return this.counted >= 4 || !this.overdue ? this.counted : this.stored;
   }
 
   /** True once the deadline has passed (a figure still missing then lacks frames). */
@@ -59,17 +68,25 @@ export class SteadyFigure {
   }
 
   add(value: number): void {
-    if (++this.seen <= this.dropped || !Number.isFinite(value)) return;
+    if (!Number.isFinite(value)) return;
     this.ring[this.next] = value;
     this.next = (this.next + 1) % this.windowSize;
     this.stored = Math.min(this.stored + 1, this.windowSize);
+    if (++this.seen > this.dropped) this.counted = Math.min(this.counted + 1, this.windowSize);
   }
 
   /** The window's figure once steady (or at the deadline), else NaN. */
   value(): number {
     const late = this.now() - this.since >= this.deadlineMs;
-    if (this.stored < (late ? 4 : this.windowSize)) return NaN;
-    const n = this.stored & ~1, half = n >> 1;
+    // Before the deadline a full window of counted frames; at it, 4 counted, else every frame seen.
+    const usable = late ? (this.counted >= 4 ? this.counted : this.stored) : this.counted >= this.windowSize ? this.counted : 0;
+    if (usable < 1) return NaN;
+    if (usable === 1) {
+      if (!this.settled) this.halvesAgree = false;
+      this.settled = true;
+      return this.ring[(this.next - 1 + this.windowSize) % this.windowSize];
+    }
+    const n = usable & ~1, half = n >> 1;
     const whole = this.whole.subarray(0, n), older = this.older.subarray(0, half), newer = this.newer.subarray(0, half);
     for (let i = 0; i < n; i++) {
       const v = this.ring[(this.next - n + i + this.windowSize) % this.windowSize]; // oldest first

@@ -15,6 +15,8 @@
  * O(instances × joints), 64 bytes per joint) or section transforms ('y' / 'axial', or
  * `gpuPath: 'sections'`: O(instances × sections), 48 bytes per section) into the texture's memory,
  * and three.js uploads it.
+ *
+ * @module gcs-skin/crowd
  */
 import * as THREE from 'three';
 import { GcsError } from './errors.js';
@@ -31,10 +33,15 @@ export { writeSkinMatrices } from './three/skin-matrices.js';
 
 /** A clip sampled once into skin matrices: `frames` poses of J × 16 floats, `fps` apart. */
 export interface BakedClip {
+  /** The clip's name. */
   name: string;
+  /** Samples per second. */
   fps: number;
+  /** Number of sampled poses. */
   frames: number;
+  /** Length in seconds (`frames / fps`). */
   duration: number;
+  /** Joints per pose (J). */
   jointCount: number;
   /** frames × J × 16 floats */
   data: Float32Array;
@@ -68,6 +75,7 @@ export function bakeClip(source: THREE.SkinnedMesh, clip: THREE.AnimationClip, f
   return { name: clip.name, fps, frames, duration: frames / fps, jointCount: J, data };
 }
 
+/** Options of `GcsCrowd`: the GCS model, the material, the texture width and the GPU path. */
 export interface GcsCrowdOptions {
   /** The GCS model (default: the weights criterion, 6 sections, plain). */
   gcs?: GcsOptions;
@@ -89,13 +97,32 @@ export interface GcsCrowdOptions {
  * (one draw call draws every instance). Morph targets are not carried (three.js's per-instance
  * morphs would need a morph texture per instance). `dispose()` frees the wasm memory, geometry,
  * texture and patched materials (not the source's material).
+ *
+ * @example
+ * ```ts
+ * const crowd = new GcsCrowd(gcs, skinnedMesh, 100);           // one InstancedMesh, one draw call
+ * scene.add(crowd.mesh);
+ * for (let i = 0; i < 100; i++) crowd.mesh.setMatrixAt(i, new THREE.Matrix4().makeTranslation(i % 10, 0, Math.floor(i / 10)));
+ * const walk = bakeClip(skinnedMesh, clip);
+ * renderer.setAnimationLoop((t) => {
+ *   for (let i = 0; i < 100; i++) crowd.setBakedPose(i, walk, t / 1000 + i * 0.1);
+ *   crowd.update();
+ *   renderer.render(scene, camera);
+ * });
+ * ```
  */
 export class GcsCrowd {
+  /** The one InstancedMesh that draws every instance: add it to the scene, place instances with `setMatrixAt`. */
   readonly mesh: THREE.InstancedMesh;
+  /** The rig read from the source's skin (owned by the crowd). */
   readonly rig: Rig;
+  /** The GCS model every instance shares (owned by the crowd). */
   readonly deformer: GcsDeformer;
+  /** The per-frame texture and the uniforms the shader reads. */
   readonly sections: GpuSections;
+  /** Number of instances. */
   readonly count: number;
+  /** Joints per instance (J). */
   readonly jointCount: number;
   private isDisposed = false;
   private readonly kit: GpuMaterialKit;
@@ -103,6 +130,15 @@ export class GcsCrowd {
   /** Set when a renderer that cannot run the kit's materials drew the crowd; update() throws it. */
   private rendererError: GcsError | null = null;
 
+  /**
+   * @param gcs The core (`await initGcsSkin()`).
+   * @param source The skinned mesh to copy; only read.
+   * @param count Number of instances, 1 or more.
+   * @param options The GCS model, material, texture width and GPU path.
+   * @throws GcsError `INVALID_ARGUMENT` when the material cannot run GCS on the GPU (a ShaderMaterial, a
+   * node material with its own position node), `NO_SKIN` when `source` is not skinned, `OUT_OF_RANGE`
+   * for a bad count, and the build's codes (`GcsError`).
+   */
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, count: number, options: GcsCrowdOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
     const material = options.material ?? source.material;
@@ -216,6 +252,7 @@ export class GcsCrowd {
     return this.sections.bytesPerUpdate;
   }
 
+  /** Frees the wasm memory, geometry, texture and patched materials; the source's material stays. */
   dispose(): void {
     if (this.isDisposed) return;
     this.isDisposed = true;
@@ -228,6 +265,7 @@ export class GcsCrowd {
     this.rig.dispose();
   }
 
+  /** Whether `dispose()` has run (`update()` then throws GcsError `DISPOSED`). */
   get disposed(): boolean {
     return this.isDisposed;
   }

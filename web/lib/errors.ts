@@ -39,6 +39,7 @@ export const CORE_ERROR_CODES: readonly (GcsErrorCode | null)[] = [
 
 /** Every failure of gcs-skin: a stable `code` and a sentence a user can act on. */
 export class GcsError extends Error {
+  /** What went wrong, stable across versions: test it instead of the sentence. */
   readonly code: GcsErrorCode;
   constructor(code: GcsErrorCode, message: string) {
     super(message);

@@ -26,6 +26,8 @@
  * Most users never touch this module: `new GcsCharacter(gcs, scene, { backend: 'gpu' })`
  * (gcs-skin/three) uses it. `GcsCrowd` draws many characters sharing one mesh and one section
  * model, each with its own pose, in one instanced draw call per skin.
+ *
+ * @module gcs-skin/gpu
  */
 export { GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, JointPoses, SectionTransforms } from './index.js';
 export type { GpuMethod, GpuPath } from './gpu/layout.js';

@@ -10,6 +10,8 @@
  *
  * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
  * 'DISPOSED'. Every failure is a GcsError with a `code`.
+ *
+ * @module gcs-skin
  */
 import { DEFORMER_KINDS, STATS } from './core-enums.js';
 import { GcsError, type GcsErrorCode } from './errors.js';
@@ -20,13 +22,22 @@ export { GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
 export { version } from './version.js';
 
+/** Fewest sections `buildGcs` takes (gcs_skin.h GCS_MIN_SECTIONS). */
 export const MIN_SECTIONS = 3;
 /** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
 export const MAX_INFLUENCES = 8;
+/** Most sections `buildGcs` takes (gcs_skin.h GCS_MAX_SECTIONS). */
 export const MAX_SECTIONS = 256;
 /** GcsOptions.centres when not given. */
 const DEFAULT_CENTRES = false;
-export const CLASSIC_LIMITS = { minContours: 2, maxContours: 256, minRays: 3, maxRays: 256, maxBulge: 4 } as const;
+/** The ranges `buildClassic` checks: contours per part, rays per contour, muscle bulge gain (gcs_skin.h). */
+export const CLASSIC_LIMITS = {
+  /** Fewest contours per resampled part. */ minContours: 2,
+  /** Most contours per resampled part. */ maxContours: 256,
+  /** Fewest rays per contour. */ minRays: 3,
+  /** Most rays per contour. */ maxRays: 256,
+  /** Largest muscle bulge gain. */ maxBulge: 4,
+} as const;
 
 /**
  * Weights criterion: the steps of the weight grid at a section count, Q = 2·(sections − 2); node
@@ -71,8 +82,10 @@ export interface RigInput {
  * - 'axial': the paper's rule, bins of the projection on the bone axis (for T-posed arms).
  */
 export type Criterion = 'weights' | 'y' | 'axial';
+/** The criteria in the order of their codes in the core (gcs_skin.h GcsCriterion). */
 export const CRITERIA: readonly Criterion[] = ['y', 'axial', 'weights'];
 
+/** Options of `Rig.buildGcs`: level of detail and how vertices are grouped into sections. */
 export interface GcsOptions {
   /**
    * Level of detail, 3..256. Default 6. Weights criterion: the weight grid step is 1/(2·(sections−2))
@@ -104,6 +117,7 @@ export interface GcsOptions {
   centres?: boolean;
 }
 
+/** Options of `Rig.buildClassic`: resampling density and muscle bulge. */
 export interface ClassicOptions {
   /** Contours per resampled part, 2..256. Default 25. */
   contours?: number;
@@ -113,10 +127,14 @@ export interface ClassicOptions {
   bulge?: number;
 }
 
+/** Which method a deformer runs: `'gcs'`, `'classic'`, `'lbs'` or `'dqs'`. */
 export type DeformerKind = (typeof DEFORMER_KINDS)[number];
 
+/** One GCS section as `GcsDeformer.sections()` reports it: its run of output vertices and what moves it. */
 export interface SectionInfo {
+  /** First output vertex of the section (GCS stores vertices section by section). */
   first: number;
+  /** Number of output vertices in the section. */
   count: number;
   /** Joint owning the part (Y/axial: for a shared section, the child part; weights: the dominant joint). */
   part: number;
@@ -149,13 +167,17 @@ export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | '
 /** The reasons in the order of their codes (GcsClassicReason). */
 export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk', 'off-surface'];
 
+/** One part of the classic model (one joint's skin): resampled into a tube, or carried. */
 export interface ClassicPart {
+  /** The joint whose part this is. */
   joint: number;
+  /** Whether the part was resampled into contours × rays (false: carried, its own triangles skinned by DQS). */
   resampled: boolean;
   /** Why it is resampled or carried (see ClassicReason). */
   reason: ClassicReason;
   /** Resampled: its rings (contours × rays vertices); carried: its carried input vertices. */
   firstVertex: number;
+  /** Number of output vertices from `firstVertex` on. */
   vertexCount: number;
 }
 
@@ -237,7 +259,14 @@ export class GcsSkin {
     return ptr;
   }
 
-  /** Validates and copies a skinned mesh and its skeleton into wasm memory. */
+  /**
+   * Validates and copies a skinned mesh and its skeleton into wasm memory.
+   * @param input Positions, triangles, joints and weights per vertex, parents and inverse bind
+   * matrices (glTF conventions, mesh space); `influences` 1…8 per vertex (default 4).
+   * @returns The rig: build deformers from it, dispose it when done.
+   * @throws GcsError `LENGTH_MISMATCH`, `INDEX_OUT_OF_RANGE`, `JOINT_OUT_OF_RANGE`, `NON_FINITE`,
+   * `BAD_WEIGHTS`, `NO_SKIN`, `INVALID_ARGUMENT` or `OUT_OF_MEMORY`, naming what is wrong.
+   */
   createRig(input: RigInput): Rig {
     if (!input || typeof input !== 'object') throw new GcsError('INVALID_ARGUMENT', 'createRig expects an object with positions, indices, joints, weights, parents and inverseBindMatrices');
     for (const key of ['positions', 'indices', 'joints', 'weights', 'parents', 'inverseBindMatrices'] as const) {
@@ -295,8 +324,28 @@ export class GcsSkin {
   }
 }
 
-/** Loads the wasm core. `wasm` overrides where the binary comes from (default: beside this module). */
-export async function initGcsSkin(options: { wasm?: WasmSource } = {}): Promise<GcsSkin> {
+/**
+ * Loads the wasm core. `wasm` overrides where the binary comes from (default: beside this module).
+ *
+ * @param options `wasm`: a URL, a path (node), the bytes or a compiled `WebAssembly.Module`.
+ * @returns The core: `createRig` makes rigs from skinned meshes.
+ * @throws GcsError `WASM_LOAD` when the binary cannot be fetched or instantiated, or is of another
+ * version than the package's.
+ *
+ * @example
+ * ```ts
+ * const gcs = await initGcsSkin();
+ * const rig = gcs.createRig({ positions, indices, joints, weights, parents, inverseBindMatrices });
+ * const deformer = rig.buildGcs({ sections: 8 });
+ * deformer.deform(skinMatrices);           // every frame: J × 16 floats
+ * const { positions, normals } = deformer;  // Float32Array views on wasm memory
+ * deformer.dispose(); rig.dispose();
+ * ```
+ */
+export async function initGcsSkin(options: {
+  /** Where gcs-skin.wasm comes from (default: beside this module). */
+  wasm?: WasmSource;
+} = {}): Promise<GcsSkin> {
   let core: CoreExports;
   try {
     core = await instantiateCore(options.wasm);
@@ -345,13 +394,18 @@ function checkFlag(value: unknown, name: string): void {
 
 /** A validated skinned mesh in wasm memory: the input every deformer is built from. */
 export class Rig {
+  /** Number of vertices of the skinned mesh. */
   readonly vertexCount: number;
+  /** Number of joints of the skeleton. */
   readonly jointCount: number;
   /** Largest extent of the bind-pose bounding box (model units). */
   readonly height: number;
   private handle: number;
 
-  /** @internal */
+  /**
+   * @internal
+   * @param gcs The core that owns the rig's memory.
+   */
   constructor(readonly gcs: GcsSkin, handle: number) {
     this.handle = handle;
     this.vertexCount = gcs.core.gcs_rig_vertex_count(handle);
@@ -364,7 +418,13 @@ export class Rig {
     return this.handle;
   }
 
-  /** Builds a generalized cross-section model (docs/method.md §2–4). */
+  /**
+   * Builds a generalized cross-section model (docs/method.md §2–4).
+   * @param options Sections (3…256, default 6), criterion (default 'weights'), smooth, centres.
+   * @returns The GCS deformer (the rig may be disposed before it).
+   * @throws GcsError `SECTION_COUNT`, `INVALID_ARGUMENT` or `OUT_OF_RANGE` for bad options,
+   * `OUT_OF_MEMORY`, `DISPOSED` when the rig was disposed.
+   */
   buildGcs(options: GcsOptions = {}): GcsDeformer {
     checkOptions(options, 'buildGcs');
     const sections = options.sections ?? 6;
@@ -385,7 +445,12 @@ export class Rig {
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }
 
-  /** Builds the classic cross-section model (docs/method.md §6). */
+  /**
+   * Builds the classic cross-section model (docs/method.md §6).
+   * @param options Contours per part, rays per contour, muscle bulge (CLASSIC_LIMITS).
+   * @returns The classic deformer: its `parts` say what was resampled and why.
+   * @throws GcsError `OUT_OF_RANGE` or `INVALID_ARGUMENT` for bad options, `OUT_OF_MEMORY`, `DISPOSED`.
+   */
   buildClassic(options: ClassicOptions = {}): ClassicDeformer {
     checkOptions(options, 'buildClassic');
     const contours = options.contours ?? 25;
@@ -437,8 +502,11 @@ export class Rig {
 
 /** A runtime deformer: owns its output mesh in wasm memory and fills it every frame. */
 export class Deformer {
+  /** The method this deformer runs. */
   readonly kind: DeformerKind;
+  /** Number of output vertices (GCS, LBS, DQS: the rig's; classic: its resampled mesh's). */
   readonly vertexCount: number;
+  /** Number of joints: `deform` takes `jointCount × 16` numbers. */
   readonly jointCount: number;
   protected handle: number;
   private positionsPtr: number;
@@ -455,7 +523,10 @@ export class Deformer {
   private swapped: { ptr: number; view: Float32Array }[] | null = null;
   private tangentsView: Float32Array | null = null;
 
-  /** @internal */
+  /**
+   * @internal
+   * @param gcs The core that owns the deformer's memory.
+   */
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
     const core = gcs.core;
     this.handle = handle;
@@ -602,6 +673,9 @@ export class Deformer {
   /**
    * Deforms for one frame from J skinning matrices S_j = posed world · inverse bind (column-major,
    * 16 floats each, bind-pose mesh space → posed mesh space). One copy into wasm, no allocation.
+   * @param skinMatrices `jointCount × 16` numbers.
+   * @throws GcsError `LENGTH_MISMATCH` for another count, `NON_FINITE` for a NaN or infinite
+   * matrix, `DISPOSED`.
    */
   deform(skinMatrices: ArrayLike<number>): void {
     const h = this.live();
@@ -688,6 +762,7 @@ export class Deformer {
     this.handle = 0;
   }
 
+  /** Whether `dispose()` has run (every other call then throws GcsError `DISPOSED`). */
   get disposed(): boolean {
     return this.handle === 0;
   }
@@ -699,6 +774,7 @@ export class GcsDeformer extends Deformer {
   get adjustedShare(): number {
     return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedShare);
   }
+  /** Last frame: number of sections whose transform is not their part's rigid transform. */
   get adjustedSections(): number {
     return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedSections);
   }
@@ -856,7 +932,12 @@ export class ClassicDeformer extends Deformer {
     return ptr ? this.gcs.viewI32(ptr, this.vertexCount).slice() : new Int32Array(0);
   }
   /** Resampling detail loss, % of model height: RMS and max distance of original vertices to the resampled surface. */
-  get detailLoss(): { rms: number; max: number } {
+  get detailLoss(): {
+    /** RMS distance, % of the model's height. */
+    rms: number;
+    /** Largest distance, % of the model's height. */
+    max: number;
+  } {
     const h = this.live();
     return { rms: this.gcs.core.gcs_classic_detail_loss(h, 0), max: this.gcs.core.gcs_classic_detail_loss(h, 1) };
   }
@@ -879,19 +960,25 @@ export class ClassicDeformer extends Deformer {
  * stays the caller's; `dispose()` frees only these buffers. See SectionTransforms and JointPoses.
  */
 export abstract class PoseTexels {
+  /** Number of poses (instances) the buffers hold. */
   readonly instanceCount: number;
+  /** Joints per instance: `skinMatrices` holds `instanceCount × jointCount × 16` numbers. */
   readonly jointCount: number;
   /** RGBA32F texels per instance. */
   readonly texelsPerInstance: number;
   /** Texture size in texels: width × height ≥ instanceCount × texelsPerInstance. */
   readonly width: number;
+  /** Texture height in texels. */
   readonly height: number;
   private skinPtr: number;
   private texelPtr: number;
   private skinView: Float32Array;
   private texelView: Float32Array;
 
-  /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). `unit`: texels per section or joint. */
+  /**
+   * `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). `unit`: texels per section or joint.
+   * @param deformer The GCS model whose poses the buffers hold (it stays the caller's).
+   */
   protected constructor(readonly deformer: GcsDeformer, instanceCount: number, maxWidth: number, perInstance: () => number, unit: number) {
     if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
     if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms and joint poses need a GCS deformer (rig.buildGcs)');
@@ -970,6 +1057,7 @@ export abstract class PoseTexels {
     this.texelPtr = 0;
   }
 
+  /** Whether `dispose()` has freed the buffers. */
   get disposed(): boolean {
     return this.skinPtr === 0;
   }
@@ -980,6 +1068,7 @@ export abstract class PoseTexels {
  * (k·S + s)·3, the rows of its affine 3×4 (gcs_gcs_compute_sections). See PoseTexels.
  */
 export class SectionTransforms extends PoseTexels {
+  /** Sections of the GCS model: texels per instance are `sectionCount × 3`. */
   readonly sectionCount: number;
 
   /** `maxWidth`: the widest texture row allowed (WebGL2 guarantees 2048). */

@@ -13,6 +13,8 @@
  *   (`JointProbe`): volume change, bulge and collapse, creases, new self-intersections.
  *
  * Plain TypeScript over typed arrays; no three.js.
+ *
+ * @module gcs-skin/measure
  */
 import type { ClassicDeformer, ClassicReason, Deformer, Rig, RigInput } from './index.js';
 import { GcsError } from './errors.js';
@@ -25,6 +27,11 @@ export { intersectingPairs } from './measure/self-intersection.js';
 
 // ------------------------------------------------------------------------------------ statistics
 
+/**
+ * The median (the 50th percentile, nearest rank); NaN for no values.
+ * @param values The numbers (not changed).
+ * @returns Their median.
+ */
 export function median(values: ArrayLike<number>): number {
   return percentile(values, 50);
 }
@@ -65,6 +72,7 @@ function select(a: Float64Array, n: number, k: number): number {
 
 // ------------------------------------------------------------------------------------ timing
 
+/** How long and how often `timeFrames` and `timeInterleaved` time. */
 export interface TimingOptions {
   /** At least this many timed frames (default 200). */
   minSamples?: number;
@@ -82,9 +90,13 @@ export interface TimingOptions {
   repeat?: number | readonly number[];
 }
 
+/** What a timing gives: milliseconds per call. */
 export interface Timing {
+  /** Median time of one call, ms. */
   medianMs: number;
+  /** 95th percentile of one call's time, ms. */
   p95Ms: number;
+  /** Number of timed samples. */
   samples: number;
 }
 
@@ -207,7 +219,12 @@ export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): numbe
  * or an overlap glued on). A closed manifold mesh has both 0; a closed input deformed into an
  * output with a gap or a torn seam has open > 0.
  */
-export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): { open: number; overused: number } {
+export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): {
+  /** Edges used by one triangle. */
+  open: number;
+  /** Edges used by more than two triangles. */
+  overused: number;
+} {
   const vertexCount = Math.floor(positions.length / 3);
   const pairs = coincidentPairs(positions);
   const weld = new Uint32Array(vertexCount);
@@ -278,15 +295,21 @@ export function restError(deformer: Deformer, rigPositions: ArrayLike<number>): 
  * cross-section model, LBS and DQS.
  */
 export type MethodName = 'gcs' | 'gcs-plain' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
+/** Every method the measures know, in the order the tables print them. */
 export const METHODS: MethodName[] = ['gcs', 'gcs-plain', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
+/** How the tables name each method. */
 export const METHOD_LABELS: Record<MethodName, string> = {
   gcs: 'GCS (weights, default)', 'gcs-plain': 'GCS plain (weights, stepped)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
   classic: 'classic', lbs: 'LBS', dqs: 'DQS',
 };
 
+/** Settings of `buildMethod`: the GCS section count and the classic model's density. */
 export interface BuildSettings {
+  /** GCS sections (default 6). */
   sections?: number;
+  /** Classic contours per part (default 25). */
   contours?: number;
+  /** Classic rays per contour (default 20). */
   rays?: number;
 }
 
@@ -304,7 +327,12 @@ export function buildMethod(rig: Rig, method: MethodName, settings: BuildSetting
 }
 
 /** A build failure as data: the GcsError code and message (e.g. a method not in this binary). */
-export function errorInfo(e: unknown): { code: string; message: string } {
+export function errorInfo(e: unknown): {
+  /** The GcsError's code, or 'ERROR' for any other exception. */
+  code: string;
+  /** Its sentence. */
+  message: string;
+} {
   if (e instanceof GcsError) return { code: e.code, message: e.message };
   return { code: 'ERROR', message: e instanceof Error ? e.message : String(e) };
 }
@@ -326,6 +354,12 @@ export interface SplitMatrix {
   dq: Float64Array;
 }
 
+/**
+ * Splits the skin matrix at `offset` into a rotation, a scale and a unit dual quaternion (SplitMatrix).
+ * @param s Skin matrices, 16 column-major numbers each.
+ * @param offset Where the matrix starts in `s`.
+ * @returns Its rotation R, scale K and dual quaternion.
+ */
 export function splitSkinMatrix(s: ArrayLike<number>, offset = 0): SplitMatrix {
   const col = (c: number) => [s[offset + 4 * c], s[offset + 4 * c + 1], s[offset + 4 * c + 2]];
   const cols = [col(0), col(1), col(2)];
@@ -442,6 +476,7 @@ export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Floa
 
 /** Fidelity of one method over a set of frames (docs/method.md §9). Distances in % of `height`. */
 export interface Fidelity {
+  /** Frames measured. */
   frames: number;
   /** Largest distance of a vertex bound ≥ 0.999 to one joint from S_j·x; null: no such vertex or no source map. */
   rigidError: number | null;
@@ -449,6 +484,7 @@ export interface Fidelity {
   rigidVertices: number;
   /** Distance from the reference DQS over every vertex and frame: 95th percentile and max; null without a source map. */
   dqsP95: number | null;
+  /** Largest distance from the reference DQS; null without a source map. */
   dqsMax: number | null;
   /** Triangles whose normal turned against their rest normal carried by their dominant joint, summed over frames. */
   flipped: number;
@@ -468,6 +504,7 @@ export interface Fidelity {
   seamGap: number;
 }
 
+/** Options of `FidelityProbe` and `classicOffSurface`. */
 export interface FidelityOptions {
   /**
    * The character's height in the units of the deformers' OUTPUT (posed mesh space). Default: the
@@ -483,7 +520,9 @@ export interface FidelityOptions {
  * `measure(deformer)` for each method.
  */
 export class FidelityProbe {
+  /** The height distances are divided by (output units). */
   readonly height: number;
+  /** Vertices of the rig. */
   readonly vertexCount: number;
   private readonly reference: Float32Array[] = [];
   private readonly rigid: Int32Array; // per rig vertex: its joint when bound ≥ 0.999, else -1
@@ -491,6 +530,11 @@ export class FidelityProbe {
   private readonly dominant: Int32Array; // per rig vertex: the joint of largest weight
   private readonly rotations: Float64Array[] = []; // per frame: J × 9 rotations
 
+  /**
+   * @param input The rig, as given to `createRig`.
+   * @param frames Skin matrices per frame (J × 16 each).
+   * @param options The character's height in output units.
+   */
   constructor(readonly input: RigInput, readonly frames: readonly Float32Array[], options: FidelityOptions = {}) {
     const n = Math.floor(input.positions.length / 3);
     this.vertexCount = n;
@@ -647,7 +691,12 @@ export const CREASE_DEGREES = 20;
  * weldByPosition of `rest`, when the caller has it.
  */
 export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>,
-  weld: ArrayLike<number> = weldByPosition(rest)): { a: Uint32Array; b: Uint32Array } {
+  weld: ArrayLike<number> = weldByPosition(rest)): {
+  /** Per edge, its first triangle. */
+  a: Uint32Array;
+  /** Per edge, its second triangle. */
+  b: Uint32Array;
+} {
   const n = Math.floor(rest.length / 3);
   // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
   const first = new Map<number, number>();
@@ -698,7 +747,12 @@ export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32A
  * of its rest angle a0 is the cosine within [cos(a0 + limit), cos(a0 − limit)] (cos falls on
  * [0, π]), so a frame compares cosines instead of taking an acos per edge.
  */
-export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): { lo: Float64Array; hi: Float64Array } {
+export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): {
+  /** Per edge, the lowest cosine without a crease. */
+  lo: Float64Array;
+  /** Per edge, the highest cosine without a crease. */
+  hi: Float64Array;
+} {
   const limit = degrees * Math.PI / 180;
   const lo = new Float64Array(restCos.length), hi = new Float64Array(restCos.length);
   for (let i = 0; i < restCos.length; i++) {
@@ -772,15 +826,21 @@ function maxOf(a: ArrayLike<number>): number {
 
 /** What the classic model makes of a rig at one setting (the paper's Fig. 5 comparison). */
 export interface ClassicFigures {
+  /** Contours per part at this setting. */
   contours: number;
+  /** Rays per contour at this setting. */
   rays: number;
+  /** Vertices of the classic model's output mesh. */
   outputVertices: number;
   /** Parts resampled (chain parts, and trunk parts along the spine) and carried. */
   resampled: number;
+  /** Trunk parts resampled along the spine. */
   trunk: number;
+  /** Parts carried (their own triangles, skinned by DQS). */
   carried: number;
   /** Detail loss, % of the mesh's height (ClassicDeformer.detailLoss). */
   rms: number;
+  /** Largest detail loss, % of the mesh's height. */
   max: number;
   /** Welded border edges of the output at rest (equal to the input's: no gap where tubes meet carried skin). */
   border: number;
@@ -829,23 +889,31 @@ export function classicAtBudget(rig: Rig): ClassicFigures {
 
 /** How far one part of a classic model's output lies from the DQS-posed source surface (% of height). */
 export interface OffSurfacePart {
+  /** The part's joint. */
   joint: number;
+  /** Whether the part is resampled (false: carried). */
   resampled: boolean;
+  /** Why it is resampled or carried. */
   reason: ClassicReason;
   /** Output vertices of the part (a shared joint ring counts for both parts). */
   vertices: number;
+  /** 99th percentile of its vertices' distances over the frames, % of height. */
   p99: number;
+  /** Largest distance, % of height. */
   max: number;
   /** Where the max is: the frame (index into the frames given) and the output vertex. */
   worstFrame: number;
+  /** The output vertex of the largest distance. */
   worstVertex: number;
 }
 
 /** The classic model against the skin it replaces (docs/method.md §9, "classic off-surface"). */
 export interface ClassicOffSurface {
+  /** Frames measured. */
   frames: number;
   /** Over every output vertex and frame, % of height. */
   p99: number;
+  /** Largest distance over every output vertex and frame, % of height. */
   max: number;
   /** Per part, in the order of `deformer.parts`. */
   parts: OffSurfacePart[];
@@ -928,14 +996,19 @@ export interface BandQuality {
   triangles: number;
   /** Smallest interior angle (degrees): the minimum, the 1st percentile and the median over triangles. */
   minAngle: number;
+  /** 1st percentile of the smallest angle, degrees. */
   minAngleP1: number;
+  /** Median of the smallest angle, degrees. */
   minAngleMedian: number;
   /** Triangles with an angle under 5° and under 10°. */
   under5: number;
+  /** Triangles with an angle under 10°. */
   under10: number;
   /** Aspect ratio longest edge × perimeter / (4√3 × area): 1 for an equilateral triangle; max, p99, median. */
   aspectMax: number;
+  /** 99th percentile of the aspect ratio. */
   aspectP99: number;
+  /** Median aspect ratio. */
   aspectMedian: number;
 }
 

@@ -15,6 +15,8 @@
  *   const skin = new SkinDeformer(gcs, skinnedMesh, { method: 'gcs', gcs: { sections: 8 } });
  *   scene.add(skin.mesh);
  *   // each frame: mixer.update(dt); skin.update(); renderer.render(scene, camera);
+ *
+ * @module gcs-skin/three
  */
 export type { Backend, GcsCharacterOptions, RebuildOptions, SkinDeformerOptions } from './three/options.js';
 export { writeSkinMatrices } from './three/skin-matrices.js';

@@ -16,6 +16,8 @@
  * Drawn by a WebGLRenderer without a nodes handler, a GPU-backend skin moves to the CPU backend
  * (`backendNote` says why, one console warning) and a crowd's update() throws GcsError naming the
  * fix; gcs-skin/three's GPU backend does the same when a WebGPURenderer draws it.
+ *
+ * @module gcs-skin/webgpu
  */
 import type * as THREE from 'three';
 import {

@@ -158,7 +158,9 @@ const DRACO_MODULE = 'draco3dgltf';
 /** A NodeIO that reads the compression extensions `used` by a file, with their decoders registered. */
 async function decodingIO(used: readonly string[]) {
   const [{ NodeIO }, ext] = await Promise.all([import('@gltf-transform/core'), import('@gltf-transform/extensions')]);
-  const io = new NodeIO().registerExtensions([ext.KHRMeshQuantization, ext.EXTMeshoptCompression, ext.KHRDracoMeshCompression, ext.KHRTextureBasisu]);
+  // Every Khronos extension is known (KHR_materials_unlit and the other material ones included: a
+  // file that uses them is not warned about), and meshopt's; the compression ones are decoded.
+  const io = new NodeIO().registerExtensions([...ext.KHRONOS_EXTENSIONS, ext.EXTMeshoptCompression]);
   const dependencies: Record<string, unknown> = {};
   if (used.includes('EXT_meshopt_compression')) {
     meshoptDecoder ??= import('meshoptimizer').then(async ({ MeshoptDecoder }) => {

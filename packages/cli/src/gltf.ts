@@ -1,3 +1,4 @@
+/** @module @gcs-skin/cli/gltf */
 // `@gcs-skin/cli/gltf`: a glTF/GLB character in node, as rigs and skin matrices, with no three.js in
 // sight. `loadCharacter(file)` reads the file (validated, compressed geometry decoded: see
 // gltf-node.ts), and gives per skinned mesh the RigInput for `gcs.createRig`, the character's

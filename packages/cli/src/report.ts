@@ -1,3 +1,4 @@
+/** @module @gcs-skin/cli/report */
 // `gcs-skin report <model.glb|.gltf> [--clip NAME] [--sections N] [--frames N] [--wide] [--json]`:
 // builds every deformer of METHODS on each skinned mesh of any glTF character and reports, per
 // method, build ms, ms per frame and the fidelity figures of docs/method.md §9 (FidelityProbe over the
@@ -29,7 +30,7 @@ export function defaultFramesPerClip(clipCount: number): number {
   return Math.max(MIN_FRAMES_PER_CLIP, Math.min(60, Math.round(FRAME_BUDGET / Math.max(1, clipCount))));
 }
 
-export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--wide] [--json]
+export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clips CLIPS.glb] [--clip NAME] [--sections N] [--frames N] [--time-ms N] [--wide] [--json]
   Builds every deformer (${METHODS.join(', ')}) on each skinned mesh of the file and prints, per
   method, build ms, ms per frame (the median of the clips', all methods timed in turn) and its
   fidelity over the sampled frames of every clip: rigid error, distance from an independent DQS
@@ -37,6 +38,8 @@ export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME
   character's height); then the knees and elbows (found from the skeleton) each bent alone to 45°,
   90°, 135°: volume change, bulge, collapse, creases, new self-intersections per method. Progress
   goes to stderr when it is a terminal.
+  --clips FILE    also play the animations of this glTF (a character's clips shipped apart), bound
+                  to the model's nodes by name as three.js's mixer does
   --clip NAME     only this animation clip (default: all clips)
   --sections N    GCS sections per part (default 6)
   --frames N      frames sampled per clip (default: 60 for one clip, fewer per clip for more
@@ -49,6 +52,11 @@ export const usage = `usage: gcs-skin report <model.glb|model.gltf> [--clip NAME
 
 export interface ReportOptions {
   clip?: string;
+  /**
+   * A companion glTF whose animations are played on the model (a character and its clips shipped in
+   * separate files): its clips bind to the model's nodes by name, as three.js's AnimationMixer binds.
+   */
+  clipsFile?: string;
   sections?: number;
   /** Frames sampled per clip (default defaultFramesPerClip). */
   frames?: number;
@@ -106,7 +114,8 @@ export interface MeshReport {
 
 export interface Report {
   file: string;
-  options: { sections: number; frames: number; clip: string | null };
+  /** `clipsFile`: the companion file the clips came from, when one was given. */
+  options: { sections: number; frames: number; clip: string | null; clipsFile?: string };
   /** The character: all skinned meshes of the scene; height in world units (bind pose, bounding box: gltf-node characterHeight). */
   character: { height: number; skinnedMeshes: number };
   meshes: MeshReport[];
@@ -139,17 +148,11 @@ const roundOrNull = (x: number | null) => (x === null ? null : round(x));
 export async function report(file: string, options: ReportOptions = {}, gcs?: GcsSkin): Promise<Report> {
   const sections = options.sections ?? 6;
   const progress = options.onProgress ?? (() => {});
-  progress(`reading ${file}`);
-  let model;
-  try {
-    model = await loadGltfFile(file);
-  } catch (e) {
-    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
-    throw new ReportError(`cannot read ${file}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
-  }
+  const model = await readModel(file, progress);
   if (!model.skinnedMeshes.length)
     throw new ReportError(`${file} has no skinned mesh (no skin, joints and weights): nothing to deform`, 'NO_SKINNED_MESH');
   let clips = model.clips;
+  if (options.clipsFile !== undefined) clips = [...clips, ...(await companionClips(options.clipsFile, file, model.skinnedMeshes, progress))];
   if (options.clip !== undefined) {
     clips = clips.filter((c) => c.name === options.clip);
     if (!clips.length)
@@ -167,10 +170,42 @@ export async function report(file: string, options: ReportOptions = {}, gcs?: Gc
     }));
   });
   return {
-    file, options: { sections, frames, clip: options.clip ?? null },
+    file, options: { sections, frames, clip: options.clip ?? null, ...(options.clipsFile !== undefined ? { clipsFile: options.clipsFile } : {}) },
     character: { height: round(height.world, 6), skinnedMeshes: model.skinnedMeshes.length }, meshes,
     warnings: model.warnings.map(oneLine),
   };
+}
+
+/** `file` read (loadGltfFile); a failure is a ReportError with the GltfError's code, or LOAD_FAILED. */
+async function readModel(file: string, progress: (text: string) => void): ReturnType<typeof loadGltfFile> {
+  progress(`reading ${file}`);
+  try {
+    return await loadGltfFile(file);
+  } catch (e) {
+    if (e instanceof GltfError) throw new ReportError(oneLine(e.message), e.code, { cause: e });
+    throw new ReportError(`cannot read ${file}: ${oneLine((e as Error).message)}`, 'LOAD_FAILED', { cause: e });
+  }
+}
+
+/**
+ * The animations of `clipsFile` that move the model: each clip keeps the tracks whose node the
+ * model has (by name, as three.js's mixer binds them); a clip that moves none of its nodes is left
+ * out, and a file none of whose clips does is a ReportError (NO_CLIP) naming both files.
+ */
+async function companionClips(clipsFile: string, file: string, meshes: readonly THREE.SkinnedMesh[], progress: (text: string) => void): Promise<THREE.AnimationClip[]> {
+  const companion = await readModel(clipsFile, progress);
+  const roots = new Set(meshes.map((m) => { let root: THREE.Object3D = m; while (root.parent) root = root.parent; return root; }));
+  const hasNode = (name: string) => [...roots].some((root) => !!root.getObjectByName(name));
+  // GLTFLoader names a track "<node>.<property>" with the node's name sanitised (no '.'): the node is what precedes the last '.'.
+  const bound = companion.clips.filter((clip) => {
+    clip.tracks = clip.tracks.filter((t) => hasNode(t.name.slice(0, t.name.lastIndexOf('.'))));
+    return clip.tracks.length > 0;
+  });
+  if (!bound.length)
+    throw new ReportError(companion.clips.length
+      ? `the clips of ${clipsFile} (${companion.clips.map((c) => c.name).join(', ')}) move no node of ${file}: their node names differ`
+      : `${clipsFile} has no animation clip`, 'NO_CLIP');
+  return bound;
 }
 
 interface MeshSettings { sections: number; frames: number; timeMs: number; height: number; worldScale: number; progress: (text: string) => void }
@@ -328,41 +363,100 @@ export function nonFiniteMethods(r: Report): { mesh: string; method: MethodName;
 const fmt = (x: number | null | undefined, digits = 3) =>
   x === null || x === undefined ? 'n/a' : Number.isFinite(x) ? (x === 0 ? '0' : Math.abs(x) < 10 ** -digits ? x.toExponential(1) : x.toFixed(digits)) : String(x);
 
-/** A text table: the first row is the header; the first column and a last 'note' column left-aligned. */
-function table(rows: string[][]): string {
-  const widths = rows[0].map((_, c) => Math.max(...rows.map((r) => r[c].length)));
-  const left = (c: number) => c === 0 || rows[0][c] === 'note';
-  return rows.map((r) => r.map((cell, c) => (left(c) ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ').trimEnd()).join('\n');
+/** `text` cut to `max` columns with an ellipsis when longer. */
+export function shortened(text: string, max: number): string {
+  return text.length <= max ? text : `${text.slice(0, Math.max(0, max - 1))}…`;
 }
 
-/** `text` in lines of at most REPORT_COLUMNS, broken at spaces (a word longer than that stays whole). */
-function wrap(text: string): string[] {
+/** Rows (the first the header) laid out with two spaces between columns; the first column and a last 'note' column left-aligned. */
+function layout(rows: string[][]): string[] {
+  const widths = rows[0].map((_, c) => Math.max(...rows.map((r) => r[c].length)));
+  const left = (c: number) => c === 0 || rows[0][c] === 'note';
+  return rows.map((r) => r.map((cell, c) => (left(c) ? cell.padEnd(widths[c]) : cell.padStart(widths[c]))).join('  ').trimEnd());
+}
+
+/**
+ * A text table within `columns`: when wider, the columns named in `drop` are left out in that order
+ * until it fits, then the first column's cells are shortened with an ellipsis. Returns its lines and
+ * the headers left out. (No limit: every column, as they are.)
+ */
+function table(rows: string[][], columns = Infinity, drop: readonly string[] = []): { lines: string[]; dropped: string[] } {
+  let kept = rows;
+  const dropped: string[] = [];
+  const widest = (lines: string[]) => Math.max(...lines.map((l) => l.length));
+  let lines = layout(kept);
+  for (const name of drop) {
+    if (widest(lines) <= columns) break;
+    const c = kept[0].indexOf(name);
+    if (c < 0) continue;
+    kept = kept.map((r) => r.filter((_, i) => i !== c));
+    dropped.push(name);
+    lines = layout(kept);
+  }
+  const over = widest(lines) - columns;
+  if (over > 0) {
+    const first = Math.max(...kept.map((r) => r[0].length));
+    lines = layout(kept.map((r) => [shortened(r[0], Math.max(4, first - over)), ...r.slice(1)]));
+  }
+  return { lines, dropped };
+}
+
+/** `text` in lines of at most `columns`, broken at spaces; a word longer than a line is shortened with an ellipsis. */
+function wrap(text: string, columns = REPORT_COLUMNS): string[] {
   const lines: string[] = [];
   let line = '';
   for (const word of text.split(' ')) {
-    if (line && line.length + 1 + word.length > REPORT_COLUMNS) { lines.push(line); line = `  ${word}`; }
+    if (line && line.length + 1 + word.length > columns) { lines.push(line); line = `  ${word}`; }
     else line = line ? `${line} ${word}` : word;
   }
   if (line) lines.push(line);
-  return lines;
+  return lines.map((l) => shortened(l, columns));
 }
 
-/** The text report fits this many columns (its tables; --wide and JSON carry the rest). */
+/** The text report fits this many columns in a pipe or a file (on a terminal: its width, at least MIN_TERMINAL_COLUMNS). */
 export const REPORT_COLUMNS = 120;
+/** The narrowest layout: a terminal narrower than this still gets 80 columns. */
+export const MIN_TERMINAL_COLUMNS = 80;
 
-/** The human-readable report: a table per mesh that fits REPORT_COLUMNS; `wide`: every column and the clips. */
-export function formatReport(r: Report, options: { wide?: boolean } = {}): string {
+/** The width of the text report on `stream`: REPORT_COLUMNS in a pipe or a file, the terminal's (at least 80) on a terminal. */
+export function reportColumns(stream: { isTTY?: boolean; columns?: number }): number {
+  return stream.isTTY ? Math.max(MIN_TERMINAL_COLUMNS, stream.columns || MIN_TERMINAL_COLUMNS) : REPORT_COLUMNS;
+}
+
+/** Main table columns left out first when the report is narrower than the table, in this order (--wide and --json keep every one). */
+const OPTIONAL_COLUMNS = ['stretched', 'rigid err %', 'DQS max %', 'build ms', 'flipped'];
+/** The same for the joints table. */
+const OPTIONAL_JOINT_COLUMNS = ['collapse p5/min', 'new self-x', 'creases'];
+
+/**
+ * Whether every method measured a joint alike (all figures equal): nothing in the joint's region
+ * blends between two bones, the limb is rigid pieces, and its figures say nothing of the methods.
+ */
+function rigidJoint(rows: string[][]): boolean {
+  const measured = rows.filter((r) => !r[2].startsWith('n/a'));
+  return measured.length > 1 && measured.every((r) => r.slice(2).join('|') === measured[0].slice(2).join('|'));
+}
+
+/**
+ * The human-readable report: a table per mesh within `columns` (default REPORT_COLUMNS; columns
+ * left out, and long names shortened with an ellipsis, when narrower); `wide`: every column and the clips.
+ */
+export function formatReport(r: Report, options: { wide?: boolean; columns?: number } = {}): string {
   const wide = options.wide ?? false;
-  const out: string[] = [`gcs-skin report: ${printable(r.file)}`,
-    `character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`];
-  for (const w of r.warnings) out.push(`loader warning: ${printable(w)}`);
+  const columns = wide ? Infinity : Math.max(MIN_TERMINAL_COLUMNS, options.columns ?? REPORT_COLUMNS);
+  const out: string[] = [];
+  const say = (text: string) => out.push(...(wide ? [text] : wrap(text, columns)));
+  say(`gcs-skin report: ${printable(r.file)}`);
+  say(`character: ${r.character.skinnedMeshes} skinned mesh(es), height ${fmt(r.character.height, 4)} world units (bind pose)`);
+  for (const w of r.warnings) say(`loader warning: ${printable(w)}`);
   for (const m of r.meshes) {
     const c = m.counts;
-    out.push('', `mesh '${shownName(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
+    out.push('');
+    say(`mesh '${shownName(m.name)}': ${c.vertices} vertices, ${c.triangles} triangles, ${c.joints} joints, ` +
       `${c.parts ?? 'n/a'} parts, ${c.sections ?? 'n/a'} GCS sections (${r.options.sections} per part)`);
-    out.push(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s), ${r.options.frames} each` : 'bind pose only: no clip'}); ` +
+    say(`fidelity over ${m.frames.count} frame(s) (${m.frames.source === 'clips' ? `${m.clips.length} clip(s), ${r.options.frames} each` : 'bind pose only: no clip'}); ` +
       `% of the character's height = ${fmt(m.height, 4)} mesh units (world scale ${fmt(m.worldScale, 4)})`);
-    out.push(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
+    say(`influences: ${c.influences} per vertex read, ${c.moreThan4Influences} vertices with more than 4` +
       (c.moreThan4Influences ? ' (three.js\'s own skinning would drop their JOINTS_1/WEIGHTS_1)' : ''));
     const lbs = m.methods.lbs?.fidelity?.flipped;
     // Creases against the baselines: the more of LBS's and DQS's count over the same frames.
@@ -382,36 +476,50 @@ export function formatReport(r: Report, options: { wide?: boolean } = {}): strin
       const flipped = name === 'lbs' || lbs === undefined ? String(f.flipped) : wide ? `${f.flipped} (LBS ${lbs})` : `${f.flipped}`;
       const creases = name === 'lbs' || name === 'dqs' || !(creaseBase > 0) ? String(f.creases)
         : `${f.creases} (${(f.creases / creaseBase).toFixed(2)}×)`;
-      const note = x.detailLoss ? `resampled: detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of its height` : '';
+      // Detail loss 0: the classic model resampled nothing (every part carried), so there is no loss to report.
+      const note = !x.detailLoss ? '' : x.detailLoss.rms === 0 && x.detailLoss.max === 0 ? 'nothing resampled: every part carried, its own skin moved by DQS'
+        : `resampled: detail loss rms ${fmt(x.detailLoss.rms)} % max ${fmt(x.detailLoss.max)} % of its height`;
       const row = [name, fmt(x.buildMs, 2), fmt(x.medianMs, 4), fmt(f.rigidError, 4), fmt(f.dqsP95), fmt(f.dqsMax), flipped, creases, String(f.stretched),
         String(f.nonFinite)];
       if (wide) row.push(fmt(x.p95Ms, 4), fmt(f.normalOffUnit, 4), fmt(f.seamGap, 4), note);
       else if (note) notes.push(`${name}: ${note}`);
       rows.push(row);
     }
-    out.push(table(rows));
-    out.push(`ms/frame: median of the clips' (methods timed in turn) · creases ×: vs the more of LBS/DQS · LBS flipped ${lbs ?? 'n/a'}`);
-    for (const n of notes) out.push(n);
-    if (!m.clips.length) out.push('(no animation clips: the bind pose was timed)');
+    const main = table(rows, columns, OPTIONAL_COLUMNS);
+    out.push(...main.lines);
+    if (main.dropped.length) say(`(${main.dropped.join(', ')}: left out at ${columns} columns; --wide or --json for every column)`);
+    say(`ms/frame: median of the clips' (methods timed in turn) · creases ×: vs the more of LBS/DQS · LBS flipped ${lbs ?? 'n/a'}`);
+    for (const n of notes) say(n);
+    if (!m.clips.length) say('(no animation clips: the bind pose was timed)');
     else if (!wide) {
       const names = m.clips.map((clip) => shownName(clip.name)).join(', ');
-      out.push(`${m.clips.length} clip(s)${names.length <= 70 ? `: ${names}` : ''} (per clip: --wide or --json)`);
+      say(`${m.clips.length} clip(s)${names.length <= 70 ? `: ${names}` : ''} (per clip: --wide or --json)`);
     }
     const j = m.joints;
-    out.push('', ...wrap(`joints, each bent alone from the bind pose: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}`),
-      'volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone',
-      'over the same at bind');
-    for (const note of j.notes) out.push(...wrap(`  note: ${printable(note)}`));
+    out.push('');
+    say(`joints, each bent alone from the bind pose: ${j.joints.length ? j.joints.map((x) => printable(x.hinge.label)).join(', ') : 'none found'}`);
+    say('volume: the joint region\'s, posed against bind; bulge and collapse: distance to the nearest bone over the same at bind');
+    for (const note of j.notes) say(`  note: ${printable(note)}`);
     if (j.joints.length) {
-      // The joint on a row of its own above its methods: a column of joint names would not fit.
+      // Each joint's name on a line of its own above its methods (a column of joint names would not
+      // fit); a joint that every method moves alike (rigid pieces) gets one line instead of numbers.
       const [head, ...body] = jointTableRows(j).map((row) => row.map(printable));
-      const rows = [head.slice(1)];
+      const perJoint: { label: string; rows: string[][] }[] = [];
       for (const row of body) {
-        if (row[0]) rows.push([row[0], ...head.slice(2).map(() => '')]);
-        rows.push([`  ${row[1]}`, ...row.slice(2)]);
+        if (row[0]) perJoint.push({ label: row[0], rows: [] });
+        perJoint[perJoint.length - 1].rows.push(row);
       }
-      rows[0][0] = 'joint / method';
-      out.push(table(rows));
+      const rows = [['joint / method', ...head.slice(2)]];
+      const blocks: { label: string; first: number; count: number }[] = [];
+      for (const joint of perJoint) {
+        const rigid = rigidJoint(joint.rows);
+        blocks.push({ label: rigid ? `${joint.label}: no soft joint: the limb is rigid pieces (every method moves it alike)` : joint.label, first: rows.length, count: rigid ? 0 : joint.rows.length });
+        if (!rigid) for (const row of joint.rows) rows.push([`  ${row[1]}`, ...row.slice(2)]);
+      }
+      const laid = table(rows, columns, OPTIONAL_JOINT_COLUMNS.map((name) => head.find((h) => h.startsWith(name)) ?? name));
+      out.push(laid.lines[0]);
+      for (const b of blocks) out.push(shortened(b.label, columns), ...laid.lines.slice(b.first, b.first + b.count));
+      if (laid.dropped.length) say(`(${laid.dropped.join(', ')}: left out at ${columns} columns; --wide or --json for every column)`);
     }
     if (wide)
       for (const clip of m.clips) {
@@ -422,7 +530,7 @@ export function formatReport(r: Report, options: { wide?: boolean } = {}): strin
           if (!x) { rows2.push([name, 'n/a', '', '', '']); continue; }
           rows2.push([name, fmt(x.medianMs, 4), fmt(x.p95Ms, 4), String(x.samples), x.adjustedShare !== undefined ? `${(100 * x.adjustedShare).toFixed(0)} %` : '']);
         }
-        out.push(table(rows2));
+        out.push(...table(rows2).lines);
       }
   }
   return out.join('\n');
@@ -437,6 +545,7 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; wide: boolea
     else if (a === '--wide') wide = true;
     else if (a === '-h' || a === '--help') help = true;
     else if (a === '--clip') options.clip = value();
+    else if (a === '--clips') options.clipsFile = value();
     else if (a === '--sections') options.sections = integer(3, 256);
     else if (a === '--frames') options.frames = integer(1, 10000);
     else if (a === '--time-ms') options.timeMs = integer(1, 60000);
@@ -513,7 +622,7 @@ export async function run(argv: string[]): Promise<number> {
   } finally {
     progress.end();
   }
-  console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r, { wide: args.wide }));
+  console.log(args.json ? JSON.stringify(r, null, 2) : formatReport(r, { wide: args.wide, columns: reportColumns(process.stdout) }));
   const bad = nonFiniteMethods(r);
   if (bad.length) {
     process.stderr.write(`gcs-skin report: non-finite values from ${bad.map((b) => `${b.method} on '${shownName(b.mesh)}' (${b.count})`).join(', ')}\n`);

@@ -22,7 +22,9 @@ function MemoModel({ url }: { url: string }) {
   return <primitive object={gltf.scene} />;
 }
 
-const memo = new URLSearchParams(location.search).get('variant') === 'memo';
+const query = new URLSearchParams(location.search);
+const memo = query.get('variant') === 'memo';
+const clip = query.get('clip') ?? undefined; // ?clip=: the docs component's clip prop
 const skins = new Set<THREE.SkinnedMesh>();
 let frames = 0;
 let setShown: (shown: boolean) => void = () => {};
@@ -38,7 +40,7 @@ function App() {
       <color attach="background" args={[0x3355aa]} />
       <hemisphereLight args={[0xffffff, 0x444444, 2]} />
       <directionalLight position={[1, 2, 3]} intensity={2} />
-      <Suspense fallback={null}>{shown && (memo ? <MemoModel url="/character.glb" /> : <GcsModel url="/character.glb" />)}</Suspense>
+      <Suspense fallback={null}>{shown && (memo ? <MemoModel url="/character.glb" /> : <GcsModel url="/character.glb" clip={clip} />)}</Suspense>
     </Canvas>
   );
 }

@@ -24,6 +24,7 @@ export type GltfErrorCode =
 
 /** A glTF file that cannot be loaded, with a stable `code` and a one-line sentence. */
 export class GltfError extends Error {
+  /** What went wrong, stable across versions (docs/report-json.md, Errors). */
   readonly code: GltfErrorCode;
   /** The file as given. */
   readonly file: string;

@@ -14,15 +14,30 @@ export interface SkinningOptions { method: 'lbs' | 'dqs'; slots: TableSlots }
 /** The uniforms a patched material reads; shared by every material of one skin. */
 export interface GcsUniforms {
   /** Path 'sections': the section transforms (per frame). */
-  gcsSections?: { value: THREE.DataTexture };
+  gcsSections?: {
+    /** The uniform's value. */
+    value: THREE.DataTexture;
+  };
   /** Path 'joints': the joint poses (per frame). */
-  gcsJoints?: { value: THREE.DataTexture };
+  gcsJoints?: {
+    /** The uniform's value. */
+    value: THREE.DataTexture;
+  };
   /** Path 'joints': each section's joints and weights (static). */
-  gcsTable?: { value: THREE.DataTexture };
+  gcsTable?: {
+    /** The uniform's value. */
+    value: THREE.DataTexture;
+  };
   /** Texel of instance 0's first section or joint. */
-  gcsBase: { value: number };
+  gcsBase: {
+    /** The uniform's value. */
+    value: number;
+  };
   /** Texels per instance (sections × 3, or joints × 4). */
-  gcsStride: { value: number };
+  gcsStride: {
+    /** The uniform's value. */
+    value: number;
+  };
   [name: string]: THREE.IUniform | undefined;
 }
 
@@ -37,7 +52,9 @@ export interface GcsUniforms {
  * built with the 'y' or 'axial' criterion is GcsError 'INVALID_ARGUMENT'.
  */
 export class GpuSections {
+  /** Which GPU path runs: 'joints' (joint poses, the weights criterion) or 'sections' (section transforms). */
   readonly path: GpuPath;
+  /** The per-frame buffers in wasm memory (JointPoses or SectionTransforms). */
   readonly transforms: PoseTexels;
   /** The per-frame texture (joint poses or section transforms). */
   readonly texture: THREE.DataTexture;
@@ -45,7 +62,9 @@ export class GpuSections {
   readonly table: THREE.DataTexture | null;
   /** Path 'joints': joints per section in `table` (4, or 8 where a section blends more); 4 otherwise. */
   readonly tableSlots: TableSlots;
+  /** The uniforms every patched material of this skin shares. */
   readonly uniforms: GcsUniforms;
+  /** Whether the model blends sections (smooth mode): the shader then reads two or three per vertex. */
   readonly smooth: boolean;
   /** Counts update() calls: what a node pass computed from is told apart from what it must recompute. */
   version = 0;
@@ -57,6 +76,14 @@ export class GpuSections {
   /** LBS / DQS: `deformer` is a GCS build of the same rig kept for its joint poses only, freed with this. */
   private readonly ownsDeformer: boolean;
 
+  /**
+   * @param deformer The GCS model (it stays the caller's).
+   * @param instanceCount Poses the texture holds (1, or a crowd's count).
+   * @param maxWidth The widest texture row (WebGL2 guarantees 2048).
+   * @param path 'joints' or 'sections' (default: 'joints' for the weights criterion, else 'sections').
+   * @throws GcsError `INVALID_ARGUMENT` for 'joints' on a 'y' or 'axial' model, `OUT_OF_RANGE` for a bad count or width.
+   * @param skinning LBS or DQS of each vertex's own joints instead of GCS (the deformer is then kept for its joint poses only, and freed with this).
+   */
   constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath, skinning?: SkinningOptions) {
     if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
     this.method = skinning?.method ?? 'gcs';
@@ -86,6 +113,7 @@ export class GpuSections {
     this.smooth = !skinning && deformer.blendOther() !== null;
   }
 
+  /** Poses the texture holds. */
   get instanceCount(): number {
     return this.transforms.instanceCount;
   }
@@ -140,6 +168,7 @@ export class GpuSections {
     this.texture.needsUpdate = true;
   }
 
+  /** Frees the textures and the wasm buffers (the deformer stays the caller's). */
   dispose(): void {
     this.texture.dispose();
     this.previous?.texture.dispose();
@@ -178,7 +207,9 @@ function floatTexture(data: Float32Array, width: number, height: number): THREE.
 
 /** A static per-vertex attribute of the GPU backend's geometry. */
 export interface SectionAttribute {
+  /** The attribute's name in the geometry and the shader. */
   name: typeof SECTION_ATTRIBUTE | typeof BLEND_ATTRIBUTE | typeof BLEND_THIRD_ATTRIBUTE;
+  /** Its values, one or more floats per vertex. */
   attribute: THREE.BufferAttribute;
 }
 

@@ -46,7 +46,12 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
  */
-export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): { depth: THREE.MeshDepthMaterial; distance: THREE.MeshDistanceMaterial } {
+export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): {
+  /** For directional and spot lights' shadows (`customDepthMaterial`). */
+  depth: THREE.MeshDepthMaterial;
+  /** For point lights' shadows (`customDistanceMaterial`). */
+  distance: THREE.MeshDistanceMaterial;
+} {
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };

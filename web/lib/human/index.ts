@@ -1,3 +1,4 @@
+/** @module gcs-skin/human */
 // gcs-skin/human: a default human character (one closed skinned surface, 19 joints, idle /
 // walk / run clips), generated procedurally. See createHuman().
 import * as THREE from 'three';
@@ -12,14 +13,18 @@ export { JOINT_NAMES, JOINT_PARENTS } from './model.js';
 export type { Pose } from './model.js';
 export { humanToGlb } from './gltf.js';
 
+/** Vertex count of the default human (the paper's model: 17,023; the mesh comes out within 1 %). */
 export const DEFAULT_VERTICES = 17023;
 /** standing height, metres (feet on y = 0, top of the head at y = HEIGHT) */
 export const HEIGHT = 1.75;
+/** Fewest vertices `createHuman` takes. */
 export const MIN_VERTICES = 2000;
+/** Most vertices `createHuman` takes. */
 export const MAX_VERTICES = 2000000;
 /** Share of vertices that are distinct positions when seams are on (paper's model: 15,620 of 17,023). */
 export const WELDED_FRACTION = 15620 / 17023;
 
+/** Options of `createHuman` and `createHumanData`. */
 export interface HumanOptions {
   /** total vertex count (default 17,023); 2,000 … 2,000,000 */
   vertices?: number;
@@ -33,12 +38,17 @@ export interface HumanOptions {
   seams?: boolean;
 }
 
+/** The human as plain arrays (glTF conventions), before any three.js object is made. */
 export interface HumanData {
+  /** The bind pose it was built in. */
   pose: Pose;
   /** xyz per vertex, metres */
   positions: Float32Array;
+  /** xyz unit normal per vertex. */
   normals: Float32Array;
+  /** uv per vertex (the charts cut along the seams). */
   uvs: Float32Array;
+  /** Triangle list. */
   indices: Uint32Array;
   /** 4 joint indices per vertex */
   joints: Uint16Array;
@@ -46,21 +56,36 @@ export interface HumanData {
   weights: Float32Array;
   /** for each vertex, the index of its welded vertex: vertices with equal weld share one position (seam copies) */
   weld: Uint32Array;
+  /** Number of distinct welded vertices (positions). */
   weldedCount: number;
+  /** Joint names, in joint order (JOINT_NAMES). */
   jointNames: string[];
+  /** Parent joint per joint, -1 for the root. */
   parents: number[];
   /** bind-pose joint positions, world (xyz per joint) */
   jointPositions: Float32Array;
   /** column-major 4×4 per joint (world → joint), as in glTF */
   inverseBindMatrices: Float32Array;
+  /** Height of the bind-pose mesh, metres. */
   height: number;
-  stats: { buildMs: number; charts: number };
+  /** How the build went: its time and the number of UV charts. */
+  stats: {
+    /** Build time, ms. */
+    buildMs: number;
+    /** Number of UV charts. */
+    charts: number;
+  };
 }
 
+/** The human as three.js objects: the skinned mesh, its clips and the raw data. */
 export interface Human {
+  /** The skinned mesh, its bones under it, bound. */
   mesh: THREE.SkinnedMesh;
+  /** The 'idle', 'walk' and 'run' clips. */
   clips: THREE.AnimationClip[];
+  /** Standing height, metres. */
   height: number;
+  /** The arrays the mesh was made from. */
   data: HumanData;
 }
 

@@ -2,8 +2,10 @@
 // (a smooth union of ellipsoids and round cones, each tagged with the bone that owns it).
 // Units: metres, y-up, facing +Z, the character's left side on +X.
 
+/** The bind pose: arms down (`'stand'`) or a T-pose (`'tpose'`). */
 export type Pose = 'stand' | 'tpose';
 
+/** The human's joint names, in joint order (Hips first). */
 export const JOINT_NAMES = [
   'Hips', 'Spine', 'Chest', 'Neck', 'Head',
   'LeftShoulder', 'LeftArm', 'LeftForeArm', 'LeftHand',
@@ -13,6 +15,7 @@ export const JOINT_NAMES = [
 ] as const;
 export type JointName = (typeof JOINT_NAMES)[number];
 
+/** Parent of each joint of JOINT_NAMES, -1 for the root (Hips). */
 export const JOINT_PARENTS: readonly number[] = [
   -1, 0, 1, 2, 3,
   2, 5, 6, 7,

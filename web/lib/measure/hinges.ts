@@ -13,15 +13,20 @@
  */
 import type { RigInput } from '../index.js';
 
+/** A point or vector: x, y, z. */
 export type Vec3 = [number, number, number];
 
+/** A knee or elbow found by `findHinges`: its joint and its anatomical hinge axis. */
 export interface Hinge {
+  /** Which joint it is. */
   kind: 'knee' | 'elbow';
+  /** The character's side. */
   side: 'left' | 'right';
   /** 'left knee', …; with the joint's name when names were given. */
   label: string;
   /** The bent joint and its parent (the thigh, the upper arm). */
   joint: number;
+  /** The parent joint (the thigh, the upper arm). */
   parent: number;
   /** Bind-pose centre of the joint (mesh space). */
   centre: Vec3;
@@ -33,14 +38,19 @@ export interface Hinge {
 
 /** The character's frame in mesh space (unit vectors; left = up × forward). */
 export interface BodyFrame {
+  /** Up, from the feet to the head. */
   up: Vec3;
+  /** Forward, where the feet point. */
   forward: Vec3;
+  /** The character's left. */
   left: Vec3;
 }
 
+/** What `findHinges` found: the hinges, the body frame and notes on what is missing. */
 export interface HingeSearch {
   /** Left knee, right knee, left elbow, right elbow (those found). */
   hinges: Hinge[];
+  /** The character's frame; null when no pair of limbs was found. */
   frame: BodyFrame | null;
   /** Why something was not found, or a guess was made. */
   notes: string[];
@@ -61,6 +71,12 @@ interface Limb {
 const MIRROR_POINTS = 4;   // joints of each limb compared by the mirror test (fingers left out)
 const MIRROR_TOLERANCE = 0.2; // largest mirror error, as a fraction of the limb's length
 
+/**
+ * Finds the knees and elbows of a skeleton from its layout (no names needed) and each one's hinge axis.
+ * @param input The rig (joint centres come from its inverse bind matrices and skin).
+ * @param names Joint names, used only in the labels.
+ * @returns The hinges found, the body frame, and notes on what was not found or guessed.
+ */
 export function findHinges(input: RigInput, names?: readonly (string | undefined)[]): HingeSearch {
   const notes: string[] = [];
   const J = input.parents.length;

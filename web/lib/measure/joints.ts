@@ -25,13 +25,17 @@ export const JOINT_ANGLES: readonly number[] = [45, 90, 135];
 
 /** One joint, one method, one bend angle. */
 export interface JointFigures {
+  /** The bend angle, degrees. */
   degrees: number;
   /** (posed − bind) / bind of the region's cone volume about the joint centre, %. */
   volumeChange: number;
   /** Distance to the nearest posed bone over the same at bind, over the region's vertices. */
   bulgeP95: number;
+  /** Largest bulge ratio over the region's vertices. */
   bulgeMax: number;
+  /** 5th percentile of the same ratio (below 1: the skin falls in towards the bone). */
   collapseP5: number;
+  /** Smallest ratio. */
   collapseMin: number;
   /** Region edges whose dihedral angle changed by more than 20°. */
   creases: number;
@@ -41,8 +45,15 @@ export interface JointFigures {
 
 /** A deformer to measure: `key` names it in JSON, `label` in tables. */
 export interface JointMethod {
+  /** Its name in JSON (a MethodName, or 'gcs-centres'). */
   key: string;
+  /** Its name in tables. */
   label: string;
+  /**
+   * Builds the deformer on `rig`.
+   * @param rig The rig to build on.
+   * @returns The deformer (the caller disposes it).
+   */
   build(rig: Rig): Deformer;
 }
 
@@ -235,6 +246,7 @@ class JointRegion {
  * that keeps the rig's vertices; a resampled model, the classic one, gets its own).
  */
 export class JointProbe {
+  /** The bend angles measured, degrees. */
   readonly angles: readonly number[];
   private readonly skins: Float32Array[];
   private readonly bones: BoneSegments;
@@ -243,6 +255,12 @@ export class JointProbe {
   private readonly resampledRegions = new WeakMap<Deformer, JointRegion>();
   private readonly posed: Float64Array;
 
+  /**
+   * @param input The rig's input.
+   * @param hinge The joint to bend and its axis (from `findHinges`).
+   * @param angles Bend angles in degrees (default JOINT_ANGLES).
+   * @throws GcsError `INVALID_ARGUMENT` when an angle is not a finite number.
+   */
   constructor(readonly input: RigInput, readonly hinge: Hinge, angles: readonly number[] = JOINT_ANGLES) {
     const J = input.parents.length;
     if (!(hinge.joint >= 0 && hinge.joint < J && hinge.parent >= 0 && hinge.parent < J))
@@ -352,21 +370,42 @@ function weightedOn(input: RigInput, joints: number[]): Uint8Array {
 
 /** What `measureJoints` finds and measures on one rig. */
 export interface JointsMeasure {
+  /** The bend angles, degrees. */
   angles: number[];
-  methods: { key: string; label: string }[];
+  /** The methods measured, in order. */
+  methods: {
+    /** The method's key. */
+    key: string;
+    /** The method's label. */
+    label: string;
+  }[];
+  /** The character's frame (null when hinges were given or none were found). */
   frame: BodyFrame | null;
+  /** Why a joint was not found, or a guess was made. */
   notes: string[];
+  /** One result per joint. */
   joints: JointResult[];
 }
 
+/** One joint's figures, per method and angle. */
 export interface JointResult {
+  /** The joint. */
   hinge: Hinge;
   /** Triangles of the joint's region (the rig's mesh). */
   regionTriangles: number;
   /** Per method key: the figures at each angle, or why the method could not be built or run. */
-  methods: Record<string, JointFigures[] | { error: { code: string; message: string } }>;
+  methods: Record<string, JointFigures[] | {
+    /** Why the method could not be built or run. */
+    error: {
+      /** The GcsError code. */
+      code: string;
+      /** Its sentence. */
+      message: string;
+    };
+  }>;
 }
 
+/** Options of `measureJoints`: which methods, angles and joints. */
 export interface JointsOptions {
   /** Default: jointMethods() (GCS default, GCS with centres of rotation, DQS, LBS, GCS plain, classic). */
   methods?: readonly JointMethod[];

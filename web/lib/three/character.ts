@@ -16,14 +16,23 @@ import { SkinDeformer } from './skin-deformer.js';
  * mixer keeps driving its bones and morph influences. Adding `root` to your scene is all it
  * takes. Morph targets: GCS, LBS and DQS (the classic model resamples the mesh and skips them).
  *
- *   const character = new GcsCharacter(gcs, gltf.scene, { method: 'gcs', gcs: { sections: 8 } });
- *   // each frame: mixer.update(dt); character.update(); renderer.render(scene, camera);
- *
  * `dispose()` frees every skin's wasm memory and deformed geometry, removes the deformed meshes
  * and shows the SkinnedMeshes again. Throws GcsError 'NO_SKIN' if root holds no SkinnedMesh; a
  * skin that cannot be built (GcsError) undoes the ones already built.
+ *
+ * @example
+ * ```ts
+ * const gcs = await initGcsSkin();
+ * const gltf = await new GLTFLoader().loadAsync('character.glb');
+ * const character = new GcsCharacter(gcs, gltf.scene, { method: 'gcs', gcs: { sections: 8 } });
+ * scene.add(gltf.scene);
+ * // each frame: mixer.update(dt); character.update(); renderer.render(scene, camera);
+ * character.rebuild('dqs');   // another method, in place
+ * character.dispose();        // the SkinnedMeshes drawn again
+ * ```
  */
 export class GcsCharacter {
+  /** The object whose SkinnedMeshes are deformed (your glTF scene). */
   readonly root: THREE.Object3D;
   /** One per SkinnedMesh, in traversal order. */
   readonly skins: readonly SkinDeformer[];
@@ -33,6 +42,13 @@ export class GcsCharacter {
   private readonly scope: THREE.Object3D;
   private isDisposed = false;
 
+  /**
+   * @param gcs The core (`await initGcsSkin()`).
+   * @param root A glTF scene or any Object3D holding SkinnedMeshes.
+   * @param options Method, model options, backend, and a filter of which skins to take.
+   * @throws GcsError `NO_SKIN` when `root` holds no SkinnedMesh; a skin that cannot be built throws its
+   * code (GcsError) after undoing the ones already built.
+   */
   constructor(readonly gcs: GcsSkin, root: THREE.Object3D, options: GcsCharacterOptions = {}) {
     if (!root || !(root as THREE.Object3D).isObject3D) throw new GcsError('INVALID_ARGUMENT', 'GcsCharacter needs a THREE.Object3D (a glTF scene, a group or a SkinnedMesh)');
     this.root = root;
@@ -105,6 +121,7 @@ export class GcsCharacter {
     for (const s of this.skins) s.dispose();
   }
 
+  /** Whether `dispose()` has run. */
   get disposed(): boolean {
     return this.isDisposed;
   }

@@ -7,10 +7,13 @@ import type { GpuPath } from '../gpu/layout.js';
 /** Where the per-vertex work runs: 'cpu' (wasm fills the vertex buffers) or 'gpu' (the vertex shader applies GCS section transforms). */
 export type Backend = 'cpu' | 'gpu';
 
+/** Options of `SkinDeformer`: the method and its model, material, placement, tangents and backend. */
 export interface SkinDeformerOptions {
   /** Which deformer drives the mesh. Default 'gcs'. */
   method?: DeformerKind;
+  /** Options of the GCS model (method `'gcs'`): sections, criterion, smooth, centres. */
   gcs?: GcsOptions;
+  /** Options of the classic model (method `'classic'`): contours, rays, bulge. */
   classic?: ClassicOptions;
   /** Material of the output mesh. Default: the source's own material (the same object, shared, not cloned). */
   material?: THREE.Material | THREE.Material[];
@@ -60,16 +63,23 @@ export interface SkinDeformerOptions {
 
 /** What rebuild() may change. */
 export interface RebuildOptions {
+  /** Options of the GCS model (method `'gcs'`): sections, criterion, smooth, centres. */
   gcs?: GcsOptions;
+  /** Options of the classic model (method `'classic'`): contours, rays, bulge. */
   classic?: ClassicOptions;
+  /** Where the per-vertex work runs from now on (default: as before). */
   backend?: Backend;
+  /** The GPU backend's path from now on (see SkinDeformerOptions.gpuPath). */
   gpuPath?: GpuPath | 'auto';
 }
 
+/** Options of `GcsCharacter`: those of `SkinDeformer` for every skin, and a filter of which skins to take. */
 export interface GcsCharacterOptions {
   /** Which deformer drives every skin. Default 'gcs'. */
   method?: DeformerKind;
+  /** Options of the GCS model (method `'gcs'`): sections, criterion, smooth, centres. */
   gcs?: GcsOptions;
+  /** Options of the classic model (method `'classic'`): contours, rays, bulge. */
   classic?: ClassicOptions;
   /** See SkinDeformerOptions.tangents. Default 'deform'. */
   tangents?: 'deform' | 'drop';

@@ -33,11 +33,23 @@ import { writeSkinMatrices } from './skin-matrices.js';
  *
  * `dispose()` frees the wasm memory and the output geometry, removes `mesh` from its parent and,
  * in place, gives the source back its layers. Materials are never disposed (they are shared).
+ *
+ * @example
+ * ```ts
+ * const skin = new SkinDeformer(gcs, skinnedMesh, { method: 'gcs', inPlace: true });
+ * // each frame, after the mixer: skin.update();
+ * skin.rebuild('gcs', { gcs: { sections: 12 } });
+ * skin.dispose();
+ * ```
  */
 export class SkinDeformer {
+  /** The skinned mesh whose skeleton drives this one (only read; in place, it leaves the render). */
   readonly source: THREE.SkinnedMesh;
+  /** The rig read from the source (owned by this SkinDeformer). */
   readonly rig: Rig;
+  /** The deformed mesh that is drawn: its attributes are views on wasm memory (CPU backend). */
   readonly mesh: THREE.Mesh;
+  /** The current deformer (replaced by `rebuild`). */
   deformer!: Deformer;
   private method: DeformerKind;
   private options: SkinDeformerOptions;
@@ -87,6 +99,13 @@ export class SkinDeformer {
   /** The backend notes already printed as console warnings. */
   private readonly warned: Set<string>;
 
+  /**
+   * @param gcs The core (`await initGcsSkin()`).
+   * @param source The SkinnedMesh to deform; its geometry and skeleton are read, not changed.
+   * @param options Method, model options, material, placement, tangents, backend.
+   * @throws GcsError `NO_SKIN` when `source` is not a skinned mesh with a skeleton, and the rig's and the
+   * build's codes (`LENGTH_MISMATCH`, `BAD_WEIGHTS`, `SECTION_COUNT`, `OUT_OF_MEMORY`, …).
+   */
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
     const input = rigInputFromSkinnedMesh(source);
     this.source = source;
@@ -363,6 +382,7 @@ export class SkinDeformer {
     this.velocity = 'wanted';
   }
 
+  /** The method the current deformer runs. */
   get currentMethod(): DeformerKind {
     return this.method;
   }
@@ -428,6 +448,7 @@ export class SkinDeformer {
     if (this.inPlace) this.source.layers.mask = this.sourceLayers;
   }
 
+  /** Whether `dispose()` has run. */
   get disposed(): boolean {
     return this.isDisposed;
   }
