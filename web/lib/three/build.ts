@@ -9,6 +9,7 @@ import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from 
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from '../gpu/kit.js';
 import type { GpuPath } from '../gpu/layout.js';
 import { GpuSections } from '../gpu/sections.js';
+import { keepAttributeLive } from './live-views.js';
 import { morphData } from './morph-data.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
 
@@ -121,7 +122,7 @@ function prepareGpu(from: BuildSource, deformer: GcsDeformer, path?: GpuPath): G
   const materials = from.kit.build(from.baseMaterial, sections, null);
   const raycast = new THREE.BufferGeometry();
   raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
-  raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
+  raycast.setAttribute('position', keepAttributeLive(new THREE.BufferAttribute(deformer.positions, 3), deformer, 'positions'));
   raycast.boundingBox = from.box;
   raycast.boundingSphere = from.sphere;
   return { sections, materials, raycast };
@@ -138,14 +139,14 @@ function makeGeometry(from: BuildSource, deformer: Deformer, keepsVertices: bool
   } else {
     geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));
-    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('position', keepAttributeLive(new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage), deformer, 'positions'));
+    geometry.setAttribute('normal', keepAttributeLive(new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage), deformer, 'normals'));
     if (keepsVertices) {
       for (const [name, attr] of Object.entries(src.attributes))
         if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, deformer));
       // The deformer's own tangent output (xyz turned, w carried), drawn in place like positions.
       const tangents = deformer.tangents;
-      if (tangents) geometry.setAttribute('tangent', new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage));
+      if (tangents) geometry.setAttribute('tangent', keepAttributeLive(new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage), deformer, 'tangents'));
     } else if (deformer instanceof ClassicDeformer) {
       // Resampled: the source's uv, colours and custom attributes from the closest source point.
       deformer.deform(identitySkin(from.rig.jointCount));

@@ -10,6 +10,7 @@ import { glslKit } from '../gpu/webgl-materials.js';
 import { boneBounds, boundsFromBones, boundsOfPositions, type BoneBalls } from './bounds.js';
 import { discardBuild, disposeGpu, prepareBuild, type GpuBuild, type PendingBuild } from './build.js';
 import { DeformedMesh } from './deformed-mesh.js';
+import { keepAttributeLive } from './live-views.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
 import { rigInputFromSkinnedMesh } from './rig-input.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
@@ -327,7 +328,8 @@ export class SkinDeformer {
       return;
     }
     this.deformer.keepPreviousPositions(true);
-    this.mesh.geometry.setAttribute(PREVIOUS_POSITION_ATTRIBUTE, new THREE.BufferAttribute(this.deformer.previousPositions!, 3).setUsage(THREE.DynamicDrawUsage));
+    const previous = new THREE.BufferAttribute(this.deformer.previousPositions!, 3).setUsage(THREE.DynamicDrawUsage);
+    this.mesh.geometry.setAttribute(PREVIOUS_POSITION_ATTRIBUTE, keepAttributeLive(previous, this.deformer, 'previousPositions'));
     const material = Array.isArray(this.baseMaterial) ? materials as THREE.Material[] : materials[0]!;
     this.mesh.material = material;
     this.velocity = { material };
