@@ -21,7 +21,7 @@ import { GltfError, n } from '../../../web/lib/gltf/error.js';
 import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
 import { LIMITS } from '../../../web/lib/gltf/limits.js';
 import { shownName } from '../../../web/lib/gltf/shown-name.js';
-import { FileRefused, readRegularFile, readStandardInput, systemReason } from './read-file.js';
+import { FileRefused, namesStandardInput, readRegularFile, readStandardInput, systemReason } from './read-file.js';
 import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
 
 export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
@@ -97,7 +97,7 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
  * no folder. Throws a GltfError (code and one sentence naming the file) for anything wrong.
  */
 export async function readGltfFile(file: string): Promise<GltfFile> {
-  if (file === '-') {
+  if (namesStandardInput(file)) {
     const name = 'standard input';
     try {
       return await readGltfBytes(await readStandardInput(LIMITS.fileBytes), name, null);
@@ -317,7 +317,7 @@ function checkDecodedCounts(doc: Doc, declared: Map<string, { vertices: number; 
  * Reads a .glb or .gltf file (a path, or its bytes: `name` then names it in messages) in node into
  * three.js objects: compressed geometry decoded, textures dropped. Throws a GltfError for a bad file.
  */
-export async function loadGltfFile(file: string | Uint8Array, name = typeof file !== 'string' ? 'the glTF bytes' : file === '-' ? 'standard input' : file): Promise<LoadedModel> {
+export async function loadGltfFile(file: string | Uint8Array, name = typeof file !== 'string' ? 'the glTF bytes' : namesStandardInput(file) ? 'standard input' : file): Promise<LoadedModel> {
   const { json, resources } = typeof file === 'string' ? await readGltfFile(file) : await readGltfBytes(file, name, null);
   file = name;
   const warnings: string[] = [];
