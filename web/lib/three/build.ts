@@ -2,7 +2,7 @@
 // around it without showing them; SkinDeformer.commit shows one, discardBuild frees one never shown
 // (GcsCharacter.rebuild prepares every skin before it commits any: all or nothing).
 import * as THREE from 'three';
-import { GcsError } from '../errors.js';
+import { asGiven, GcsError } from '../errors.js';
 import { ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type Rig } from '../index.js';
 import { transferSurfaceAttributes } from '../surface-attributes.js';
 import { bindGeometry, identitySkin, remapAttribute, SKINNING_ATTRIBUTES } from '../gpu/bind.js';
@@ -62,12 +62,12 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
   const gcsOptions = { ...from.options.gcs, ...options.gcs };
   const classicOptions = { ...from.options.classic, ...options.classic };
   const backend = options.backend ?? from.options.backend ?? 'cpu';
-  if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got '${String(backend)}'`);
+  if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got ${asGiven(backend)}`);
   const note = backend === 'gpu' ? gpuUnsupported(from, method) : '';
   const onGpu = backend === 'gpu' && !note;
   const gpuPath = options.gpuPath ?? from.options.gpuPath ?? 'auto';
   if (gpuPath !== 'auto' && gpuPath !== 'joints' && gpuPath !== 'sections')
-    throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got '${String(gpuPath)}'`);
+    throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got ${asGiven(gpuPath)}`);
   const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
     : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
   const deformer = build(from.rig);

@@ -9,6 +9,7 @@ import type { GpuSections } from '../gpu/sections.js';
 import { glslKit } from '../gpu/webgl-materials.js';
 import { boneBounds, boundsFromBones, boundsOfPositions, type BoneBalls } from './bounds.js';
 import { discardBuild, disposeGpu, prepareBuild, type GpuBuild, type PendingBuild } from './build.js';
+import { checkGcsSkin } from './check-gcs.js';
 import { DeformedMesh } from './deformed-mesh.js';
 import { keepAttributeLive } from './live-views.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
@@ -89,6 +90,7 @@ export class SkinDeformer {
   private readonly warned: Set<string>;
 
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
+    checkGcsSkin(gcs, 'SkinDeformer');
     const input = rigInputFromSkinnedMesh(source);
     this.source = source;
     this.options = { ...options };
