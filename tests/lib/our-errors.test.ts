@@ -5,7 +5,7 @@
 import { describe, expect, test } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin } from '../../web/lib/index.js';
-import { GltfError } from '../../web/lib/gltf/error.js';
+import { GltfError, loaderFailure } from '../../web/lib/gltf/error.js';
 import { bakeClip, GcsCrowd } from '../../web/lib/crowd.js';
 import { CORE_FUNCTIONS } from '../../web/lib/core-check.js';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
@@ -107,6 +107,12 @@ describe('sources checked by type, modules by their exports', () => {
 });
 
 describe('decoder input checked before the decoder runs', () => {
+  test('a loader\'s engine error is never the LOAD_FAILED sentence; its own message is', () => {
+    expect(loaderFailure(new RangeError('Invalid typed array length: 50008'))).toBe('the loader failed inside on data the checks let through (please report the file)');
+    expect(loaderFailure(new TypeError("Cannot read properties of undefined (reading 'count')"))).not.toMatch(/Cannot read/);
+    expect(loaderFailure(new Error('THREE.GLTFLoader: Unsupported asset.\nglTF versions >=2.0 are supported.'))).toBe('THREE.GLTFLoader: Unsupported asset. glTF versions >=2.0 are supported.');
+  });
+
   test('a Draco primitive whose JOINTS_0 has no Draco attribute id (nor a buffer view): BAD_STRUCTURE, no engine text', async () => {
     const glb = await compressGlb(await humanToGlb(human), 'draco');
     const { json, bin } = splitGlb(glb);

@@ -12,7 +12,7 @@ import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import { readValidatedGltf, type ValidatedGltf } from '../lib/gltf/buffers.js';
 import { restoreZeroWeights, zeroWeightVertices } from '../lib/gltf/accessors.js';
-import { GltfError, n } from '../lib/gltf/error.js';
+import { GltfError, loaderFailure, n } from '../lib/gltf/error.js';
 import type { GltfJson } from '../lib/gltf/json.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 import { addDecoders, decoderFailure } from './gltf-decoders.js';
@@ -168,8 +168,7 @@ async function parseValidated(gltf: ValidatedGltf, name: string, blobs: string[]
     if (e instanceof GltfError) throw e;
     const failed = decoderFailure(used);
     if (failed) throw new GltfError('BAD_DATA', name, '', `${name}: ${failed}`);
-    const message = (e as Error)?.message ?? String(e);
-    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${shownName(message, 120)}`);
+    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${shownName(loaderFailure(e), 120)}`);
   }
   const refused = takeRefused();
   if (refused.length)

@@ -17,7 +17,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { restoreZeroWeights } from '../../../web/lib/gltf/accessors.js';
 import { decodeBufferPath, readValidatedGltf } from '../../../web/lib/gltf/buffers.js';
 import { sniffGltf } from '../../../web/lib/gltf/container.js';
-import { GltfError, n } from '../../../web/lib/gltf/error.js';
+import { GltfError, loaderFailure, n } from '../../../web/lib/gltf/error.js';
 import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
 import { LIMITS } from '../../../web/lib/gltf/limits.js';
 import { shownName } from '../../../web/lib/gltf/shown-name.js';
@@ -334,7 +334,7 @@ export async function loadGltfFile(file: string | Uint8Array, name = typeof file
     // The decoders' own exceptions ("Invalid typed array length", a Draco status) become ours.
     const compressed = COMPRESSED_DATA.filter(([ext]) => used.includes(ext)).map(([, what]) => what);
     if (compressed.length) throw new GltfError('BAD_DATA', file, '', `${file}: its ${compressed.join(' or ')} data does not decode`);
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   checkDecodedCounts(doc, declared, file);
   try {
@@ -356,13 +356,13 @@ export async function loadGltfFile(file: string | Uint8Array, name = typeof file
     bytes = await io.writeBinary(doc);
   } catch (e) {
     if (e instanceof GltfError) throw e;
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   let model: LoadedModel;
   try {
     model = await parseGlb(bytes, { warnings, zeroWeights });
   } catch (e) {
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   return model;
 }
