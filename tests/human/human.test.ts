@@ -1,6 +1,7 @@
 import { beforeAll, describe, expect, it } from 'vitest';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { GcsError } from '../../web/lib/errors.js';
 import { createHuman, createHumanData, Human, HumanData, humanToGlb, JOINT_NAMES, JOINT_PARENTS } from '../../web/lib/human/index.js';
 
 const PAPER_V = 17023;
@@ -111,10 +112,10 @@ function trackAngles(clip: THREE.AnimationClip, bone: string, axis?: THREE.Vecto
 }
 
 describe('human: options', () => {
-  it('rejects out-of-range vertex counts and unknown poses with a RangeError', () => {
-    expect(() => createHumanData({ vertices: 100 })).toThrow(RangeError);
+  it('rejects out-of-range vertex counts and unknown poses with a GcsError OUT_OF_RANGE', () => {
+    expect(() => createHumanData({ vertices: 100 })).toThrow(GcsError);
     expect(() => createHumanData({ vertices: 3e6 })).toThrow(/2000 to 2000000/);
-    expect(() => createHumanData({ vertices: NaN })).toThrow(RangeError);
+    expect(() => createHumanData({ vertices: NaN })).toThrow(GcsError);
     expect(() => createHumanData({ pose: 'sit' as never })).toThrow(/'stand' or 'tpose'/);
   });
 });

@@ -115,11 +115,20 @@ uint32_t Rig::dominantJoint(uint32_t v) const {
 void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                     std::vector<glm::vec3>& normals) {
   normals.assign(positions.size(), glm::vec3(0.0f));
+  // Scale-free: the cross products grow as the square of the size and their sums' squared
+  // lengths as its fourth power, so a mesh far from unit size (a ×1e37 tube overflowed, a ×1e-20
+  // one underflowed) has its edges scaled by a power of two near 1 / extent first (exact, so the
+  // directions are the same). Ordinary sizes skip it and stay bit-identical.
+  float extent = 0.0f;
+  for (const glm::vec3& p : positions) extent = std::fmax(extent, std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))));
+  const float scale = extent > 1e6f || (extent > 0.0f && extent < 1e-6f) ? std::ldexp(1.0f, -std::ilogb(extent)) : 1.0f;
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     const glm::vec3& a = positions[indices[t]];
     const glm::vec3& b = positions[indices[t + 1]];
     const glm::vec3& c = positions[indices[t + 2]];
-    glm::vec3 n = glm::cross(b - a, c - a);  // length = 2 · area: area weighting for free
+    // length = 2 · area (× scale²): area weighting for free. Scaled before subtracting: the
+    // difference of two coordinates near ±3.4e38 overflows too.
+    glm::vec3 n = glm::cross(b * scale - a * scale, c * scale - a * scale);
     normals[indices[t]] += n;
     normals[indices[t + 1]] += n;
     normals[indices[t + 2]] += n;

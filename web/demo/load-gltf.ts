@@ -12,12 +12,12 @@ import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import { readValidatedGltf, type ValidatedGltf } from '../lib/gltf/buffers.js';
 import { restoreZeroWeights, zeroWeightVertices } from '../lib/gltf/accessors.js';
-import { GltfError, n } from '../lib/gltf/error.js';
+import { GltfError, loaderFailure, n } from '../lib/gltf/error.js';
 import type { GltfJson } from '../lib/gltf/json.js';
 import { shownName } from '../lib/gltf/shown-name.js';
 import { addDecoders, decoderFailure } from './gltf-decoders.js';
 import { droppedReader, fetchAtMost, guardedManager, MAX_FILE_BYTES, siteReader, siteUrl, takeRefused, tooLarge, type ResourceReader } from './gltf-sources.js';
-import { imageSize, imageTooLarge } from './image-size.js';
+import { IMAGE_FORMATS, IMAGE_LIMITS, imageSize, imageTooLarge, MIME_TYPES, texelsOf } from './image-size.js';
 import { state } from './state.js';
 
 export { GltfError } from '../lib/gltf/error.js';
@@ -44,14 +44,14 @@ export function modelName(value: string): string {
 export const fileName = (file: File): string => shownName(file.name, FILE_NAME_LENGTH);
 
 /** A dropped .glb or .gltf with the files dropped beside it (its external buffers and images, found by name). */
-export async function loadDroppedGltf(main: File, companions: readonly File[]): Promise<GLTF> {
+export async function loadDroppedGltf(main: File, companions: readonly File[]): Promise<LoadedGltf> {
   const name = fileName(main);
   if (main.size > MAX_FILE_BYTES) throw tooLarge(name, main.size);
   return loadBytes(new Uint8Array(await main.arrayBuffer()), name, droppedReader(companions, name));
 }
 
 /** A .glb or .gltf on this site (a path relative to the page) or in a data: URI; `name` names it in messages. */
-export async function loadGltfUrl(value: string, name = modelName(value)): Promise<GLTF> {
+export async function loadGltfUrl(value: string, name = modelName(value)): Promise<LoadedGltf> {
   const url = siteUrl(value);
   const what = `Could not load ${name}`;
   const bytes = await fetchAtMost(url, MAX_FILE_BYTES, name, what).catch((e: unknown) => {
@@ -74,41 +74,89 @@ export function startsLikeHtml(bytes: Uint8Array): boolean {
   return head.startsWith('<!doctype html') || head.startsWith('<html');
 }
 
-async function loadBytes(bytes: Uint8Array, name: string, read: ResourceReader): Promise<GLTF> {
+/** What a loaded file gave the page: three's GLTF and notes to show with the character (textures skipped). */
+export interface LoadedGltf extends GLTF {
+  notes: string[];
+}
+
+async function loadBytes(bytes: Uint8Array, name: string, read: ResourceReader): Promise<LoadedGltf> {
   const gltf = await readValidatedGltf(bytes, name, (uri, i, maxBytes) => read(uri, 'buffer', i, maxBytes));
   const blobs: string[] = [];
   try {
-    await checkImages(gltf, name, read, blobs);
-    return await parseValidated(gltf, name, blobs);
+    const notes = await checkImages(gltf, name, read, blobs);
+    return Object.assign(await parseValidated(gltf, name, blobs), { notes });
   } finally {
     setTimeout(() => blobs.forEach((u) => URL.revokeObjectURL(u)), 10000); // textures may still be decoding
   }
 }
 
 /**
- * Reads every image (its uri's file, data: URI or buffer view), refuses one that declares too many
- * pixels before anything decodes it, and points each uri at a blob URL of the bytes read.
+ * Reads every image (its uri's file, data: URI or buffer view) and sizes it by its own bytes
+ * (image-size.ts; its declared MIME type is not trusted). One the page would not decode (a format
+ * it cannot size, a side or texel count past IMAGE_LIMITS, or past the texels left of all the
+ * file's images) is skipped before anything decodes it: the textures made of it are removed from
+ * the materials, which then draw untextured; each skip is a note. Kept images' uris point at blob
+ * URLs of the bytes read, labelled by their sniffed format.
  */
-async function checkImages({ json, buffers }: ValidatedGltf, name: string, read: ResourceReader, blobs: string[]): Promise<void> {
+async function checkImages({ json, buffers }: ValidatedGltf, name: string, read: ResourceReader, blobs: string[]): Promise<string[]> {
   const images: GltfJson[] = Array.isArray(json.images) ? json.images : [];
-  let budget = MAX_FILE_BYTES;
+  let budget = MAX_FILE_BYTES, texelsLeft: number = IMAGE_LIMITS.totalTexels;
+  const skipped = new Map<number, string>();
   for (const [i, image] of images.entries()) {
     let bytes: Uint8Array | undefined;
     if (typeof image?.uri === 'string') {
       bytes = await read(image.uri, 'image', i, budget + 1);
       if (bytes.byteLength > budget) throw tooLarge(name, MAX_FILE_BYTES, `${name}'s images`);
       budget -= bytes.byteLength;
-      image.uri = URL.createObjectURL(new Blob([bytes as Uint8Array<ArrayBuffer>], typeof image.mimeType === 'string' ? { type: image.mimeType } : {}));
-      blobs.push(image.uri);
     } else if (Number.isInteger(image?.bufferView)) {
       const view = json.bufferViews?.[image.bufferView];
       const data = view && buffers[view.buffer];
       if (data) bytes = data.subarray(view.byteOffset ?? 0, (view.byteOffset ?? 0) + view.byteLength);
     }
-    const size = bytes && imageSize(bytes);
-    const why = size && imageTooLarge(size);
-    if (why) throw new GltfError('TOO_LARGE', name, `/images/${i}`, `${name}: image ${i} ${why}`);
+    if (!bytes) continue;
+    const size = imageSize(bytes);
+    const why = !size ? `is not an image this page can size (${IMAGE_FORMATS})`
+      : imageTooLarge(size) ?? (texelsOf(size) > texelsLeft ? `would take the file's images past the ${IMAGE_LIMITS.totalTexels.toLocaleString('en-US')} texels this page decodes` : null);
+    if (why) {
+      skipped.set(i, why);
+      if (typeof image.uri === 'string') image.uri = PLACEHOLDER_PNG; // never fetched: no texture refers to it any more
+      continue;
+    }
+    texelsLeft -= texelsOf(size!);
+    if (typeof image.uri === 'string') {
+      image.uri = URL.createObjectURL(new Blob([bytes as Uint8Array<ArrayBuffer>], { type: MIME_TYPES[size!.format] }));
+      blobs.push(image.uri);
+    } else {
+      image.mimeType = MIME_TYPES[size!.format];
+    }
   }
+  if (!skipped.size) return [];
+  dropTexturesOf(json, new Set(skipped.keys()));
+  const [first, why] = [...skipped][0];
+  const more = skipped.size > 1 ? ` (and ${skipped.size - 1} more image${skipped.size > 2 ? 's' : ''})` : '';
+  return [`${name}: image ${first} ${why}, so it was skipped${more}: the character is drawn without those textures.`];
+}
+
+/** A 1×1 PNG: what a skipped image's uri becomes (nothing refers to it; GLTFLoader never asks for it). */
+const PLACEHOLDER_PNG = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAQAAAC1HAwCAAAAC0lEQVR42mNkYAAAAAYAAjCB0C8AAAAASUVORK5CYII=';
+
+/**
+ * Removes from every material each texture reference ({ index, texCoord }, in the core material
+ * and in any extension) whose texture's image (its source, or an extension's: KTX2, WebP, AVIF)
+ * was skipped: the material keeps its factors and draws untextured.
+ */
+function dropTexturesOf(json: GltfJson, images: Set<number>): void {
+  const textures: GltfJson[] = Array.isArray(json.textures) ? json.textures : [];
+  const sourcesOf = (t: GltfJson) => [t?.source, ...Object.values((t?.extensions ?? {}) as Record<string, GltfJson>).map((e) => e?.source)];
+  const dropped = new Set(textures.flatMap((t, k) => (sourcesOf(t).some((s) => images.has(s)) ? [k] : [])));
+  const strip = (node: unknown, depth: number): void => {
+    if (!node || typeof node !== 'object' || depth > 8) return;
+    for (const [key, value] of Object.entries(node as GltfJson)) {
+      if (/Texture$/.test(key) && value && typeof value === 'object' && dropped.has((value as GltfJson).index)) delete (node as GltfJson)[key];
+      else strip(value, depth + 1);
+    }
+  };
+  for (const material of Array.isArray(json.materials) ? json.materials : []) strip(material, 0);
 }
 
 /**
@@ -136,8 +184,7 @@ async function parseValidated(gltf: ValidatedGltf, name: string, blobs: string[]
     if (e instanceof GltfError) throw e;
     const failed = decoderFailure(used);
     if (failed) throw new GltfError('BAD_DATA', name, '', `${name}: ${failed}`);
-    const message = (e as Error)?.message ?? String(e);
-    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${shownName(message, 120)}`);
+    throw new GltfError('LOAD_FAILED', name, '', `${name} passed the checks but three's GLTFLoader could not read it: ${shownName(loaderFailure(e), 120)}`);
   }
   const refused = takeRefused();
   if (refused.length)

@@ -123,6 +123,7 @@ async function loadFiles(files: File[]): Promise<void> {
   // Validated as the CLI validates (a GltfError: one sentence and a code), then parsed.
   const gltf = await loadDroppedGltf(main, files.filter((f) => f !== main));
   await install(name, gltf.scene, gltf.animations, { normalise: true, key: 'file', credit: null });
+  if (gltf.notes.length) showMessage(gltf.notes.join(' ')); // after install, which clears the message
 }
 
 /** A URL, or a character shipped in public/ (served beside the page). */
@@ -131,6 +132,7 @@ async function loadUrl(url: string, shipped?: Shipped): Promise<void> {
   showStatus(`building… loading ${name}`);
   const gltf = await loadGltfUrl(url, name);
   await install(name, gltf.scene, gltf.animations, { normalise: true, key: shipped?.key ?? 'file', credit: shipped?.credit ?? null });
+  if (gltf.notes.length) showMessage(gltf.notes.join(' ')); // after install, which clears the message
 }
 
 interface InstallOptions {

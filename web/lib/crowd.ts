@@ -19,13 +19,15 @@
  * @module gcs-skin/crowd
  */
 import * as THREE from 'three';
-import { GcsError } from './errors.js';
+import { asGiven, GcsError } from './errors.js';
 import type { GcsDeformer, GcsOptions, GcsSkin, Rig } from './index.js';
 import { bindGeometry } from './gpu/bind.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from './gpu/kit.js';
 import type { GpuPath } from './gpu/layout.js';
 import { GpuSections } from './gpu/sections.js';
 import { glslKit } from './gpu/webgl-materials.js';
+import { bakedFrameCount } from './three/bake-limits.js';
+import { checkGcsSkin } from './three/check-gcs.js';
 import { rigInputFromSkinnedMesh } from './three/rig-input.js';
 import { writeSkinMatrices } from './three/skin-matrices.js';
 
@@ -55,11 +57,10 @@ export interface BakedClip {
  */
 export function bakeClip(source: THREE.SkinnedMesh, clip: THREE.AnimationClip, fps = 60): BakedClip {
   if (!source?.isSkinnedMesh || !source.skeleton) throw new GcsError('NO_SKIN', 'bakeClip needs a THREE.SkinnedMesh with a skeleton');
-  if (!(fps > 0 && fps <= 1000)) throw new GcsError('OUT_OF_RANGE', `fps must be in (0, 1000]; got ${fps}`);
   let root: THREE.Object3D = source;
   while (root.parent) root = root.parent;
   const J = source.skeleton.bones.length;
-  const frames = Math.max(1, Math.round(clip.duration * fps));
+  const frames = bakedFrameCount(clip, fps, J); // bounds checked before allocating
   const data = new Float32Array(frames * J * 16);
   const mixer = new THREE.AnimationMixer(root);
   const action = mixer.clipAction(clip);
@@ -137,9 +138,10 @@ export class GcsCrowd {
    * @param options The GCS model, material, texture width and GPU path.
    * @throws GcsError `INVALID_ARGUMENT` when the material cannot run GCS on the GPU (a ShaderMaterial, a
    * node material with its own position node), `NO_SKIN` when `source` is not skinned, `OUT_OF_RANGE`
-   * for a bad count, and the build's codes (`GcsError`).
+   * for a bad count (default 1), and the build's codes (`GcsError`).
    */
-  constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, count: number, options: GcsCrowdOptions = {}) {
+  constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, count = 1, options: GcsCrowdOptions = {}) {
+    checkGcsSkin(gcs, 'GcsCrowd');
     const input = rigInputFromSkinnedMesh(source);
     const material = options.material ?? source.material;
     const kit = this.kit = options.gpuKit ?? glslKit;
@@ -224,12 +226,13 @@ export class GcsCrowd {
 
   /** Where instance i's J × 16 skin matrices start in `skins`. */
   offsetOf(i: number): number {
-    if (!Number.isInteger(i) || i < 0 || i >= this.count) throw new GcsError('OUT_OF_RANGE', `instance ${i} is out of range: the crowd has ${this.count}`);
+    if (!Number.isInteger(i) || i < 0 || i >= this.count) throw new GcsError('OUT_OF_RANGE', `instance ${asGiven(i)} is out of range: the crowd has ${this.count}`);
     return i * this.jointCount * 16;
   }
 
   /** Poses instance i at `time` seconds into a baked clip (looped; the nearest sampled frame). A copy of J × 16 floats. */
   setBakedPose(i: number, clip: BakedClip, time: number): void {
+    if (!(clip?.data instanceof Float32Array)) throw new GcsError('INVALID_ARGUMENT', 'setBakedPose takes a clip that bakeClip made');
     if (clip.jointCount !== this.jointCount) throw new GcsError('LENGTH_MISMATCH', `the clip was baked for ${clip.jointCount} joints; the crowd has ${this.jointCount}`);
     const o = this.offsetOf(i);
     const n = this.jointCount * 16;

@@ -51,3 +51,14 @@ export class GcsError extends Error {
     return CORE_ERROR_CODES[n] ?? 'UNKNOWN_CORE_ERROR';
   }
 }
+
+/** A value as the caller gave it, for messages: strings in quotes ('6'), so a string is told from a number. */
+export function asGiven(value: unknown): string {
+  if (typeof value === 'string') return `'${value}'`;
+  if (typeof value === 'bigint') return `${value}n`;
+  if (typeof value === 'symbol') return 'a symbol';
+  if (typeof value === 'function') return 'a function';
+  if (Array.isArray(value)) return 'an array';
+  if (value !== null && typeof value === 'object') return 'an object';
+  return String(value);
+}

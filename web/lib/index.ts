@@ -14,11 +14,12 @@
  * @module gcs-skin
  */
 import { DEFORMER_KINDS, STATS } from './core-enums.js';
-import { GcsError, type GcsErrorCode } from './errors.js';
+import { checkWasmSource, loadFailure } from './core-check.js';
+import { asGiven, GcsError, type GcsErrorCode } from './errors.js';
 import { instantiateCore, type CoreExports, type WasmSource } from './loader.js';
 import { VERSION, versionNumber, versionString } from './version.js';
 
-export { GcsError, type GcsErrorCode } from './errors.js';
+export { asGiven, GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
 export { version } from './version.js';
 
@@ -45,6 +46,8 @@ export const CLASSIC_LIMITS = {
  * formula (gcs_model.cpp); this is the one JavaScript copy.
  */
 export function weightGridSteps(sections: number): number {
+  if (typeof sections !== 'number' || !Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
+    throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${asGiven(sections)}`);
   return 2 * (sections - 2);
 }
 
@@ -275,6 +278,10 @@ export class GcsSkin {
     }
     const { positions, normals, indices, joints, weights, parents, inverseBindMatrices } = input;
     const influences = checkInfluences(input.influences);
+    // Bounds before any loop or allocation: what does not fit in wasm memory (4 GiB) is refused at once.
+    const numbers = positions.length + (normals?.length ?? 0) + indices.length + joints.length + weights.length + parents.length + inverseBindMatrices.length;
+    if (!(numbers * 4 <= 2 ** 32))
+      throw new GcsError('OUT_OF_MEMORY', `out of memory: the rig's arrays hold ${numbers} numbers, more than wasm memory (4 GiB) holds`);
     if (positions.length % 3 !== 0) throw new GcsError('LENGTH_MISMATCH', `positions has ${positions.length} numbers, which is not a multiple of 3`);
     const vertexCount = positions.length / 3;
     const jointCount = parents.length;
@@ -301,6 +308,12 @@ export class GcsSkin {
         if (!Number.isInteger(j) || j < 0)
           throw new GcsError('JOINT_OUT_OF_RANGE', `vertex ${(i - (i % influences)) / influences} has joint id ${asGiven(j)} (joints[${i}]): joint ids are whole numbers from 0 to ${jointCount - 1}`);
       }
+    for (let j = 0; j < jointCount; j++) {
+      const parent = parents[j];
+      // Copied into wasm as i32, 1.5 would become 1: refuse it as given (the core checks the range and cycles).
+      if (!Number.isInteger(parent))
+        throw new GcsError('JOINT_OUT_OF_RANGE', `joint ${j} has parent ${asGiven(parent)}: a parent is a joint index (a whole number) or -1 for a root`);
+    }
     const ptrs: number[] = [];
     try {
       const p = this.copyIn(positions, 'f32'); ptrs.push(p);
@@ -348,9 +361,12 @@ export async function initGcsSkin(options: {
 } = {}): Promise<GcsSkin> {
   let core: CoreExports;
   try {
-    core = await instantiateCore(options.wasm);
+    checkOptions(options, 'initGcsSkin');
+    checkWasmSource(options?.wasm);
+    core = await instantiateCore(options?.wasm);
   } catch (e) {
-    throw new GcsError('WASM_LOAD', `could not load gcs-skin.wasm: ${(e as Error).message}`);
+    if (e instanceof GcsError) throw e;
+    throw new GcsError('WASM_LOAD', `could not load gcs-skin.wasm: ${loadFailure(e)}`);
   }
   // A binary of another version would answer the same calls differently: refuse it here.
   const coreVersion = typeof core.gcs_version === 'function' ? core.gcs_version() : null;
@@ -360,14 +376,6 @@ export async function initGcsSkin(options: {
   return new GcsSkin(core);
 }
 
-/** A value as the caller gave it, for messages: strings in quotes ('6'), so a string is told from a number. */
-export function asGiven(value: unknown): string {
-  if (typeof value === 'string') return `'${value}'`;
-  if (typeof value === 'bigint') return `${value}n`;
-  if (Array.isArray(value)) return 'an array';
-  if (value !== null && typeof value === 'object') return 'an object';
-  return String(value);
-}
 
 /** RigInput.influences: a whole number in 1 … MAX_INFLUENCES, 4 when omitted. */
 function checkInfluences(value: unknown): number {
@@ -489,7 +497,7 @@ export class Rig {
       case 'classic': return this.buildClassic(options);
       case 'lbs': return this.buildLbs();
       case 'dqs': return this.buildDqs();
-      default: throw new GcsError('INVALID_ARGUMENT', `unknown deformer kind '${String(kind)}' (gcs, classic, lbs, dqs)`);
+      default: throw new GcsError('INVALID_ARGUMENT', `unknown deformer kind ${asGiven(kind)} (gcs, classic, lbs, dqs)`);
     }
   }
 
@@ -695,6 +703,8 @@ export class Deformer {
    */
   setMorphTargets(deltas: readonly ArrayLike<number>[], normalDeltas?: readonly ArrayLike<number>[] | null): void {
     const h = this.live();
+    if (!Array.isArray(deltas) || (normalDeltas != null && !Array.isArray(normalDeltas)))
+      throw new GcsError('INVALID_ARGUMENT', 'setMorphTargets takes an array of delta arrays (one per target) and optionally an array of normal delta arrays');
     const T = deltas.length, V = this.vertexCount;
     if (normalDeltas && normalDeltas.length !== T)
       throw new GcsError('LENGTH_MISMATCH', `${normalDeltas.length} normal delta arrays for ${T} morph targets`);
@@ -944,8 +954,8 @@ export class ClassicDeformer extends Deformer {
   /** Changes the muscle bulge gain (0..4) without rebuilding. */
   setBulge(bulge: number): void {
     const h = this.live();
-    if (!(bulge >= 0 && bulge <= CLASSIC_LIMITS.maxBulge))
-      throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${CLASSIC_LIMITS.maxBulge}; got ${bulge}`);
+    if (typeof bulge !== 'number' || !(bulge >= 0 && bulge <= CLASSIC_LIMITS.maxBulge))
+      throw new GcsError('OUT_OF_RANGE', `bulge must be between 0 and ${CLASSIC_LIMITS.maxBulge}; got ${asGiven(bulge)}`);
     if (!this.gcs.core.gcs_classic_set_bulge(h, bulge)) this.gcs.raise('setBulge failed');
   }
 }
@@ -980,8 +990,8 @@ export abstract class PoseTexels {
    * @param deformer The GCS model whose poses the buffers hold (it stays the caller's).
    */
   protected constructor(readonly deformer: GcsDeformer, instanceCount: number, maxWidth: number, perInstance: () => number, unit: number) {
-    if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
     if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms and joint poses need a GCS deformer (rig.buildGcs)');
+    if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
     if (!Number.isInteger(instanceCount) || instanceCount < 1 || instanceCount > MAX_INSTANCES)
       throw new GcsError('OUT_OF_RANGE', `the instance count must be a whole number from 1 to ${MAX_INSTANCES}; got ${instanceCount}`);
     if (!Number.isInteger(maxWidth) || maxWidth < unit)

@@ -1,4 +1,5 @@
 // Instantiates the standalone gcs-skin.wasm (no emscripten JS glue) in node, vitest and browsers.
+import { checkCoreExports } from './core-check.js';
 
 /** Where to find the wasm binary: a URL or path, its bytes, or a compiled module. */
 export type WasmSource = URL | string | ArrayBuffer | Uint8Array | WebAssembly.Module;
@@ -96,6 +97,7 @@ export async function instantiateCore(source?: WasmSource): Promise<CoreExports>
     },
   };
   const instance = await WebAssembly.instantiate(module, imports);
+  checkCoreExports(instance.exports);
   exports = unsignedResults(instance.exports as unknown as CoreExports);
   exports._initialize();
   return exports;

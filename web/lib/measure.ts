@@ -539,6 +539,9 @@ export class FidelityProbe {
     const n = Math.floor(input.positions.length / 3);
     this.vertexCount = n;
     this.height = options.height ?? boundsHeight(input.positions);
+    // Nothing to measure is an error, not NaN figures: no frames, or no height to divide by.
+    if (!Array.isArray(frames) || frames.length === 0) throw new GcsError('INVALID_ARGUMENT', 'FidelityProbe needs at least one frame (skin matrices) to measure');
+    if (!(this.height > 0 && this.height < Infinity)) throw new GcsError('OUT_OF_RANGE', `FidelityProbe needs a positive, finite height to give distances in % of it; got ${this.height}`);
     this.rigid = new Int32Array(n).fill(-1);
     this.dominant = new Int32Array(n);
     let rigidCount = 0;

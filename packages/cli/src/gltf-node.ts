@@ -17,11 +17,11 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { restoreZeroWeights } from '../../../web/lib/gltf/accessors.js';
 import { decodeBufferPath, readValidatedGltf } from '../../../web/lib/gltf/buffers.js';
 import { sniffGltf } from '../../../web/lib/gltf/container.js';
-import { GltfError, n } from '../../../web/lib/gltf/error.js';
+import { GltfError, loaderFailure, n } from '../../../web/lib/gltf/error.js';
 import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
 import { LIMITS } from '../../../web/lib/gltf/limits.js';
 import { shownName } from '../../../web/lib/gltf/shown-name.js';
-import { FileRefused, readRegularFile, readStandardInput, systemReason } from './read-file.js';
+import { FileRefused, namesStandardInput, readRegularFile, readStandardInput, systemReason } from './read-file.js';
 import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
 
 export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
@@ -97,7 +97,7 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
  * no folder. Throws a GltfError (code and one sentence naming the file) for anything wrong.
  */
 export async function readGltfFile(file: string): Promise<GltfFile> {
-  if (file === '-') {
+  if (namesStandardInput(file)) {
     const name = 'standard input';
     try {
       return await readGltfBytes(await readStandardInput(LIMITS.fileBytes), name, null);
@@ -319,7 +319,7 @@ function checkDecodedCounts(doc: Doc, declared: Map<string, { vertices: number; 
  * Reads a .glb or .gltf file (a path, or its bytes: `name` then names it in messages) in node into
  * three.js objects: compressed geometry decoded, textures dropped. Throws a GltfError for a bad file.
  */
-export async function loadGltfFile(file: string | Uint8Array, name = typeof file !== 'string' ? 'the glTF bytes' : file === '-' ? 'standard input' : file): Promise<LoadedModel> {
+export async function loadGltfFile(file: string | Uint8Array, name = typeof file !== 'string' ? 'the glTF bytes' : namesStandardInput(file) ? 'standard input' : file): Promise<LoadedModel> {
   const { json, resources } = typeof file === 'string' ? await readGltfFile(file) : await readGltfBytes(file, name, null);
   file = name;
   const warnings: string[] = [];
@@ -336,7 +336,7 @@ export async function loadGltfFile(file: string | Uint8Array, name = typeof file
     // The decoders' own exceptions ("Invalid typed array length", a Draco status) become ours.
     const compressed = COMPRESSED_DATA.filter(([ext]) => used.includes(ext)).map(([, what]) => what);
     if (compressed.length) throw new GltfError('BAD_DATA', file, '', `${file}: its ${compressed.join(' or ')} data does not decode`);
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   checkDecodedCounts(doc, declared, file);
   try {
@@ -358,13 +358,13 @@ export async function loadGltfFile(file: string | Uint8Array, name = typeof file
     bytes = await io.writeBinary(doc);
   } catch (e) {
     if (e instanceof GltfError) throw e;
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   let model: LoadedModel;
   try {
     model = await parseGlb(bytes, { warnings, zeroWeights });
   } catch (e) {
-    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${reason(e)}`);
+    throw new GltfError('LOAD_FAILED', file, '', `cannot read ${file}: ${shownName(loaderFailure(e), 160)}`);
   }
   return model;
 }

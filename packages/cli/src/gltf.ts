@@ -8,6 +8,7 @@
 import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
 import { GltfError } from '../../../web/lib/gltf/error.js';
+import { asGiven, GcsError } from '../../../web/lib/errors.js';
 import type { RigInput } from '../../../web/lib/index.js';
 import { morphData } from '../../../web/lib/three/morph-data.js';
 import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
@@ -89,8 +90,8 @@ export interface LoadCharacterOptions {
  * file, and a GltfError with code 'NO_SKINNED_MESH' when the file has no skinned mesh.
  */
 export async function loadCharacter(source: string | URL | Uint8Array | ArrayBuffer, options: LoadCharacterOptions = {}): Promise<Character> {
-  const path = source instanceof URL ? fileURLToPath(source) : source;
-  const file = typeof path === 'string' ? path : (options.name ?? 'the glTF bytes');
+  const path = characterSource(source);
+  const file = typeof path === 'string' ? path : (typeof options?.name === 'string' ? options.name : 'the glTF bytes');
   const model = typeof path === 'string' ? await loadGltfFile(path)
     : await loadGltfFile(path instanceof Uint8Array ? path : new Uint8Array(path), file);
   if (!model.skinnedMeshes.length)
@@ -99,6 +100,22 @@ export async function loadCharacter(source: string | URL | Uint8Array | ArrayBuf
   const height = characterHeight(model.skinnedMeshes);
   const meshes = model.skinnedMeshes.map((mesh, i) => characterMesh(mesh, height.meshUnits[i], poser));
   return { file, height: height.world, meshes, clipNames: model.clips.map((c) => c.name), warnings: model.warnings };
+}
+
+/** loadCharacter's source by type: a path, a file: URL, or bytes; anything else is a GltfError naming what was given. */
+function characterSource(source: unknown): string | Uint8Array | ArrayBuffer {
+  if (typeof source === 'string' || source instanceof Uint8Array || source instanceof ArrayBuffer) return source;
+  const given = source instanceof URL ? source.href : typeof source === 'object' && source !== null ? 'an object' : String(typeof source === 'symbol' ? 'a symbol' : source);
+  if (source instanceof URL && source.protocol === 'file:') {
+    try {
+      return fileURLToPath(source);
+    } catch {
+      throw new GltfError('BAD_URI', given, '', `${given} does not name a local file (a file: URL with a host, or an encoded '/')`);
+    }
+  }
+  if (source instanceof URL)
+    throw new GltfError('UNREADABLE', given, '', `${given} is not a file: URL: loadCharacter reads files (a path or a file: URL) or bytes; fetch the file first and pass its bytes`);
+  throw new GltfError('UNREADABLE', given, '', `loadCharacter reads a path, a file: URL, a Uint8Array or an ArrayBuffer; got ${given}`);
 }
 
 /**
@@ -154,7 +171,7 @@ function characterMesh(mesh: THREE.SkinnedMesh, height: number, poser: Poser): C
   const tmp = new THREE.Matrix4();
   const skin = (out?: Float32Array) => {
     const o = out ?? new Float32Array(16 * J);
-    if (o.length < 16 * J) throw new RangeError(`sample(): out has ${o.length} floats, ${16 * J} are needed (16 per joint)`);
+    if (!(o instanceof Float32Array) || o.length < 16 * J) throw new GcsError('LENGTH_MISMATCH', `sample(): out must be a Float32Array of ${16 * J} floats (16 per joint)`);
     writeSkinMatrices(mesh, o, 0, tmp);
     return o;
   };
@@ -171,12 +188,12 @@ function characterMesh(mesh: THREE.SkinnedMesh, height: number, poser: Poser): C
     name: clip.name,
     duration: clip.duration,
     sample(t: number, out?: Float32Array) {
-      if (!Number.isFinite(t)) throw new RangeError(`sample(${t}): the time must be a finite number of seconds`);
+      if (typeof t !== 'number' || !Number.isFinite(t)) throw new GcsError('OUT_OF_RANGE', `sample(${asGiven(t)}): the time must be a finite number of seconds`);
       poser.pose(c, t);
       return skin(out);
     },
     morphInfluences(t: number, out?: Float32Array) {
-      if (!Number.isFinite(t)) throw new RangeError(`morphInfluences(${t}): the time must be a finite number of seconds`);
+      if (typeof t !== 'number' || !Number.isFinite(t)) throw new GcsError('OUT_OF_RANGE', `morphInfluences(${asGiven(t)}): the time must be a finite number of seconds`);
       poser.pose(c, t);
       return influences(out);
     },

@@ -3,10 +3,19 @@
 // the open handle before a byte is read (only regular files: FIFOs, devices, sockets and
 // directories are refused), its size checked against the caller's limit before it is read, and
 // at most the bytes needed: first a head for the caller to sniff (a file that is not glTF costs
-// 64 KiB however large it is), then the rest, never past the limit. Standard input ('-') is read
-// as bytes, up to the same limit.
+// 64 KiB however large it is), then the rest, never past the limit. Standard input, by any of its
+// names ('-', /dev/stdin, /dev/fd/0), is read as bytes, up to the same limit.
 import { constants, type Stats } from 'node:fs';
 import { open } from 'node:fs/promises';
+import { resolve } from 'node:path';
+
+/** The paths that name standard input: '-' and the system's names for file descriptor 0. */
+const STANDARD_INPUT = new Set(['/dev/stdin', '/dev/fd/0', '/proc/self/fd/0']);
+
+/** Whether `path` names standard input ('-', /dev/stdin, /dev/fd/0, /proc/self/fd/0, however written): read it with readStandardInput. */
+export function namesStandardInput(path: string): boolean {
+  return path === '-' || STANDARD_INPUT.has(resolve(path));
+}
 
 /** Why a file was not read: 'type' (not a regular file), 'size' (past the limit) or 'io' (the system's error). */
 export class FileRefused extends Error {

@@ -102,7 +102,7 @@ export async function readValidatedGltf(bytes: Uint8Array, file: string, externa
     if (inline) { keep(inline, 'its data: URI'); continue; }
     if (!external)
       throw new GltfError('UNREADABLE', file, `/buffers/${i}/uri`,
-        `${file}: buffer ${i} is in the file '${shownName(uri)}', which cannot be read from bytes alone: give the .gltf's path, or a .glb`);
+        `${file}: buffer ${i} is in the file '${shownName(uri)}', which cannot be resolved without the .gltf's folder: give the .gltf's path, or a .glb`);
     const maxBytes = Number.isInteger(b.byteLength) && b.byteLength >= 0 ? b.byteLength : 0; // a bad byteLength is reported next
     keep(await external(uri, i, maxBytes), `its file '${shownName(uri)}'`);
   }

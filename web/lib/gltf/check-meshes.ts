@@ -45,6 +45,10 @@ export function checkMeshes(ctx: ValidationContext): void {
           if (p.attributes[k] === undefined)
             fail('BAD_STRUCTURE', `${dw}/attributes/${k}`, `${prim} has Draco data for ${shownName(k)} but no ${shownName(k)} attribute`);
         }
+        // An attribute with no buffer view has its data only in the Draco stream: it needs its id there.
+        for (const [k, a] of Object.entries(p.attributes))
+          if (accessors[a as number].bufferView === undefined && draco.attributes[k] === undefined)
+            fail('BAD_STRUCTURE', `${dw}/attributes`, `${prim}'s ${shownName(k)} has neither a buffer view nor a Draco attribute id: its data is nowhere`);
       }
       ref(p.material, materials, 'material', `${where}/material`, prim);
       if (p.targets !== undefined) {

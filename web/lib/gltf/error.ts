@@ -42,3 +42,15 @@ export class GltfError extends Error {
 /** 1,234,567 */
 export const n = (x: number) => x.toLocaleString('en-US');
 export const plural = (x: number, one: string, many = one.endsWith('sh') ? `${one}es` : `${one}s`) => `${n(x)} ${x === 1 ? one : many}`;
+
+/**
+ * What a loader's failure says in a LOAD_FAILED sentence: the loader's own message, but never an
+ * engine's (a TypeError or RangeError thrown inside a loader or decoder: "Invalid typed array
+ * length: 50008" says nothing a user can act on).
+ */
+export function loaderFailure(e: unknown): string {
+  if (e instanceof TypeError || e instanceof RangeError || e instanceof SyntaxError || e instanceof ReferenceError)
+    return 'the loader failed inside on data the checks let through (please report the file)';
+  const message = (e as Error)?.message;
+  return typeof message === 'string' && message ? message.replace(/\s*\n\s*/g, ' ') : 'the loader failed without saying why';
+}

@@ -6,6 +6,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
+import { keepLive } from '../three/live-views.js';
 import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuMethod, type GpuPath, type TableSlots } from './layout.js';
 
 /** LBS / DQS on the GPU: the method and the influences per vertex the shader blends (4, or 8). */
@@ -92,6 +93,7 @@ export class GpuSections {
     this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth) : new SectionTransforms(deformer, instanceCount, maxWidth);
     const t = this.transforms;
     this.texture = floatTexture(t.texels, t.width, t.height);
+    keepLive(this.texture.image as { data: ArrayBufferView }, 'data', () => (t.disposed ? null : t.texels)); // live after memory growth
     const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
     this.tableSlots = 4;
     if (skinning) {

@@ -22,8 +22,12 @@ interface HumanLike {
 
 /** Write the character (mesh, skin, skeleton, clips) as a binary glTF. */
 export async function humanToGlb(human: HumanLike): Promise<Uint8Array> {
+  const mesh = (human as HumanLike | null)?.mesh, clips = (human as HumanLike | null)?.clips;
+  const skinned = mesh?.isSkinnedMesh && mesh.skeleton && mesh.geometry?.isBufferGeometry
+    && ['position', 'normal', 'skinIndex', 'skinWeight'].every((name) => (mesh.geometry.getAttribute(name) as { isBufferAttribute?: boolean } | undefined)?.isBufferAttribute);
+  if (!skinned || !Array.isArray(clips) || !clips.every((c) => Array.isArray((c as THREE.AnimationClip | null)?.tracks)))
+    throw new GcsError('INVALID_ARGUMENT', 'humanToGlb takes { mesh, clips }: a SkinnedMesh with position, normal, skinIndex and skinWeight, and an array of AnimationClips (what createHuman returns)');
   const { Document, WebIO } = await gltfTransform();
-  const { mesh, clips } = human;
   const doc = new Document();
   doc.createScene('Scene');
   const buffer = doc.createBuffer();

@@ -2,6 +2,7 @@
 // gcs-skin/human: a default human character (one closed skinned surface, 19 joints, idle /
 // walk / run clips), generated procedurally. See createHuman().
 import * as THREE from 'three';
+import { asGiven, GcsError } from '../errors.js';
 import { polygonizeBody, relax, vertexNormals } from './body.js';
 import { makeClips } from './clips.js';
 import { BodyField } from './field.js';
@@ -90,15 +91,41 @@ export interface Human {
 }
 
 function validate(options: HumanOptions): { vertices: number; pose: Pose; seams: boolean } {
+  if (options === null || typeof options !== 'object' || Array.isArray(options))
+    throw new GcsError('INVALID_ARGUMENT', `the human's options must be an object ({ vertices, pose, seams }); got ${asGiven(options)}`);
   const vertices = options.vertices ?? DEFAULT_VERTICES;
   if (typeof vertices !== 'number' || !Number.isFinite(vertices) || vertices < MIN_VERTICES || vertices > MAX_VERTICES) {
-    throw new RangeError(`vertices must be a number from ${MIN_VERTICES} to ${MAX_VERTICES} (got ${String(vertices)}).`);
+    throw new GcsError('OUT_OF_RANGE', `vertices must be a number from ${MIN_VERTICES} to ${MAX_VERTICES} (got ${asGiven(vertices)}).`);
   }
   const pose = options.pose ?? 'stand';
   if (pose !== 'stand' && pose !== 'tpose') {
-    throw new RangeError(`pose must be 'stand' or 'tpose' (got ${JSON.stringify(pose)}).`);
+    throw new GcsError('OUT_OF_RANGE', `pose must be 'stand' or 'tpose' (got ${asGiven(pose)}).`);
   }
-  return { vertices: Math.round(vertices), pose, seams: options.seams ?? true };
+  const seams = options.seams ?? true;
+  if (typeof seams !== 'boolean') throw new GcsError('INVALID_ARGUMENT', `seams must be true or false (got ${asGiven(seams)}).`);
+  return { vertices: Math.round(vertices), pose, seams };
+}
+
+/** humanFromData's input: what createHumanData returns (or a copy of it), checked by shape before use. */
+function checkHumanData(data: HumanData): void {
+  const arrays: [keyof HumanData, number][] = [['positions', 3], ['normals', 3], ['uvs', 2], ['joints', 4], ['weights', 4]];
+  if (data === null || typeof data !== 'object')
+    throw new GcsError('INVALID_ARGUMENT', `humanFromData takes what createHumanData returns; got ${asGiven(data)}`);
+  const count = ArrayBuffer.isView(data.positions) ? (data.positions as Float32Array).length / 3 : -1;
+  for (const [key, size] of arrays) {
+    const a = data[key] as ArrayLike<number>;
+    if (!ArrayBuffer.isView(a) || a.length !== size * count || !Number.isInteger(count))
+      throw new GcsError('INVALID_ARGUMENT', `humanFromData: ${key} must be a typed array of ${size} numbers per vertex, as createHumanData returns`);
+  }
+  const joints = data.jointNames, parents = data.parents, jp = data.jointPositions;
+  if (!ArrayBuffer.isView(data.indices) || !Array.isArray(joints) || !Array.isArray(parents) || parents.length !== joints.length
+    || !ArrayBuffer.isView(jp) || (jp as Float32Array).length !== 3 * joints.length || parents.filter((p) => p === -1).length !== 1
+    || !(data.pose === 'stand' || data.pose === 'tpose') || typeof data.height !== 'number')
+    throw new GcsError('INVALID_ARGUMENT', 'humanFromData: the data is not what createHumanData returns (indices, jointNames, parents with one root, jointPositions, pose, height)');
+  parents.forEach((p, j) => {
+    if (!Number.isInteger(p) || p < -1 || p >= parents.length || p === j)
+      throw new GcsError('JOINT_OUT_OF_RANGE', `humanFromData: joint ${j}'s parent ${asGiven(p)} is not a joint of the human`);
+  });
 }
 
 /** Generate the raw arrays of the character (no three.js objects). */
@@ -150,6 +177,7 @@ export function createHumanData(options: HumanOptions = {}): HumanData {
 
 /** Build the three.js objects from raw data. */
 export function humanFromData(data: HumanData): Human {
+  checkHumanData(data);
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(data.positions, 3));
   g.setAttribute('normal', new THREE.BufferAttribute(data.normals, 3));
@@ -185,7 +213,7 @@ export function humanFromData(data: HumanData): Human {
 
 /**
  * Create the default human: a THREE.SkinnedMesh (bones under the mesh, bound) and its
- * 'idle', 'walk' and 'run' clips. Throws RangeError on bad options.
+ * 'idle', 'walk' and 'run' clips. Throws GcsError on bad options (OUT_OF_RANGE, INVALID_ARGUMENT).
  */
 export function createHuman(options: HumanOptions = {}): Human {
   return humanFromData(createHumanData(options));

@@ -2,7 +2,7 @@
 // around it without showing them; SkinDeformer.commit shows one, discardBuild frees one never shown
 // (GcsCharacter.rebuild prepares every skin before it commits any: all or nothing).
 import * as THREE from 'three';
-import { GcsError } from '../errors.js';
+import { asGiven, GcsError } from '../errors.js';
 import { ClassicDeformer, type ClassicOptions, type Deformer, type DeformerKind, type GcsDeformer, type GcsOptions, type Rig } from '../index.js';
 import { transferSurfaceAttributes } from '../surface-attributes.js';
 import { bindGeometry, identitySkin, influenceAttributes, remapAttribute, SKINNING_ATTRIBUTES, type VertexAttribute } from '../gpu/bind.js';
@@ -10,6 +10,7 @@ import { rigInputFromSkinnedMesh } from './rig-input.js';
 import { disposeGpuMaterials, type GpuMaterialKit, type GpuMaterials } from '../gpu/kit.js';
 import type { GpuPath } from '../gpu/layout.js';
 import { GpuSections } from '../gpu/sections.js';
+import { keepAttributeLive } from './live-views.js';
 import { morphData } from './morph-data.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
 
@@ -64,12 +65,12 @@ export function prepareBuild(from: BuildSource, method: DeformerKind, options: R
   const gcsOptions = { ...from.options.gcs, ...options.gcs };
   const classicOptions = { ...from.options.classic, ...options.classic };
   const backend = options.backend ?? from.options.backend ?? 'cpu';
-  if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got '${String(backend)}'`);
+  if (backend !== 'cpu' && backend !== 'gpu') throw new GcsError('INVALID_ARGUMENT', `backend must be 'cpu' or 'gpu'; got ${asGiven(backend)}`);
   const note = backend === 'gpu' ? gpuUnsupported(from, method) : '';
   const onGpu = backend === 'gpu' && !note;
   const gpuPath = options.gpuPath ?? from.options.gpuPath ?? 'auto';
   if (gpuPath !== 'auto' && gpuPath !== 'joints' && gpuPath !== 'sections')
-    throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got '${String(gpuPath)}'`);
+    throw new GcsError('INVALID_ARGUMENT', `gpuPath must be 'auto', 'joints' or 'sections'; got ${asGiven(gpuPath)}`);
   const build = (rig: Rig) => method === 'gcs' ? rig.buildGcs(gcsOptions)
     : method === 'classic' ? rig.buildClassic(classicOptions) : rig.build(method);
   const deformer = build(from.rig);
@@ -141,7 +142,7 @@ function prepareGpu(from: BuildSource, deformer: Deformer, method: DeformerKind,
   const materials = from.kit.build(from.baseMaterial, sections, null);
   const raycast = new THREE.BufferGeometry();
   raycast.setIndex(new THREE.BufferAttribute(deformer.indices, 1));
-  raycast.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3));
+  raycast.setAttribute('position', keepAttributeLive(new THREE.BufferAttribute(deformer.positions, 3), deformer, 'positions'));
   raycast.boundingBox = from.box;
   raycast.boundingSphere = from.sphere;
   return { sections, materials, raycast, influences };
@@ -158,14 +159,14 @@ function makeGeometry(from: BuildSource, deformer: Deformer, keepsVertices: bool
   } else {
     geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));
-    geometry.setAttribute('position', new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('position', keepAttributeLive(new THREE.BufferAttribute(deformer.positions, 3).setUsage(THREE.DynamicDrawUsage), deformer, 'positions'));
+    geometry.setAttribute('normal', keepAttributeLive(new THREE.BufferAttribute(deformer.normals, 3).setUsage(THREE.DynamicDrawUsage), deformer, 'normals'));
     if (keepsVertices) {
       for (const [name, attr] of Object.entries(src.attributes))
         if (!SKINNING_ATTRIBUTES.has(name)) geometry.setAttribute(name, remapAttribute(attr, deformer));
       // The deformer's own tangent output (xyz turned, w carried), drawn in place like positions.
       const tangents = deformer.tangents;
-      if (tangents) geometry.setAttribute('tangent', new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage));
+      if (tangents) geometry.setAttribute('tangent', keepAttributeLive(new THREE.BufferAttribute(tangents, 4).setUsage(THREE.DynamicDrawUsage), deformer, 'tangents'));
     } else if (deformer instanceof ClassicDeformer) {
       // Resampled: the source's uv, colours and custom attributes from the closest source point.
       deformer.deform(identitySkin(from.rig.jointCount));

@@ -4,6 +4,7 @@ import { GcsError } from '../errors.js';
 import type { DeformerKind, GcsSkin } from '../index.js';
 import type { PendingBuild } from './build.js';
 import type { Backend, GcsCharacterOptions, RebuildOptions } from './options.js';
+import { checkGcsSkin } from './check-gcs.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
 import { SkinDeformer } from './skin-deformer.js';
 
@@ -50,6 +51,7 @@ export class GcsCharacter {
    * code (GcsError) after undoing the ones already built.
    */
   constructor(readonly gcs: GcsSkin, root: THREE.Object3D, options: GcsCharacterOptions = {}) {
+    checkGcsSkin(gcs, 'GcsCharacter');
     if (!root || !(root as THREE.Object3D).isObject3D) throw new GcsError('INVALID_ARGUMENT', 'GcsCharacter needs a THREE.Object3D (a glTF scene, a group or a SkinnedMesh)');
     this.root = root;
     const sources: THREE.SkinnedMesh[] = [];

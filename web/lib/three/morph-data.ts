@@ -1,7 +1,24 @@
 // Morph targets of a geometry as relative deltas in its vertex order, what
 // deformer.setMorphTargets takes, with each target's largest delta (for the bounds).
 import type * as THREE from 'three';
+import { GcsError } from '../errors.js';
 import type { AnyAttribute } from './rig-input.js';
+
+/**
+ * The one check of a geometry's morph targets, wherever it is read (the three.js adapters, the
+ * command line's report and loadCharacter): every position and normal value finite, else GcsError
+ * NON_FINITE naming the target and vertex (what the core says of such deltas, earlier).
+ */
+export function checkMorphTargets(geometry: THREE.BufferGeometry): void {
+  for (const kind of ['position', 'normal'] as const) {
+    (geometry.morphAttributes[kind] ?? []).forEach((attr, t) => {
+      for (let i = 0; i < attr.count; i++)
+        for (let k = 0; k < attr.itemSize; k++)
+          if (!Number.isFinite(attr.getComponent(i, k)))
+            throw new GcsError('NON_FINITE', `morph target ${t}${attr.name ? ` '${attr.name}'` : ''} has a NaN or infinite ${kind} delta at vertex ${i}`);
+    });
+  }
+}
 
 /**
  * Morph targets as relative deltas in the source's vertex order (glTF / three: morphTargetsRelative).

@@ -3,6 +3,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import type { RigInput } from '../index.js';
+import { checkMorphTargets } from './morph-data.js';
 
 export type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
 
@@ -106,5 +107,6 @@ export function rigInputFromSkinnedMesh(source: THREE.SkinnedMesh): RigInput {
     m.multiplyMatrices(inv, source.bindMatrix);
     inverseBindMatrices.set(m.elements, 16 * i);
   });
+  checkMorphTargets(geometry); // one rule for morph deltas, however the mesh is read
   return { positions, normals, indices, joints, weights, influences, parents, inverseBindMatrices };
 }

@@ -9,7 +9,9 @@ import type { GpuSections } from '../gpu/sections.js';
 import { glslKit } from '../gpu/webgl-materials.js';
 import { boneBounds, boundsFromBones, boundsOfPositions, type BoneBalls } from './bounds.js';
 import { discardBuild, disposeGpu, prepareBuild, type GpuBuild, type PendingBuild } from './build.js';
+import { checkGcsSkin } from './check-gcs.js';
 import { DeformedMesh } from './deformed-mesh.js';
+import { keepAttributeLive } from './live-views.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
 import { rigInputFromSkinnedMesh } from './rig-input.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
@@ -107,6 +109,7 @@ export class SkinDeformer {
    * build's codes (`LENGTH_MISMATCH`, `BAD_WEIGHTS`, `SECTION_COUNT`, `OUT_OF_MEMORY`, …).
    */
   constructor(readonly gcs: GcsSkin, source: THREE.SkinnedMesh, options: SkinDeformerOptions = {}) {
+    checkGcsSkin(gcs, 'SkinDeformer');
     const input = rigInputFromSkinnedMesh(source);
     this.source = source;
     this.options = { ...options };
@@ -368,7 +371,8 @@ export class SkinDeformer {
       return;
     }
     this.deformer.keepPreviousPositions(true);
-    this.mesh.geometry.setAttribute(PREVIOUS_POSITION_ATTRIBUTE, new THREE.BufferAttribute(this.deformer.previousPositions!, 3).setUsage(THREE.DynamicDrawUsage));
+    const previous = new THREE.BufferAttribute(this.deformer.previousPositions!, 3).setUsage(THREE.DynamicDrawUsage);
+    this.mesh.geometry.setAttribute(PREVIOUS_POSITION_ATTRIBUTE, keepAttributeLive(previous, this.deformer, 'previousPositions'));
     const material = Array.isArray(this.baseMaterial) ? materials as THREE.Material[] : materials[0]!;
     this.mesh.material = material;
     this.velocity = { material };
