@@ -122,7 +122,7 @@ void groupBlendRuns(GcsDeformerImpl& m) {
 void finishModel(GcsDeformerImpl& m, bool runsGrouped) {
   const uint32_t S = uint32_t(m.sections.size());
   if (m.settings.smooth && !runsGrouped) groupBlendRuns(m);
-  m.sectionInfo.resize(size_t(S) * 8);
+  m.sectionInfo.resize(size_t(S) * GCS_SECTION_INFO_FLOATS);
   for (uint32_t i = 0; i < S; ++i) {
     Section& sec = m.sections[i];
     glm::vec3 lo(INFINITY), hi(-INFINITY);
@@ -133,15 +133,15 @@ void finishModel(GcsDeformerImpl& m, bool runsGrouped) {
     }
     sec.centre = sec.count ? 0.5f * (lo + hi) : glm::vec3(0.0f);  // a node only blended towards has no vertex
     sec.radius = sec.count ? 0.5f * glm::length(hi - lo) : 0.0f;
-    float* info = &m.sectionInfo[size_t(i) * 8];
-    info[0] = float(sec.first);
-    info[1] = float(sec.count);
-    info[2] = float(sec.part);
-    info[3] = float(sec.distal);
-    info[4] = sec.rigid ? 2.0f : sec.shared ? 1.0f : 0.0f;
-    info[5] = sec.t;
-    info[6] = sec.alpha;
-    info[7] = sec.beta;
+    float* info = &m.sectionInfo[size_t(i) * GCS_SECTION_INFO_FLOATS];
+    info[GCS_SECTION_INFO_FIRST] = float(sec.first);
+    info[GCS_SECTION_INFO_COUNT] = float(sec.count);
+    info[GCS_SECTION_INFO_PART] = float(sec.part);
+    info[GCS_SECTION_INFO_DISTAL] = float(sec.distal);
+    info[GCS_SECTION_INFO_KIND] = float(sec.rigid ? GCS_SECTION_RIGID : sec.shared ? GCS_SECTION_SHARED : GCS_SECTION_INNER);
+    info[GCS_SECTION_INFO_T] = sec.t;
+    info[GCS_SECTION_INFO_ALPHA] = sec.alpha;
+    info[GCS_SECTION_INFO_BETA] = sec.beta;
   }
   if (m.settings.criterion == GCS_CRITERION_WEIGHTS) {
     uint32_t most = 1;
@@ -210,8 +210,39 @@ void finishModel(GcsDeformerImpl& m, bool runsGrouped) {
   m.normals = m.restNormals;
 }
 
-// The settings are the C API's, checked there once (gcs_build_gcs).
-GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings) {
+bool validateSettings(const GcsSettings& given, ModelSettings& settings) {
+  if (given.sections < GCS_MIN_SECTIONS || given.sections > GCS_MAX_SECTIONS) {
+    fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
+         GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, given.sections);
+    return false;
+  }
+  if (given.criterion > GCS_CRITERION_WEIGHTS) {
+    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)", given.criterion);
+    return false;
+  }
+  if (!(given.influenceWidth > 0.0f && given.influenceWidth <= 1.0f)) {
+    fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(given.influenceWidth));
+    return false;
+  }
+  if (given.smooth < GCS_SMOOTH_BY_CRITERION || given.smooth > 1) {
+    fail(GCS_ERR_INVALID_ARGUMENT, "smooth must be 0, 1 or GCS_SMOOTH_BY_CRITERION (-1); got %d", int(given.smooth));
+    return false;
+  }
+  if (given.twistSpread < 0 || given.twistSpread > 1 || given.centres < 0 || given.centres > 1) {
+    fail(GCS_ERR_INVALID_ARGUMENT, "twistSpread and centres must be 0 or 1; got %d and %d", int(given.twistSpread), int(given.centres));
+    return false;
+  }
+  settings.sections = given.sections;
+  settings.criterion = GcsCriterion(given.criterion);
+  settings.influenceWidth = given.influenceWidth;
+  settings.smooth = given.smooth == GCS_SMOOTH_BY_CRITERION ? settings.criterion == GCS_CRITERION_WEIGHTS : given.smooth == 1;
+  settings.twistSpread = given.twistSpread == 1;
+  settings.centres = given.centres == 1;
+  return true;
+}
+
+// The settings are checked (validateSettings, by gcs_build_gcs).
+GcsDeformerImpl* buildGcs(const Rig& rig, const ModelSettings& settings) {
   GcsDeformerImpl* model = nullptr;
   try {
     model = new GcsDeformerImpl();

@@ -155,14 +155,14 @@ std::vector<uint32_t> sectionsFromKeys(GcsDeformerImpl& m, const std::vector<Wei
 }
 
 // The weights criterion (docs/method.md §2): sections are bins of the welded vertices' skin weights on
-// a grid of step 1/Q, Q = 2 · (sections − 2) (so the even split between two joints is a bin: their
-// shared section). Each section's blend is its members' mean weights on the joints of its key; a
+// a grid of step 1/Q, Q = GCS_WEIGHT_GRID_STEPS(sections) (so the even split between two joints is
+// a bin: their shared section). Each section's blend is its members' mean weights on the joints of its key; a
 // key with one joint is that joint's rigid core (transform exactly S_j). The stepped level of
 // detail (smooth: false); smooth mode builds nodes instead (buildWeightNodes).
 void buildWeightSections(const Rig& rig, GcsDeformerImpl& m, const std::vector<uint32_t>& representative,
                          std::vector<uint32_t>& sectionOfGroup) {
   const uint32_t G = uint32_t(representative.size());
-  const uint32_t Q = 2 * (m.settings.sections - 2);
+  const uint32_t Q = GCS_WEIGHT_GRID_STEPS(m.settings.sections);
   FlatIndex<WeightKey, WeightKeyHash> table(256);  // sections are far fewer than vertices (it grows)
   const std::vector<WeightKey>& keys = table.keys;
   std::vector<uint32_t> keyOf(G);
@@ -261,7 +261,7 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>&
   const uint32_t G = uint32_t(rig.cache.weldRepresentative.size());
   // Keys count weight in units of 1/(8Q): at level l the shape u gets 8·l units, so every node's
   // weights sit on one grid of 1/(8Q) (1/64 at the default) and the shape is resolved to s/(8l) ≤ 1/(8Q).
-  const uint32_t Q = 2 * (m.settings.sections - 2), total = 8 * Q;
+  const uint32_t Q = GCS_WEIGHT_GRID_STEPS(m.settings.sections), total = 8 * Q;
   FlatIndex<WeightKey, WeightKeyHash> table(256);  // nodes are far fewer than vertices (it grows)
   const std::vector<WeightKey>& keys = table.keys;
   auto keyId = [&](WeightKey key) {
