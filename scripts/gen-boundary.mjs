@@ -37,7 +37,7 @@ export function parseHeader(text) {
   const code = text.replace(/\/\*[\s\S]*?\*\//g, '');
   const enums = [];
   for (const [, name, body] of code.matchAll(/typedef enum (\w+) \{([^}]*)\} \1;/g)) {
-    const values = [...body.matchAll(/(\w+)\s*=\s*(\d+)/g)].map(([, k, v]) => [k, Number(v)]);
+    const values = [...body.matchAll(/(\w+)\s*=\s*(\d+)/g)].map(([, k, v]) => /** @type {[string, number]} */ ([k, Number(v)]));
     if (values.length !== body.split(',').length) throw new Error(`gen-boundary: enum ${name}: every value needs '= number'`);
     enums.push({ name, values, prefix: prefixOf(values.map(([k]) => k)) });
   }

@@ -320,7 +320,7 @@ if (args.jointsMarkdown) {
     const at = j.angles.indexOf(135);
     if (!j.joints.length) rows.push([`${rep.name}: ${j.notes.join('; ') || 'no knee or elbow found'}`, ...methods.map(() => ''), '']);
     for (const joint of j.joints) {
-      const f = ({ key }) => (joint.methods[key].error ? null : joint.methods[key][at]);
+      const f = ({ key }) => ('error' in joint.methods[key] ? null : joint.methods[key][at]);
       rows.push([`${rep.name}, ${joint.hinge.label}`, ...methods.map((m) => (f(m) ? `${num(f(m).bulgeP95, 2)} / ${num(f(m).bulgeMax, 2)}` : 'n/a')),
         methods.map((m) => (f(m) ? f(m).volumeChange.toFixed(1) : 'n/a')).join(' / ')]);
     }
