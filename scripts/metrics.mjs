@@ -23,11 +23,12 @@ import { rigInputFromSkinnedMesh, writeSkinMatrices } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import {
-  FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, restOfOutput,
+  FidelityProbe, METHODS, METHOD_LABELS, buildMethod, dominantJoints, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints,
+  restOfOutput,
 } from '../dist/measure.js';
 import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
 import {
-  bindCentres, dominantJoints, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
+  bindCentres, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
   rotateBoneWorld, signedVolume, worldPos,
 } from './bench/fidelity.mjs';
 

@@ -486,6 +486,13 @@ export class Rig {
   }
 }
 
+/** J identity matrices: the skin matrices of the bind pose (what `deform` takes at rest). */
+export function identitySkin(jointCount: number): Float32Array {
+  const skin = new Float32Array(jointCount * 16);
+  for (let j = 0; j < jointCount; j++) skin[16 * j] = skin[16 * j + 5] = skin[16 * j + 10] = skin[16 * j + 15] = 1;
+  return skin;
+}
+
 /** A runtime deformer: owns its output mesh in wasm memory and fills it every frame. */
 export class Deformer {
   readonly kind: DeformerKind;
