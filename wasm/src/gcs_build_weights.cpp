@@ -239,6 +239,32 @@ LatticeCell latticeCell(const float (&weight)[kMaxInfluences], uint32_t Q) {
   return cell;
 }
 
+// The key of a group's node at level l > 0 (d its dominant joint, s = 1 − w_d): d keeps 8·(Q − l)
+// units, the shape u's 8·l units go by largest remainders.
+WeightKey levelKey(const uint32_t* joint, const float* weight, uint32_t n, uint32_t d, float s, uint32_t l, uint32_t Q) {
+  WeightKey key;
+  key.n = n;
+  const uint32_t units = 8 * l;
+  float rem[kMaxInfluences] = {-1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f};
+  uint32_t used = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    key.joint[i] = joint[i];
+    if (i == d) continue;
+    const float share = s > 0.0f ? weight[i] / s * float(units) : 0.0f;
+    key.q[i] = uint32_t(std::floor(share));
+    rem[i] = share - float(key.q[i]);
+    used += key.q[i];
+  }
+  while (used < units) {
+    uint32_t best = d == 0 ? 1 : 0;
+    for (uint32_t i = 0; i < n; ++i)
+      if (i != d && rem[i] > rem[best]) best = i;
+    ++key.q[best], rem[best] = -1.0f, ++used;
+  }
+  key.q[d] = 8 * (Q - l);
+  return key;
+}
+
 // Smooth weights criterion (the default). A welded vertex's cleaned weights are w = (1 − s)·e_d + s·u:
 // d its dominant joint, s = 1 − w_d how far it lies from d's rigid core, u the shape of the rest
 // (the other joints' shares of s, summing to 1). Sections are NODES on the rays leaving each rigid
@@ -335,32 +361,12 @@ void buildWeightNodes(const Rig& rig, GcsDeformerImpl& m, std::vector<uint32_t>&
     const float x = s * float(Q);
     const uint32_t level = std::min(uint32_t(std::floor(x)), Q);
     const float frac = x - float(level);
-    // The node at level l: d keeps 8·(Q − l) units, the shape u's 8·l units go by largest remainders.
+    // The node at level l (levelKey), looked up once per (pair, level) where the group has a pair.
     uint32_t* pairLevels = byPair && groups.pairOf[g] != ~0u ? &pairNode[size_t(groups.pairOf[g]) * levels] : nullptr;
     auto nodeKey = [&](uint32_t l) {
       if (l == 0) return rigidId(joint[d]);  // the key below would reduce to it (canonical)
       if (pairLevels && pairLevels[l] != ~0u) return pairLevels[l];
-      WeightKey key;
-      key.n = n;
-      const uint32_t units = 8 * l;
-      float rem[kMaxInfluences] = {-1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f, -1.0f};
-      uint32_t used = 0;
-      for (uint32_t i = 0; i < n; ++i) {
-        key.joint[i] = joint[i];
-        if (i == d) continue;
-        const float share = s > 0.0f ? weight[i] / s * float(units) : 0.0f;
-        key.q[i] = uint32_t(std::floor(share));
-        rem[i] = share - float(key.q[i]);
-        used += key.q[i];
-      }
-      while (used < units) {
-        uint32_t best = d == 0 ? 1 : 0;
-        for (uint32_t i = 0; i < n; ++i)
-          if (i != d && rem[i] > rem[best]) best = i;
-        ++key.q[best], rem[best] = -1.0f, ++used;
-      }
-      key.q[d] = 8 * (Q - l);
-      const uint32_t id = keyId(key);
+      const uint32_t id = keyId(levelKey(joint, weight, n, d, s, l, Q));
       if (pairLevels) pairLevels[l] = id;
       return id;
     };
