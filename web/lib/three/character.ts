@@ -5,6 +5,7 @@ import type { DeformerKind, GcsSkin } from '../index.js';
 import type { PendingBuild } from './build.js';
 import type { Backend, GcsCharacterOptions, RebuildOptions } from './options.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
+import { SkeletonPoses } from './skeleton-poses.js';
 import { SkinDeformer } from './skin-deformer.js';
 
 /**
@@ -32,6 +33,9 @@ export class GcsCharacter {
   /** What update() refreshes: root, or a common ancestor of root and bones kept outside it. */
   private readonly scope: THREE.Object3D;
   private isDisposed = false;
+  /** Each skeleton posed once a frame, whatever the number of skins on it. */
+  private readonly poses = new SkeletonPoses();
+  private readonly skinUpdate = Object.freeze({ updateMatrixWorld: false, poses: this.poses });
 
   constructor(readonly gcs: GcsSkin, root: THREE.Object3D, options: GcsCharacterOptions = {}) {
     if (!root || !(root as THREE.Object3D).isObject3D) throw new GcsError('INVALID_ARGUMENT', 'GcsCharacter needs a THREE.Object3D (a glTF scene, a group or a SkinnedMesh)');
@@ -63,13 +67,15 @@ export class GcsCharacter {
 
   /**
    * Once per frame, after the mixer: one world-matrix update of the character (ancestors first),
-   * then every skin poses from its skeleton and deforms. No allocation.
+   * then each skeleton posed once (the skins sharing it read the same skin matrices) and every
+   * skin deforms. No allocation.
    */
   update(): void {
     if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCharacter has been disposed');
     updateWorld(this.scope);
+    this.poses.nextFrame();
     const skins = this.skins;
-    for (let i = 0; i < skins.length; i++) skins[i].update(NO_WORLD_UPDATE);
+    for (let i = 0; i < skins.length; i++) skins[i].update(this.skinUpdate);
   }
 
   /**
@@ -110,4 +116,3 @@ export class GcsCharacter {
   }
 }
 
-const NO_WORLD_UPDATE = Object.freeze({ updateMatrixWorld: false });
