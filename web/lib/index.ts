@@ -10,6 +10,10 @@
  *
  * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
  * 'DISPOSED'. Every failure is a GcsError with a `code`.
+ *
+ * One file for the core's API, over 700 lines on purpose: GcsSkin, Rig, the deformers and the pose
+ * buffers share internal state (handles, views on wasm memory, raise()) that a split would have to
+ * export; the boundary itself is boundary.generated.ts, the measures measure/, the adapters three/.
  */
 import {
   GCS_CLASSIC_DEFAULT_BULGE, GCS_CLASSIC_DEFAULT_CONTOURS, GCS_CLASSIC_DEFAULT_RAYS, GCS_CLASSIC_MAX_BULGE, GCS_CLASSIC_MAX_CONTOURS,
