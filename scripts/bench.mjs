@@ -101,7 +101,7 @@ function framesOf(mesh, clip) {
 /** The wasm memcpy of the bytes one GCS frame reads and writes (rest positions + normals in, positions + normals out). */
 function timeMemcpy(vertexCount, timing) {
   const bytes = vertexCount * 24;
-  const core = gcs.core;
+  const core = /** @type {any} */ (gcs).core; // the raw exports (internal to the library)
   const src = core.gcs_alloc(bytes), dst = core.gcs_alloc(bytes);
   if (!src || !dst) throw new Error('out of wasm memory for the memcpy bound');
   try {
@@ -119,7 +119,7 @@ function timeMemcpy(vertexCount, timing) {
  */
 function timeRatios(deformers, fr, vertexCount, timing) {
   const bytes = vertexCount * 24;
-  const core = gcs.core;
+  const core = /** @type {any} */ (gcs).core; // the raw exports (internal to the library)
   const src = core.gcs_alloc(bytes), dst = core.gcs_alloc(bytes);
   if (!src || !dst) throw new Error('out of wasm memory for the memcpy bound');
   try {

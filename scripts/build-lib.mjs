@@ -41,7 +41,7 @@ const placed = (file) => {
 };
 // Static `from '…'` and `import('…')` with a relative specifier, in .js and .d.ts alike.
 const RELATIVE_IMPORT = /(\bfrom\s*|\bimport\s*\(\s*)(['"])(\.{1,2}\/[^'"]+)\2/g;
-const files = readdirSync(staging, { recursive: true, withFileTypes: true }).filter((e) => e.isFile()).map((e) => join(e.parentPath ?? e.path, e.name));
+const files = readdirSync(staging, { recursive: true, withFileTypes: true }).filter((e) => e.isFile()).map((e) => join(e.parentPath ?? /** @type {any} */ (e).path, e.name));
 for (const file of files) {
   const target = placed(file);
   if (!target) throw new Error(`build-lib: tsc emitted ${relative(root, file)} for the command line, outside packages/cli/src and web/lib`);

@@ -64,7 +64,7 @@ const off = [['character / mesh', 'frames', 'off-surface p99 %', 'max %', 'worst
   'band triangles: min angle ° / under 5° / aspect max']];
 for (const ch of characters) {
   const heights = characterHeight(ch.meshes);
-  ch.meshes.flatMap((mesh, i) => [[mesh, i, false], [mesh, i, true]]).forEach(([mesh, i, rigid]) => {
+  ch.meshes.flatMap((mesh, i) => /** @type {[import('three').SkinnedMesh, number, boolean][]} */ ([[mesh, i, false], [mesh, i, true]])).forEach(([mesh, i, rigid]) => {
     const own = rigInputFromSkinnedMesh(mesh);
     const input = rigid ? rigidRebind(own) : own;  // rigid: a rig of rigid parts, like X Bot
     const rig = gcs.createRig(input);

@@ -23,11 +23,12 @@ import { rigInputFromSkinnedMesh, writeSkinMatrices } from '../dist/three.js';
 import { createHuman } from '../dist/human/index.js';
 import { characterHeight, loadGltfFile, rootOf, sampleClip } from '../packages/cli/dist/gltf-node.js';
 import {
-  FidelityProbe, METHODS, METHOD_LABELS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, restOfOutput,
+  FidelityProbe, METHODS, METHOD_LABELS, buildMethod, dominantJoints, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints,
+  restOfOutput,
 } from '../dist/measure.js';
 import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
 import {
-  bindCentres, dominantJoints, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
+  bindCentres, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
   rotateBoneWorld, signedVolume, worldPos,
 } from './bench/fidelity.mjs';
 
@@ -122,14 +123,29 @@ function fidelityOf(meshes, clips, heights) {
 function shapeOf(mesh, height) {
   const input = rigInputFromSkinnedMesh(mesh);
   const rig = gcs.createRig(input);
+  const posing = humanPoses(mesh);
+  const shape = {
+    ...posing, input, dominant: dominantJoints(input), centres: bindCentres(input),
+    bindProbe: new FidelityProbe(input, [identitySkin(posing.J)], { height }),
+    poseProbe: new FidelityProbe(input, Object.values(posing.poses), { height }),
+  };
+  const methods = eachMethod(rig, (d, method) => shapeFigures(d, method, shape));
+  rig.dispose();
+  return { mesh: mesh.name, poses: Object.keys(posing.poses), notes: posing.notes, methods };
+}
+
+/**
+ * The poses shapeOf measures, as skin-matrix sets from bones (found by their human names) rotated
+ * on top of the reference pose: the knee and the elbow bent 90° and 135°, both at once, the
+ * forearm twisted 90° and 180°; with what was not measured and why (notes).
+ */
+function humanPoses(mesh) {
   const bones = mesh.skeleton.bones;
   const root = rootOf(mesh);
   const J = bones.length;
   const rest0 = bones.map((b) => b.quaternion.clone());
   const resetPose = () => { bones.forEach((b, j) => b.quaternion.copy(rest0[j])); root.updateMatrixWorld(true); };
   const skinOf = () => { root.updateMatrixWorld(true); const s = new Float32Array(J * 16); writeSkinMatrices(mesh, s); return s; };
-  const dominant = dominantJoints(input);
-  const centres = bindCentres(input);
   const meshWorldInv = new THREE.Matrix4().copy(mesh.matrixWorld).invert();
   const toMesh = (v) => v.clone().transformDirection(meshWorldInv);
   const notes = [];
@@ -186,69 +202,67 @@ function shapeOf(mesh, height) {
     }
   }
   resetPose();
-  const bindProbe = new FidelityProbe(input, [identitySkin(J)], { height });
-  const poseProbe = new FidelityProbe(input, Object.values(poses), { height });
+  return { J, B, poses, bends, twist, notes };
+}
 
-  const methods = eachMethod(rig, (d, method) => {
-    const r = {};
-    const indices = d.indices;
-    const vj = outputJoints(d, dominant);
-    const restOut = restOfOutput(d, input.positions);
-    // At the bind pose the reference DQS is the rig's own positions: its distance is the rest error.
-    r.restError = bindProbe.measure(d).dqsMax;
-    r.flippedPoses = poseProbe.measure(d).flipped;
-    if (method === 'classic') r.detailLoss = d.detailLoss;
-    const deformed = (skin) => { d.deform(skin); return Float32Array.from(d.positions); };
-    const ref = deformed(poses.reference);
-    const closed = isClosed(restOut, indices);
-    const refVolume = closed ? signedVolume(ref, indices) : null;
-    // Joint thickness across the bend, in the bisector plane of the two bones, over the reference pose.
-    const thickness = (P, skin, s) => {
-      const cj = posedCentre(skin, B[s.joint], centres[B[s.joint]]);
-      const cu = posedCentre(skin, B[s.upper], centres[B[s.upper]]);
-      const cc = posedCentre(skin, B[s.child], centres[B[s.child]]);
-      const u = cj.clone().sub(cu), l = cc.clone().sub(cj);
-      const n = u.clone().normalize().add(l.clone().normalize()).normalize();
-      const e = new THREE.Vector3().crossVectors(bends[s.key].axisMesh, n).normalize();
-      const segments = [];
-      planeSection(P, indices, vj, new Set([B[s.upper], B[s.joint]]), cj, n, 0.6 * Math.min(u.length(), l.length()), segments);
-      return rayThickness(segments, cj, e, bends[s.key].axisMesh);
-    };
-    for (const key of Object.keys(bends)) {
-      const s = bends[key];
-      const t0 = thickness(ref, poses.reference, s);
-      for (const a of [90, 135]) {
-        const skin = poses[`${key}${a}`];
-        r[`${key}${a}`] = thickness(deformed(skin), skin, s) / t0;
-      }
+/** shapeOf's figures for one method's deformer `d`: rest error, flips, joint thickness, twist width, volume. */
+function shapeFigures(d, method, { input, dominant, centres, B, poses, bends, twist, bindProbe, poseProbe }) {
+  const r = {};
+  const indices = d.indices;
+  const vj = outputJoints(d, dominant);
+  const restOut = restOfOutput(d, input.positions);
+  // At the bind pose the reference DQS is the rig's own positions: its distance is the rest error.
+  r.restError = bindProbe.measure(d).dqsMax;
+  r.flippedPoses = poseProbe.measure(d).flipped;
+  if (method === 'classic') r.detailLoss = d.detailLoss;
+  const deformed = (skin) => { d.deform(skin); return Float32Array.from(d.positions); };
+  const ref = deformed(poses.reference);
+  const closed = isClosed(restOut, indices);
+  const refVolume = closed ? signedVolume(ref, indices) : null;
+  // Joint thickness across the bend, in the bisector plane of the two bones, over the reference pose.
+  const thickness = (P, skin, s) => {
+    const cj = posedCentre(skin, B[s.joint], centres[B[s.joint]]);
+    const cu = posedCentre(skin, B[s.upper], centres[B[s.upper]]);
+    const cc = posedCentre(skin, B[s.child], centres[B[s.child]]);
+    const u = cj.clone().sub(cu), l = cc.clone().sub(cj);
+    const n = u.clone().normalize().add(l.clone().normalize()).normalize();
+    const e = new THREE.Vector3().crossVectors(bends[s.key].axisMesh, n).normalize();
+    const segments = [];
+    planeSection(P, indices, vj, new Set([B[s.upper], B[s.joint]]), cj, n, 0.6 * Math.min(u.length(), l.length()), segments);
+    return rayThickness(segments, cj, e, bends[s.key].axisMesh);
+  };
+  for (const key of Object.keys(bends)) {
+    const s = bends[key];
+    const t0 = thickness(ref, poses.reference, s);
+    for (const a of [90, 135]) {
+      const skin = poses[`${key}${a}`];
+      r[`${key}${a}`] = thickness(deformed(skin), skin, s) / t0;
     }
-    // Twist: narrowest width of the arm's cross-sections from above the elbow to mid-forearm, over rest.
-    if (twist) {
-      const ce = centres[B.LeftForeArm], ch = centres[B.LeftHand];
-      const along = ch.clone().sub(ce);
-      const n = twist.axisMesh;
-      const u = new THREE.Vector3().crossVectors(n, Math.abs(n.y) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0)).normalize();
-      const w = new THREE.Vector3().crossVectors(n, u);
-      const limb = new Set([B.LeftArm, B.LeftForeArm, B.LeftHand]);
-      const ts = [-0.2, -0.1, 0, 0.1, 0.2, 0.35, 0.5];
-      const widths = (P, skin) => ts.map((t) => {
-        const c = posedCentre(skin, B.LeftArm, ce.clone().addScaledVector(along, t)); // the upper arm stays put under the twist
-        return minWidth(planeSection(P, indices, vj, limb, c, n, 0.5 * along.length()), u, w);
-      });
-      const w0 = widths(ref, poses.reference);
-      for (const a of [90, 180]) {
-        const skin = poses[`twist${a}`];
-        const wa = widths(deformed(skin), skin);
-        r[`twist${a}`] = Math.min(...wa.map((x, i) => x / w0[i]).filter(Number.isFinite));
-      }
+  }
+  // Twist: narrowest width of the arm's cross-sections from above the elbow to mid-forearm, over rest.
+  if (twist) {
+    const ce = centres[B.LeftForeArm], ch = centres[B.LeftHand];
+    const along = ch.clone().sub(ce);
+    const n = twist.axisMesh;
+    const u = new THREE.Vector3().crossVectors(n, Math.abs(n.y) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0)).normalize();
+    const w = new THREE.Vector3().crossVectors(n, u);
+    const limb = new Set([B.LeftArm, B.LeftForeArm, B.LeftHand]);
+    const ts = [-0.2, -0.1, 0, 0.1, 0.2, 0.35, 0.5];
+    const widths = (P, skin) => ts.map((t) => {
+      const c = posedCentre(skin, B.LeftArm, ce.clone().addScaledVector(along, t)); // the upper arm stays put under the twist
+      return minWidth(planeSection(P, indices, vj, limb, c, n, 0.5 * along.length()), u, w);
+    });
+    const w0 = widths(ref, poses.reference);
+    for (const a of [90, 180]) {
+      const skin = poses[`twist${a}`];
+      const wa = widths(deformed(skin), skin);
+      r[`twist${a}`] = Math.min(...wa.map((x, i) => x / w0[i]).filter(Number.isFinite));
     }
-    if (closed) for (const a of [90, 135]) if (poses[`bend${a}`]) r[`volume${a}`] = signedVolume(deformed(poses[`bend${a}`]), indices) / refVolume;
-    r.closed = closed;
-    r.triangles = indices.length / 3;
-    return r;
-  });
-  rig.dispose();
-  return { mesh: mesh.name, poses: Object.keys(poses), notes, methods };
+  }
+  if (closed) for (const a of [90, 135]) if (poses[`bend${a}`]) r[`volume${a}`] = signedVolume(deformed(poses[`bend${a}`]), indices) / refVolume;
+  r.closed = closed;
+  r.triangles = indices.length / 3;
+  return r;
 }
 
 /** The knees and elbows of one mesh, each bent alone (measureJoints), with the time it took. */
@@ -320,7 +334,7 @@ if (args.jointsMarkdown) {
     const at = j.angles.indexOf(135);
     if (!j.joints.length) rows.push([`${rep.name}: ${j.notes.join('; ') || 'no knee or elbow found'}`, ...methods.map(() => ''), '']);
     for (const joint of j.joints) {
-      const f = ({ key }) => (joint.methods[key].error ? null : joint.methods[key][at]);
+      const f = ({ key }) => ('error' in joint.methods[key] ? null : joint.methods[key][at]);
       rows.push([`${rep.name}, ${joint.hinge.label}`, ...methods.map((m) => (f(m) ? `${num(f(m).bulgeP95, 2)} / ${num(f(m).bulgeMax, 2)}` : 'n/a')),
         methods.map((m) => (f(m) ? f(m).volumeChange.toFixed(1) : 'n/a')).join(' / ')]);
     }

@@ -17,7 +17,6 @@ import { MeshoptEncoder } from 'meshoptimizer';
 import { npm, packTarballs, ROOT, sizeOf, userEnv, type Tarballs } from './helpers/pack.js';
 import { quoted, quotes } from './helpers/readme.js';
 import { startRegistry, upstreamRegistry } from './helpers/registry.js';
-// @ts-expect-error: a plain .mjs script, no types
 import { installedSizes } from '../scripts/install-size.mjs';
 
 const npx = process.platform === 'win32' ? 'npx.cmd' : 'npx';

@@ -24,18 +24,6 @@ export function worldPos(bone) {
   return bone.getWorldPosition(new THREE.Vector3());
 }
 
-/** Dominant joint of each rig vertex. */
-export function dominantJoints(input) {
-  const n = input.positions.length / 3;
-  const out = new Int32Array(n);
-  for (let v = 0; v < n; v++) {
-    let best = -1, bw = -Infinity;
-    for (let k = 0; k < 4; k++) if (input.weights[4 * v + k] > bw) { bw = input.weights[4 * v + k]; best = input.joints[4 * v + k]; }
-    out[v] = best;
-  }
-  return out;
-}
-
 /** Joint of each output vertex of a deformer: via sourceVertex, or the classic model's parts. */
 export function outputJoints(deformer, rigDominant) {
   const out = new Int32Array(deformer.vertexCount).fill(-1);

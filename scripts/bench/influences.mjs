@@ -80,7 +80,7 @@ async function measureBuild(dist, withSpread) {
     const base = rigInputFromSkinnedMesh(c.mesh);
     for (const [label, input] of withSpread ? [['4', base], ['8', spread(base)]] : [['4', base]]) {
       const rig = gcs.createRig(input);
-      const row = out[`${c.name}/${label}`] = { vertices: rig.vertexCount };
+      const row = out[`${c.name}/${label}`] = /** @type {Record<string, any>} */ ({ vertices: rig.vertexCount });
       for (const method of METHODS) {
         const builds = [];
         let d;

@@ -13,6 +13,7 @@ import { EXTMeshoptCompression, KHRDracoMeshCompression, KHRMeshQuantization } f
 import { draco, meshopt, quantize } from '@gltf-transform/functions';
 import { MeshoptDecoder, MeshoptEncoder } from 'meshoptimizer';
 // draco3dgltf (CommonJS, no types): createEncoderModule / createDecoderModule
+// @ts-expect-error: the package ships no types
 import draco3d from 'draco3dgltf';
 import { createHuman, humanToGlb } from '../../web/lib/human/index.js';
 import { run, type Report } from '../../packages/cli/src/report.js';
@@ -174,7 +175,7 @@ describe('8 influences per vertex', () => {
       }
       expected.push(m);
     }
-    const acc = (a: Uint16Array | Float32Array) => doc.createAccessor().setType('VEC4').setArray(a).setBuffer(j0.getBuffer());
+    const acc = (a: Uint16Array<ArrayBuffer> | Float32Array<ArrayBuffer>) => doc.createAccessor().setType('VEC4').setArray(a).setBuffer(j0.getBuffer());
     prim.setAttribute('JOINTS_0', acc(joints0)).setAttribute('WEIGHTS_0', acc(weights0));
     prim.setAttribute('JOINTS_1', acc(joints1)).setAttribute('WEIGHTS_1', acc(weights1));
     const file = join(dir, 'human-8.glb');

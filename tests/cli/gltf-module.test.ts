@@ -89,7 +89,7 @@ describe('loadCharacter', () => {
     const rig = gcs.createRig(m.rigInput);
     const d = rig.buildGcs({ sections: 6 });
     d.deform(rest);
-    const src = d.sourceVertex;
+    const src = d.sourceVertex!;
     let err = 0;
     for (let v = 0; v < d.vertexCount; v++)
       for (let k = 0; k < 3; k++) err = Math.max(err, Math.abs(d.positions[3 * v + k] - m.rigInput.positions[3 * src[v] + k]));

@@ -219,7 +219,7 @@ describe('human: default body', () => {
         mixer.setTime((f / (frames - 1)) * clip.duration * 0.9999);
         mesh.updateMatrixWorld(true);
         mesh.skeleton.update();
-        for (const m of mesh.skeleton.boneMatrices) expect(Number.isFinite(m)).toBe(true);
+        for (const m of mesh.skeleton.boneMatrices!) expect(Number.isFinite(m)).toBe(true);
       }
     }
   });
@@ -292,7 +292,7 @@ describe('human: default body', () => {
     mixer.setTime(0.3);
     gltf.scene.updateMatrixWorld(true);
     sk!.skeleton.update();
-    for (const m of sk!.skeleton.boneMatrices) expect(Number.isFinite(m)).toBe(true);
+    for (const m of sk!.skeleton.boneMatrices!) expect(Number.isFinite(m)).toBe(true);
   });
 });
 

@@ -1,115 +1,111 @@
-// The wasm boundary, read from the header: wasm/include/gcs_skin.h is the one statement of the C
-// API, and what the JavaScript side restates of it (the export table and its unsigned results,
-// error codes, enums, limits, texel constants, the version) must say the same. A change to the
-// header that the wrapper does not follow fails here. Also: an unknown error code from the core is
-// an error of its own, and a core of another version is refused at load.
+// The wasm boundary, one statement: wasm/include/gcs_skin.h. The TypeScript side (every function
+// with its arguments, unsigned results, error codes, enums, limits, defaults, packed layouts, the
+// settings struct) is generated from it (scripts/gen-boundary.mjs → web/lib/boundary.generated.ts,
+// committed). Here: the committed file is what the header gives today (any drift fails, argument
+// counts included), the binary exports what the header declares with as many arguments, the
+// header's comments name only what exists, and the defaults the docs state are the header's.
+// Also: an unknown error code from the core is an error of its own, and a core of another version
+// is refused at load.
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { beforeAll, describe, expect, test } from 'vitest';
 import {
-  CLASSIC_LIMITS, CLASSIC_REASONS, CRITERIA, GcsError, GPU_TEXELS_PER_JOINT, GPU_TEXELS_PER_SECTION, initGcsSkin, MAX_INFLUENCES,
-  MAX_INSTANCES, MAX_SECTIONS, MIN_SECTIONS, version, type GcsSkin, type RigInput,
+  CLASSIC_DEFAULTS, CRITERIA, GCS_DEFAULTS, GcsError, initGcsSkin, version, type GcsSkin, type RigInput,
 } from '../../web/lib/index.js';
-import { DEFORMER_KINDS, STATS } from '../../web/lib/core-enums.js';
-import { CORE_ERROR_CODES } from '../../web/lib/errors.js';
-import { UNSIGNED_RESULTS } from '../../web/lib/loader.js';
+import {
+  ARGUMENT_COUNTS, GCS_MAX_VERTICES, GCS_VERSION, GcsSettingsBytes, GcsStat, writeGcsSettings, type GcsSettings,
+} from '../../web/lib/boundary.generated.js';
 import { LIMITS as GLTF_LIMITS } from '../../web/lib/gltf/limits.js';
+import { generateBoundary, GENERATED, HEADER, parseHeader } from '../../scripts/gen-boundary.mjs';
 import { makeTube } from '../helpers/cylinder.js';
 
 const ROOT = join(__dirname, '../..');
-const header = readFileSync(join(ROOT, 'wasm/include/gcs_skin.h'), 'utf8');
-const code = header.replace(/\/\*[\s\S]*?\*\//g, ''); // the declarations, without the comments
+const header = readFileSync(HEADER, 'utf8');
 
-/** `#define GCS_X value` → value (numeric; GCS_VERSION evaluated from its parts). */
-function defines(): Map<string, number> {
-  const out = new Map<string, number>();
-  for (const [, name, value] of code.matchAll(/^#define (GCS_\w+)[ \t]+(.+?)\s*$/gm)) {
-    const expr = value.replace(/\b(GCS_\w+)\b/g, (_, n: string) => String(out.get(n) ?? NaN)).replace(/(\d)f\b/g, '$1');
-    if (!/^[\d\s.+*()-]+$/.test(expr)) throw new Error(`cannot read #define ${name} ${value}`);
-    out.set(name, Function(`return (${expr});`)() as number);
-  }
-  return out;
-}
-
-/** `typedef enum Name { A = 0, B = 1 } Name;` → [[A, 0], [B, 1]]. */
-function enumOf(name: string): [string, number][] {
-  const body = new RegExp(`typedef enum ${name} \\{([\\s\\S]*?)\\} ${name};`).exec(code)?.[1];
-  if (!body) throw new Error(`no enum ${name} in the header`);
-  return [...body.matchAll(/(\w+)\s*=\s*(\d+)/g)].map(([, k, v]) => [k, Number(v)]);
-}
-
-/** Every function the header declares, with whether its result is a pointer or a uint32_t. */
-function functions(): { name: string; unsigned: boolean }[] {
-  return [...code.matchAll(/^((?:const\s+)?[A-Za-z_]\w*\s*\**)\s*(gcs_\w+)\s*\(/gm)]
-    .map(([, ret, name]) => ({ name, unsigned: ret.includes('*') || ret.trim() === 'uint32_t' }));
-}
-
-/** The members of the loader's CoreExports interface (its source). */
-function loaderExports(): string[] {
-  const loader = readFileSync(join(ROOT, 'web/lib/loader.ts'), 'utf8');
-  const body = /export interface CoreExports \{([\s\S]*?)\n\}/.exec(loader)![1];
-  return [...body.matchAll(/^\s+(gcs_\w+)\(/gm)].map((m) => m[1]);
-}
-
-const sorted = (a: Iterable<string>) => [...a].sort();
-
-describe('the JavaScript side says what gcs_skin.h says', () => {
-  test('every function: in the loader, in the binary, unsigned results read as unsigned', () => {
-    const declared = functions();
-    expect(declared.length).toBeGreaterThan(40);
-    expect(sorted(loaderExports())).toEqual(sorted(declared.map((f) => f.name)));
-    const wasm = new WebAssembly.Module(readFileSync(join(ROOT, 'web/lib/gcs-skin.wasm')));
-    const exported = WebAssembly.Module.exports(wasm).filter((e) => e.kind === 'function' && e.name.startsWith('gcs_')).map((e) => e.name);
-    expect(sorted(exported)).toEqual(sorted(declared.map((f) => f.name)));
-    expect(sorted(UNSIGNED_RESULTS)).toEqual(sorted(declared.filter((f) => f.unsigned).map((f) => f.name)));
+describe('the TypeScript side is generated from gcs_skin.h', () => {
+  test('the committed boundary.generated.ts is what the header gives (npm run gen:boundary rewrites it)', () => {
+    expect(readFileSync(GENERATED, 'utf8')).toBe(generateBoundary(header));
   });
 
-  test('error codes: GcsError by number', () => {
-    const entries = enumOf('GcsError');
-    expect(CORE_ERROR_CODES.length).toBe(Math.max(...entries.map(([, v]) => v)) + 1);
-    for (const [name, n] of entries) expect(CORE_ERROR_CODES[n], name).toBe(name === 'GCS_OK' ? null : name.replace(/^GCS_ERR_/, ''));
+  test('drift is caught: an argument added to a function, a renumbered enum, a changed limit', () => {
+    const committed = readFileSync(GENERATED, 'utf8');
+    const drifted = [
+      header.replace('GcsDeformer* gcs_build_gcs(const GcsRig* rig, const GcsSettings* settings);',
+        'GcsDeformer* gcs_build_gcs(const GcsRig* rig, const GcsSettings* settings, int extra);'),
+      header.replace('GCS_STAT_ADJUSTED_SECTIONS = 3', 'GCS_STAT_ADJUSTED_SECTIONS = 4'),
+      header.replace('#define GCS_MAX_SECTIONS 256', '#define GCS_MAX_SECTIONS 255'),
+    ];
+    for (const text of drifted) expect(text).not.toBe(header);
+    expect(generateBoundary(drifted[0])).toMatch(/gcs_build_gcs: 3,/);
+    for (const text of drifted) expect(generateBoundary(text)).not.toBe(committed);
   });
 
-  test('enums: criteria, deformer kinds, statistics, classic reasons', () => {
-    for (const [name, n] of enumOf('GcsCriterion')) expect(CRITERIA[n], name).toBe(name.replace(/^GCS_CRITERION_/, '').toLowerCase());
-    expect(CRITERIA.length).toBe(enumOf('GcsCriterion').length);
-    for (const [name, n] of enumOf('GcsDeformerKind')) expect(DEFORMER_KINDS[n], name).toBe(name.replace(/^GCS_KIND_/, '').toLowerCase());
-    expect(DEFORMER_KINDS.length).toBe(enumOf('GcsDeformerKind').length);
-    const camel = (s: string) => s.toLowerCase().replace(/_(\w)/g, (_, c: string) => c.toUpperCase());
-    expect(Object.fromEntries(enumOf('GcsStat').map(([name, n]) => [camel(name.replace(/^GCS_STAT_/, '')), n]))).toEqual(STATS);
-    for (const [name, n] of enumOf('GcsClassicReason'))
-      expect(CLASSIC_REASONS[n], name).toBe(name.replace(/^GCS_CLASSIC_/, '').toLowerCase().replace(/_/g, '-'));
-    expect(CLASSIC_REASONS.length).toBe(enumOf('GcsClassicReason').length);
+  test('what the generator cannot read is an error, not a silent gap', () => {
+    expect(() => generateBoundary(`${header}\n#define GCS_ODD "text"\n`)).toThrow(/cannot read #define GCS_ODD/);
+    expect(() => generateBoundary(`${header}\ntypedef struct GcsOdd { double x; } GcsOdd;\n`)).toThrow(/cannot lay out 'double x'/);
+    expect(() => generateBoundary(`${header}\ntypedef enum GcsOdd { GCS_ODD_A, GCS_ODD_B = 1 } GcsOdd;\n`)).toThrow(/enum GcsOdd/);
   });
 
-  test('limits, texel constants and the version: every #define has its JavaScript value', () => {
-    const v = version().split('.').map(Number);
-    const pkg = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')).version as string;
-    expect(version()).toBe(pkg);
-    const js: Record<string, number> = {
-      GCS_VERSION_MAJOR: v[0], GCS_VERSION_MINOR: v[1], GCS_VERSION_PATCH: v[2], GCS_VERSION: v[0] * 10000 + v[1] * 100 + v[2],
-      GCS_MIN_SECTIONS: MIN_SECTIONS, GCS_MAX_SECTIONS: MAX_SECTIONS, GCS_MAX_INFLUENCES: MAX_INFLUENCES,
-      GCS_MAX_VERTICES: GLTF_LIMITS.vertices, GCS_MAX_INSTANCES: MAX_INSTANCES,
-      GCS_GPU_TEXELS_PER_SECTION: GPU_TEXELS_PER_SECTION, GCS_GPU_TEXELS_PER_JOINT: GPU_TEXELS_PER_JOINT,
-      GCS_CLASSIC_MIN_CONTOURS: CLASSIC_LIMITS.minContours, GCS_CLASSIC_MAX_CONTOURS: CLASSIC_LIMITS.maxContours,
-      GCS_CLASSIC_MIN_RAYS: CLASSIC_LIMITS.minRays, GCS_CLASSIC_MAX_RAYS: CLASSIC_LIMITS.maxRays, GCS_CLASSIC_MAX_BULGE: CLASSIC_LIMITS.maxBulge,
-    };
-    // Checked by the core alone (the wrapper passes them through and reports the core's error).
-    const coreOnly = ['GCS_MAX_JOINTS', 'GCS_MAX_MORPH_TARGETS'];
-    const found = defines();
-    expect(sorted(found.keys())).toEqual(sorted([...Object.keys(js), ...coreOnly]));
-    for (const [name, value] of Object.entries(js)) expect(value, name).toBe(found.get(name));
+  test('the binary exports every declared function, each with the declared number of arguments', async () => {
+    const { functions } = parseHeader(header);
+    expect(functions.length).toBeGreaterThan(40);
+    const module = new WebAssembly.Module(readFileSync(join(ROOT, 'web/lib/gcs-skin.wasm')));
+    const exported = WebAssembly.Module.exports(module).filter((e) => e.kind === 'function' && e.name.startsWith('gcs_')).map((e) => e.name);
+    expect(exported.sort()).toEqual(functions.map((f) => f.name).sort());
+    const instance = await WebAssembly.instantiate(module, {
+      env: { emscripten_notify_memory_growth: () => {} }, wasi_snapshot_preview1: { proc_exit: () => {} },
+    });
+    const raw = instance.exports as Record<string, unknown>;
+    for (const f of functions) {
+      expect((raw[f.name] as (...a: number[]) => number).length, f.name).toBe(f.args.length);
+      expect(ARGUMENT_COUNTS[f.name as keyof typeof ARGUMENT_COUNTS], f.name).toBe(f.args.length);
+    }
+  });
+
+  test("the header's comments name only what it declares, and document every statistic", () => {
+    const code = header.replace(/\/\*[\s\S]*?\*\//g, '');
+    const comments = [...header.matchAll(/\/\*[\s\S]*?\*\//g)].map((m) => m[0]).join('\n');
+    const declared = new Set(code.match(/\b(GCS_\w+|gcs_\w+|Gcs\w+)\b/g));
+    const named = new Set(comments.match(/\b(GCS_\w*[A-Z0-9]|gcs_\w*[a-z0-9]|Gcs[A-Z]\w*)\b/g));
+    expect([...named].filter((n) => !declared.has(n))).toEqual([]);
+    const statDocs = /\* Per-deformer statistics[\s\S]*?\*\//.exec(header)![0];
+    for (const [name] of parseHeader(header).enums.find((e) => e.name === 'GcsStat')!.values) expect(statDocs, name).toContain(name);
+  });
+
+  test('the limits the glTF reader shares with the core are the same', () => {
+    expect(GLTF_LIMITS.vertices).toBe(GCS_MAX_VERTICES);
+    const [major, minor, patch] = version().split('.').map(Number);
+    expect(major * 10000 + minor * 100 + patch).toBe(GCS_VERSION);
+    expect(version()).toBe(JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')).version);
+  });
+
+  test("the defaults the library's docs state are the header's", () => {
+    const index = readFileSync(join(ROOT, 'web/lib/index.ts'), 'utf8');
+    const stated = [...index.matchAll(/Default `(GCS|CLASSIC)_DEFAULTS\.(\w+)` \(([^,)]+)/g)];
+    expect(stated.length).toBe(8); // every option but smooth, whose default depends on the criterion
+    const defaults: Record<string, Record<string, unknown>> = { GCS: GCS_DEFAULTS, CLASSIC: CLASSIC_DEFAULTS };
+    for (const [, group, key, value] of stated) expect(String(defaults[group][key]), `${group}_DEFAULTS.${key}`).toBe(value.replace(/'/g, ''));
   });
 });
 
-describe('version and unknown codes at run time', () => {
+describe('the core at run time', () => {
   let gcs: GcsSkin;
   beforeAll(async () => {
     gcs = await initGcsSkin();
   });
 
   test("the binary's gcs_version() is the header's GCS_VERSION", () => {
-    expect(gcs.core.gcs_version()).toBe(defines().get('GCS_VERSION'));
+    expect(gcs.core.gcs_version()).toBe(GCS_VERSION);
+  });
+
+  test('smooth left out is the default the library documents, under every criterion (the core resolves it)', () => {
+    const rig = gcs.createRig(makeTube().input);
+    for (const criterion of CRITERIA) {
+      const d = rig.buildGcs({ criterion });
+      expect(d.blendOther() !== null, criterion).toBe(GCS_DEFAULTS.smooth(criterion));
+      d.dispose();
+    }
+    rig.dispose();
   });
 
   test("an error code the wrapper does not know is UNKNOWN_CORE_ERROR, with the core's number and sentence", () => {
@@ -128,23 +124,34 @@ describe('version and unknown codes at run time', () => {
     }
     expect(GcsError.codeFromNumber(0)).toBe('UNKNOWN_CORE_ERROR'); // a failure reported as GCS_OK
     expect(GcsError.codeFromNumber(7)).toBe('SECTION_COUNT');
+    expect(GcsStat.adjustedSections).toBe(3);
   });
 
-  test('the core checks gcs_build_gcs\'s settings itself (C callers have no wrapper), each once', () => {
+  test("the core checks gcs_build_gcs's settings itself (C callers have no wrapper), once", () => {
     const rig = gcs.createRig(makeTube().input);
     const handle = (rig as unknown as { handle: number }).handle;
     const core = gcs.core;
-    const refused = (sections: number, criterion: number, width: number) => {
-      expect(core.gcs_build_gcs(handle, sections, criterion, width, 1, 0)).toBe(0);
+    const ptr = core.gcs_alloc(GcsSettingsBytes);
+    const build = (change: Partial<GcsSettings>) => {
+      writeGcsSettings(gcs.memory.buffer, ptr, { sections: 6, criterion: 2, influenceWidth: 1, smooth: 1, twistSpread: 0, centres: 0, ...change });
+      return core.gcs_build_gcs(handle, ptr);
+    };
+    const refused = (change: Partial<GcsSettings>) => {
+      expect(build(change)).toBe(0);
       return { code: core.gcs_last_error_code(), message: (() => { try { gcs.raise(''); } catch (e) { return (e as Error).message; } })() };
     };
-    expect(refused(2, 2, 1)).toEqual({ code: 7, message: expect.stringMatching(/between 3 and 256 .*got 2$/) });
-    expect(refused(257, 2, 1)).toEqual({ code: 7, message: expect.stringMatching(/got 257$/) });
-    expect(refused(6, 3, 1)).toEqual({ code: 1, message: expect.stringMatching(/unknown section criterion 3/) });
-    expect(refused(6, 0, 0)).toEqual({ code: 9, message: expect.stringMatching(/influence width must be in \(0, 1\]; got 0/) });
-    const ok = core.gcs_build_gcs(handle, 6, 2, 1, 1, 0);
+    expect(refused({ sections: 2 })).toEqual({ code: 7, message: expect.stringMatching(/between 3 and 256 .*got 2$/) });
+    expect(refused({ sections: 257 })).toEqual({ code: 7, message: expect.stringMatching(/got 257$/) });
+    expect(refused({ criterion: 3 })).toEqual({ code: 1, message: expect.stringMatching(/unknown section criterion 3/) });
+    expect(refused({ influenceWidth: 0 })).toEqual({ code: 9, message: expect.stringMatching(/influence width must be in \(0, 1\]; got 0/) });
+    expect(refused({ smooth: 2 })).toEqual({ code: 1, message: expect.stringMatching(/smooth must be 0, 1 or .*got 2$/) });
+    expect(refused({ centres: -1 })).toEqual({ code: 1, message: expect.stringMatching(/centres must be 0 or 1; got 0 and -1$/) });
+    expect(core.gcs_build_gcs(handle, 0)).toBe(0);
+    expect(core.gcs_last_error_code()).toBe(1);
+    const ok = build({ smooth: -1 });
     expect(ok).not.toBe(0);
     core.gcs_deformer_destroy(ok);
+    core.gcs_free(ptr);
     rig.dispose();
   });
 

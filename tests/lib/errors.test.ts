@@ -3,6 +3,7 @@
 import { beforeAll, describe, expect, test } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsSkin, type RigInput } from '../../web/lib/index.js';
+import { GcsSettingsBytes, writeGcsSettings } from '../../web/lib/boundary.generated.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
 
 let gcs: GcsSkin;
@@ -127,12 +128,18 @@ describe('model settings', () => {
     const rig = gcs.createRig(makeTube().input);
     const core = gcs.core;
     const handle = (rig as unknown as { handle: number }).handle;
-    expect(core.gcs_build_gcs(handle, 2, 1, 1, 0, 0, 0)).toBe(0);
+    const settings = core.gcs_alloc(GcsSettingsBytes);
+    const withSettings = (sections: number, criterion: number) => {
+      writeGcsSettings(gcs.memory.buffer, settings, { sections, criterion, influenceWidth: 1, smooth: 0, twistSpread: 0, centres: 0 });
+      return settings;
+    };
+    expect(core.gcs_build_gcs(handle, withSettings(2, 1))).toBe(0);
     expect(core.gcs_last_error_code()).toBe(7);
-    expect(core.gcs_build_gcs(handle, 6, 9, 1, 0, 0, 0)).toBe(0);
+    expect(core.gcs_build_gcs(handle, withSettings(6, 9))).toBe(0);
     expect(core.gcs_last_error_code()).toBe(1);
-    expect(core.gcs_build_gcs(0, 6, 1, 1, 0, 0, 0)).toBe(0);
+    expect(core.gcs_build_gcs(0, withSettings(6, 1))).toBe(0);
     expect(core.gcs_last_error_code()).toBe(1);
+    core.gcs_free(settings);
     rig.dispose();
   });
 });

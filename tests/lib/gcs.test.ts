@@ -369,7 +369,7 @@ describe('a mesh that uses a few joints of a larger skeleton', () => {
     // The tube's joints 0 and 1 become 1 and 2 under an unused root (0); the tip (3) is unused too.
     const tube = makeTube();
     const { input } = tube;
-    const joints = input.joints.map((j, i) => (input.weights[i] > 0 ? j + 1 : 0));
+    const joints = Array.from(input.joints, (j, i) => (input.weights[i] > 0 ? j + 1 : 0));
     const ibm = new Float32Array(64);
     ibm.set(new THREE.Matrix4().elements, 0);
     ibm.set(input.inverseBindMatrices, 16);

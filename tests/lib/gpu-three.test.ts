@@ -204,7 +204,7 @@ describe('GPU backend (three.js adapter)', () => {
     const character = new GcsCharacter(gcs, group, { backend: 'gpu' });
     const skin = character.skins[0];
     expect(skin.backend).toBe('gpu');
-    const morph = skin.mesh.geometry.morphAttributes.position[0];
+    const morph = skin.mesh.geometry.morphAttributes.position![0];
     const src = skin.deformer.sourceVertex!;
     expect(morph.count).toBe(src.length);
     expect(skin.mesh.morphTargetInfluences).toBe(mesh.morphTargetInfluences);

@@ -25,7 +25,7 @@ function tubeSkinnedMesh() {
   bones[2].position.y = 1;
   bones[0].add(bones[1]);
   bones[1].add(bones[2]);
-  const mesh = new THREE.SkinnedMesh(g, new THREE.MeshBasicMaterial());
+  const mesh = new THREE.SkinnedMesh<THREE.BufferGeometry, THREE.Material | THREE.Material[]>(g, new THREE.MeshBasicMaterial());
   const group = new THREE.Group();
   group.position.set(3, 0, -2);
   group.rotation.y = 0.7;

@@ -1,4 +1,4 @@
-// The default GCS's nodes in weight space (wasm/src/gcs_model.cpp, buildWeightNodes): each vertex's
+// The default GCS's nodes in weight space (wasm/src/gcs_build_weights.cpp, buildWeightNodes): each vertex's
 // blend of its nodes reproduces its own skin weights. Two-joint vertices blend two nodes on a ray
 // from a rigid core; three-joint vertices the three corners of their weight-lattice cell. A wrong
 // corner or barycentric factor, or a cell of the wrong triangulation, shows as a weight mismatch;

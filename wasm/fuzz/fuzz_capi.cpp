@@ -77,6 +77,12 @@ std::string g_context;  // what is being checked (printed with a failure)
 // not 1e20: the normal matrix of a non-uniform or mirrored 1e20 scale overflows), tinynormal (no
 // unit-normal check for scales whose axes differ by more than 1e6: a normal of length 1e-22 or
 // 1e-30 is normalised from underflowed squares, or not at all). Reproducers: wasm/fuzz/findings.
+// gcs_build_gcs with its settings given one by one (the fuzzer picks each).
+GcsDeformer* buildGcs(const GcsRig* rig, uint32_t sections, uint32_t criterion, float width, int smooth, int twist, int centres) {
+  const GcsSettings settings{sections, criterion, width, smooth, twist, centres};
+  return gcs_build_gcs(rig, &settings);
+}
+
 bool allowed(const char* id) {
   static const char* list = std::getenv("GCS_FUZZ_ALLOW");
   if (!list) return false;
@@ -639,7 +645,7 @@ struct Built {
   int smooth = 0, twist = 0, centres = 0;
   GcsDeformer* rebuild(const GcsRig* rig) const {
     switch (kind) {
-      case GCS_KIND_GCS: return gcs_build_gcs(rig, a, c, w, smooth, twist, centres);
+      case GCS_KIND_GCS: return buildGcs(rig, a, c, w, smooth, twist, centres);
       case GCS_KIND_CLASSIC: return gcs_build_classic(rig, a, c, w);
       case GCS_KIND_LBS: return gcs_build_lbs(rig);
       default: return gcs_build_dqs(rig);
@@ -1305,12 +1311,13 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
     const float width = fuzzWidth(f);
     static const int flags[] = {0, 0, 1, -1, 2};
     const int smooth = f.PickValueInArray(flags), twist = f.PickValueInArray(flags), centres = f.PickValueInArray(flags);
-    const bool valid = sections >= GCS_MIN_SECTIONS && sections <= GCS_MAX_SECTIONS && width > 0.0f && width <= 1.0f;
+    const bool valid = sections >= GCS_MIN_SECTIONS && sections <= GCS_MAX_SECTIONS && width > 0.0f && width <= 1.0f &&
+                       smooth >= GCS_SMOOTH_BY_CRITERION && smooth <= 1 && twist >= 0 && twist <= 1 && centres >= 0 && centres <= 1;
     char label[160];
     std::snprintf(label, sizeof label, "gcs criterion %u sections %u width %g smooth %d twist %d centres %d", criterion,
                   sections, double(width), smooth, twist, centres);
     g_context = std::string(ctx) + "; " + label;
-    GcsDeformer* d = gcs_build_gcs(rig, sections, criterion, width, smooth, twist, centres);
+    GcsDeformer* d = buildGcs(rig, sections, criterion, width, smooth, twist, centres);
     if (!valid) {
       CHECK(d == nullptr, "gcs_build_gcs accepted out-of-range settings");
       checkRejected("gcs_build_gcs with out-of-range settings", codeSections);
@@ -1322,13 +1329,16 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
       continue;
     }
     checkOk("gcs_build_gcs");
-    add(d, GCS_KIND_GCS, label, sections, criterion, width, smooth, twist, centres);
+    const int smoothBuilt = smooth == GCS_SMOOTH_BY_CRITERION ? int(criterion == GCS_CRITERION_WEIGHTS) : smooth;
+    add(d, GCS_KIND_GCS, label, sections, criterion, width, smoothBuilt, twist, centres);
   }
   {  // an unknown criterion
     const uint32_t criterion = 3 + f.ConsumeIntegral<uint8_t>() * (f.ConsumeBool() ? 1u : 0x1000000u);
     g_context = std::string(ctx) + "; unknown criterion";
-    CHECK(gcs_build_gcs(rig, 6, criterion, 1.0f, 0, 0, 1) == nullptr, "criterion %u accepted", criterion);
+    CHECK(buildGcs(rig, 6, criterion, 1.0f, 0, 0, 1) == nullptr, "criterion %u accepted", criterion);
     checkRejected("gcs_build_gcs with an unknown criterion", codeInvalid);
+    CHECK(gcs_build_gcs(rig, nullptr) == nullptr, "null settings accepted");
+    checkRejected("gcs_build_gcs with null settings", codeInvalid);
   }
   {
     static const uint32_t oddC[] = {0, 1, 2, 256, 257, 0xffffffffu};
@@ -1517,7 +1527,7 @@ void runRig(FuzzedDataProvider& f, RigInput& in) {
 // Calls on null handles and the memory helpers.
 void nullHandles() {
   g_context = "null handles";
-  CHECK(gcs_build_gcs(nullptr, 6, 2, 1.0f, 0, 0, 1) == nullptr, "build on a null rig");
+  CHECK(buildGcs(nullptr, 6, 2, 1.0f, 0, 0, 1) == nullptr, "build on a null rig");
   checkRejected("gcs_build_gcs(null)", codeInvalid);
   CHECK(gcs_build_classic(nullptr, 25, 20, 1.0f) == nullptr, "classic on a null rig");
   checkRejected("gcs_build_classic(null)", codeInvalid);

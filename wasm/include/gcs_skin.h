@@ -136,24 +136,53 @@ typedef enum GcsDeformerKind {
   GCS_KIND_DQS = 3
 } GcsDeformerKind;
 
+/* The defaults of gcs_build_gcs's settings (GcsSettings): the one statement of each, read by the
+   JavaScript library (web/lib/boundary.generated.ts), its demo and docs. */
+#define GCS_DEFAULT_SECTIONS 6
+#define GCS_DEFAULT_CRITERION GCS_CRITERION_WEIGHTS
+#define GCS_DEFAULT_INFLUENCE_WIDTH 1.0f /* the paper */
+#define GCS_SMOOTH_BY_CRITERION (-1)     /* smooth's default: on under the weights criterion, off under Y / axial */
+#define GCS_DEFAULT_TWIST_SPREAD 0
+#define GCS_DEFAULT_CENTRES 0
+
+/* The weights criterion's weight grid: steps of 1/Q, Q = GCS_WEIGHT_GRID_STEPS(sections) =
+   2·(sections − 2) (6 sections → eighths; 3 → only rigid cores and even splits). The factor 2 makes
+   the even split of two joints a grid point. */
+#define GCS_WEIGHT_GRID_STEPS(sections) (2 * ((sections) - 2))
+
 /*
- * Builds a generalized cross-section model from a rig.
- *   sections        level of detail, in [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS].
- *                   Weights criterion: the grid step of the skin weights is 1 / (2·(sections − 2))
- *                   (6 → eighths; 3 → only rigid cores and even splits).
- *                   Y / axial: sections per part (2 shared + sections − 2 inner).
- *   criterion       a GcsCriterion (values above GCS_CRITERION_WEIGHTS are rejected).
- *   influenceWidth  Y / axial: fraction of a part over which joint influence ramps, in (0, 1];
- *                   1 = the paper. Checked but unused by the weights criterion.
- *   smooth          nonzero: each vertex blends two sections' transforms, normals renormalised
- *                   (Y / axial: the sections bracketing its axial coordinate; weights: the nodes
- *                   around its weights, below). The JS API turns it on by default for the weights
- *                   criterion; zero there is the stepped, fastest level of detail.
- *   twistSpread     Y / axial, nonzero: a joint's twist about its bone is spread along the child part.
- *   centres         weights criterion, nonzero: every section of a bending pair turns about its
- *                   centre of rotation (below) instead of moving by the dual-quaternion blend's
- *                   translation.
+ * The settings of a GCS model, checked once by gcs_build_gcs (each field's range below; a field
+ * outside it is refused with the error named there). Fill every field: start from the defaults
+ * above.
+ *   sections        level of detail, in [GCS_MIN_SECTIONS, GCS_MAX_SECTIONS] (else
+ *                   GCS_ERR_SECTION_COUNT). Weights criterion: the grid step of the skin weights is
+ *                   1/Q, Q = GCS_WEIGHT_GRID_STEPS(sections). Y / axial: sections per part
+ *                   (2 shared + sections − 2 inner).
+ *   criterion       a GcsCriterion (else GCS_ERR_INVALID_ARGUMENT).
+ *   influenceWidth  Y / axial: fraction of a part over which joint influence ramps, in (0, 1] (else
+ *                   GCS_ERR_OUT_OF_RANGE); 1 = the paper. Checked but unused by the weights criterion.
+ *   smooth          1: each vertex blends two sections' transforms, normals renormalised (Y / axial:
+ *                   the sections bracketing its axial coordinate; weights: the nodes around its
+ *                   weights, below); 0: stepped (under the weights criterion the fastest level of
+ *                   detail); GCS_SMOOTH_BY_CRITERION: 1 under the weights criterion, 0 under Y / axial.
+ *   twistSpread     Y / axial, 1: a joint's twist about its bone is spread along the child part; 0: not.
+ *   centres         weights criterion, 1: every section of a bending pair turns about its centre of
+ *                   rotation (below) instead of moving by the dual-quaternion blend's translation; 0: not.
  *                   Ignored by Y / axial.
+ * smooth, twistSpread and centres outside those values: GCS_ERR_INVALID_ARGUMENT.
+ */
+typedef struct GcsSettings {
+  uint32_t sections;
+  uint32_t criterion;
+  float influenceWidth;
+  int32_t smooth;
+  int32_t twistSpread;
+  int32_t centres;
+} GcsSettings;
+
+/*
+ * Builds a generalized cross-section model from a rig with the given settings (above; null
+ * settings: GCS_ERR_INVALID_ARGUMENT).
  *
  * Weights criterion (docs/method.md §2): welded vertices (same bind-pose position) are binned by their
  * weights (influences < 0.5 % dropped, renormalised; the non-dominant ones rounded to the grid, the
@@ -165,7 +194,7 @@ typedef enum GcsDeformerKind {
  * of the S_j blended linearly and applied first.
  * Weights criterion, smooth (the default of the JS API; no steps): a welded vertex's weights are
  * w = (1 − s)·e_d + s·u (d dominant, s = 1 − w_d, u the other joints' shares). Sections are nodes
- * (d, u, level l) at s = l/Q, Q = 2·(sections − 2), each node's weights on a grid of 1/(8Q) (the
+ * (d, u, level l) at s = l/Q, Q = GCS_WEIGHT_GRID_STEPS(sections), each node's weights on a grid of 1/(8Q) (the
  * shape u gets 8·l units by largest remainders), moved by the dual-quaternion blend at exactly those
  * weights (level 0: the rigid core, exactly S_d; the even split of two joints: one node for both).
  * A vertex belongs to the node at the level below its s (its run in the output) and blends with the
@@ -200,8 +229,7 @@ typedef enum GcsDeformerKind {
  * The output mesh is the rig's vertices reordered section by section (see
  * gcs_deformer_source_vertex) with the rig's triangles remapped (gcs_deformer_indices).
  */
-GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
-                           float influenceWidth, int smooth, int twistSpread, int centres);
+GcsDeformer* gcs_build_gcs(const GcsRig* rig, const GcsSettings* settings);
 /* Linear blend skinning and dual-quaternion skinning; output in the rig's vertex order.
    LBS: positions by Σ w_j S_j, normals by the same matrix then unit length (as three.js), the rest
    normal turned by the first joint's rotation where that matrix has collapsed.
@@ -279,7 +307,7 @@ float* gcs_deformer_normals(GcsDeformer* deformer);     /* vertexCount × 3 */
 uint32_t gcs_deformer_index_count(const GcsDeformer* deformer);
 const uint32_t* gcs_deformer_indices(const GcsDeformer* deformer);
 /* For each output vertex, the rig vertex it comes from; null for resampled (classic) vertices
-   that come from no rig vertex (there, see gcs_deformer_source_part). */
+   that come from no rig vertex (there, see gcs_classic_source_of_vertex). */
 const uint32_t* gcs_deformer_source_vertex(const GcsDeformer* deformer);
 /*
  * Vertex data in the output order: item o of `out` (vertexCount items of itemBytes bytes) is item
@@ -296,8 +324,9 @@ int gcs_deformer_gather(const GcsDeformer* deformer, const void* source, uint32_
  *   GCS_STAT_SECTIONS          number of sections (GCS), contours (classic), 0 otherwise
  *   GCS_STAT_PARTS             number of parts
  *   GCS_STAT_ADJUSTED_SHARE    last frame: share of sections whose transform is not their part's
- *                              rigid transform (moves a vertex by > 0.1 % of model height)
- *   GCS_STAT_BUILD_MS          not measured in C++ (no clock import); always 0
+ *                              rigid transform (moves a vertex by > 0.1 % of model height); classic: 1
+ *                              (every contour is recomputed each frame); 0 for LBS and DQS
+ *   GCS_STAT_ADJUSTED_SECTIONS last frame: the number of those sections (classic: every contour)
  */
 typedef enum GcsStat {
   GCS_STAT_SECTIONS = 0,
@@ -310,15 +339,31 @@ float gcs_deformer_stat(const GcsDeformer* deformer, uint32_t stat);
 /*
  * GCS introspection (for colouring by section, tests and metrics).
  *   gcs_gcs_section_of_vertex   output vertexCount uint32: section id of each output vertex.
- *   gcs_gcs_section_info        sectionCount × 8 floats per section:
- *                               [first vertex, vertex count, part joint, distal joint or -1,
- *                                kind (0 inner, 1 shared section, 2 rigid core), t, alpha, beta]
+ *   gcs_gcs_section_info        sectionCount × GCS_SECTION_INFO_FLOATS floats, at the offsets of
+ *                               GcsSectionInfoField: [first vertex, vertex count, part joint,
+ *                               distal joint or -1, kind (a GcsSectionKind), t, alpha, beta]
  *                               Y / axial: part = the part's joint, distal = the child part its
  *                               branch leads to, t = mean axial coordinate, alpha/beta = fractions.
  *                               Weights: part = dominant joint, distal = second joint, alpha/beta =
  *                               their mean weights, t = beta.
  * Null for deformers that are not GCS.
  */
+typedef enum GcsSectionInfoField {
+  GCS_SECTION_INFO_FIRST = 0,
+  GCS_SECTION_INFO_COUNT = 1,
+  GCS_SECTION_INFO_PART = 2,
+  GCS_SECTION_INFO_DISTAL = 3,
+  GCS_SECTION_INFO_KIND = 4,
+  GCS_SECTION_INFO_T = 5,
+  GCS_SECTION_INFO_ALPHA = 6,
+  GCS_SECTION_INFO_BETA = 7
+} GcsSectionInfoField;
+#define GCS_SECTION_INFO_FLOATS 8
+typedef enum GcsSectionKind {
+  GCS_SECTION_INNER = 0,   /* an inner section (Y / axial) or a blended one (weights) */
+  GCS_SECTION_SHARED = 1,  /* a shared generalized section: between a part and its parent, or an even split */
+  GCS_SECTION_RIGID = 2    /* weights criterion: a rigid core, moved exactly by its joint's S_j */
+} GcsSectionKind;
 const uint32_t* gcs_gcs_section_of_vertex(const GcsDeformer* deformer);
 const float* gcs_gcs_section_info(const GcsDeformer* deformer);
 /* The transform (16 floats, column-major) of each section in the last frame; sectionCount × 16. */
@@ -435,6 +480,10 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
 #define GCS_CLASSIC_MIN_RAYS 3
 #define GCS_CLASSIC_MAX_RAYS 256
 #define GCS_CLASSIC_MAX_BULGE 4.0f
+/* The recommended settings of gcs_build_classic (below): the one statement of each. */
+#define GCS_CLASSIC_DEFAULT_CONTOURS 25
+#define GCS_CLASSIC_DEFAULT_RAYS 20
+#define GCS_CLASSIC_DEFAULT_BULGE 0.3f
 
 /*
  * Builds the classic cross-section model (Shen, Magnenat-Thalmann, Thalmann 1994; docs/method.md §6).
@@ -489,9 +538,10 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  *   bulge     muscle bulge gain b in [0, GCS_CLASSIC_MAX_BULGE]: radii of a part's contours scale by
  *             1 + b · flex · sin(π t), flex = bend of the part's distal joint / π (the swing angle
  *             of the child part's bone relative to this part, twist excluded).
- * Recommended defaults (the paper's leg comparison: ≈ 500 points on the thigh, ≈ 400 on the shank):
- * contours 25, rays 20 — 500 points on the longest bone (the thigh on a human), the shank
- * 25 · shank/thigh length · 20 (500 on the default human, whose thigh and shank are equally long).
+ * Recommended settings: GCS_CLASSIC_DEFAULT_CONTOURS, _RAYS and _BULGE (the paper's leg comparison:
+ * ≈ 500 points on the thigh, ≈ 400 on the shank): contours × rays points on the longest bone (the
+ * thigh on a human), the shank contours · shank/thigh length · rays (the same on the default human,
+ * whose thigh and shank are equally long).
  *
  * Bind contour planes: the end normal is the bone direction, or at a shared joint the bisector
  * N_o = normalize(N_u + N_l); inner contours interpolate the end normals linearly (normalised).
@@ -533,14 +583,22 @@ typedef enum GcsClassicReason {
                                  the height), or its end cap would cut across a non-flat end */
 } GcsClassicReason;
 /*
- * Per-part report of a classic model: partCount × 5 int32 per part, parts in joint order:
- *   [joint id, resampled (1) or carried rigidly (0), first output vertex, output vertex count,
- *    reason (GcsClassicReason)].
+ * Per-part report of a classic model: partCount × GCS_CLASSIC_PART_INTS int32, parts in joint
+ * order, at the offsets of GcsClassicPartField: [joint id, resampled (1) or carried rigidly (0),
+ * first output vertex, output vertex count, reason (GcsClassicReason)].
  * Resampled part: its rings, contours × rays vertices, proximal ring first (a shared joint ring is
  * in both neighbours' ranges). Rigid part: its carried input vertices. Not in any range: input
  * vertices of resampled parts kept by carried triangles (a band's loop; a trunk part's branch region).
  * gcs_classic_part_count gives partCount. Null (and 0) for other deformers.
  */
+typedef enum GcsClassicPartField {
+  GCS_CLASSIC_PART_JOINT = 0,
+  GCS_CLASSIC_PART_RESAMPLED = 1,
+  GCS_CLASSIC_PART_FIRST_VERTEX = 2,
+  GCS_CLASSIC_PART_VERTEX_COUNT = 3,
+  GCS_CLASSIC_PART_REASON = 4
+} GcsClassicPartField;
+#define GCS_CLASSIC_PART_INTS 5
 uint32_t gcs_classic_part_count(const GcsDeformer* deformer);
 const int32_t* gcs_classic_parts(const GcsDeformer* deformer);
 /* For each output vertex (vertexCount int32): the contour its ring belongs to (0 … contours − 1,

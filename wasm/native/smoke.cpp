@@ -30,7 +30,8 @@ int main() {
   GcsRig* rig = gcs_rig_create(pos.data(), nullptr, uint32_t(pos.size() / 3), idx.data(),
                                uint32_t(idx.size()), joints.data(), weights.data(), 4, parents, ibm, 2);
   if (!rig) { std::printf("rig: %s\n", gcs_last_error_message()); return 1; }
-  GcsDeformer* d = gcs_build_gcs(rig, 5, GCS_CRITERION_AXIAL, 1.0f, 0, 0, 0);
+  const GcsSettings axial{5, GCS_CRITERION_AXIAL, 1.0f, 0, 0, 0};
+  GcsDeformer* d = gcs_build_gcs(rig, &axial);
   if (!d) { std::printf("gcs: %s\n", gcs_last_error_message()); return 1; }
   float skin[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
                     1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -48,7 +49,8 @@ int main() {
     if (!std::isfinite(out[i])) { std::printf("non-finite output\n"); return 1; }
   // The weights criterion (the default): every vertex of this bar is bound 100 % to one joint, so
   // every section is a rigid core and the bent bar is exactly S_j · x, part by part.
-  GcsDeformer* w = gcs_build_gcs(rig, 5, GCS_CRITERION_WEIGHTS, 1.0f, 0, 0, 1);
+  const GcsSettings byWeights{5, GCS_CRITERION_WEIGHTS, 1.0f, 0, 0, 1};
+  GcsDeformer* w = gcs_build_gcs(rig, &byWeights);
   if (!w) { std::printf("gcs weights: %s\n", gcs_last_error_message()); return 1; }
   if (!gcs_deformer_deform(w, bent, 2)) { std::printf("deform: %s\n", gcs_last_error_message()); return 1; }
   const float* wp = gcs_deformer_positions(w);

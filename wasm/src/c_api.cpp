@@ -73,35 +73,19 @@ static bool checkRig(const GcsRig* rig) {
   return true;
 }
 
-GcsDeformer* gcs_build_gcs(const GcsRig* rig, uint32_t sections, uint32_t criterion,
-                           float influenceWidth, int smooth, int twistSpread, int centres) {
+GcsDeformer* gcs_build_gcs(const GcsRig* rig, const GcsSettings* settings) {
   gcs::clearError();
   if (!checkRig(rig)) return nullptr;
-  // The settings, checked here once (buildGcs takes them as valid); the criterion before it becomes an enum.
-  if (sections < GCS_MIN_SECTIONS || sections > GCS_MAX_SECTIONS) {
-    fail(GCS_ERR_SECTION_COUNT, "the section count must be between %d and %d (2 shared + at least 1 inner per part); got %u",
-         GCS_MIN_SECTIONS, GCS_MAX_SECTIONS, sections);
+  if (!settings) {
+    fail(GCS_ERR_INVALID_ARGUMENT, "the settings are null");
     return nullptr;
   }
-  if (criterion > GCS_CRITERION_WEIGHTS) {
-    fail(GCS_ERR_INVALID_ARGUMENT, "unknown section criterion %u (0 = Y, 1 = axial, 2 = weights)", criterion);
-    return nullptr;
-  }
-  if (!(influenceWidth > 0.0f && influenceWidth <= 1.0f)) {
-    fail(GCS_ERR_OUT_OF_RANGE, "the influence width must be in (0, 1]; got %g", double(influenceWidth));
-    return nullptr;
-  }
+  gcs::ModelSettings checked;
+  if (!gcs::validateSettings(*settings, checked)) return nullptr;
   const gcs::Rig& r = rig->rig;
   if (!gcs::reserveMemory(gcs::gcsPeakBytes(r.vertexCount, r.indices.size(), r.jointCount, r.influenceSlots), "the GCS model"))
     return nullptr;
-  gcs::GcsSettings settings;
-  settings.sections = sections;
-  settings.criterion = GcsCriterion(criterion);
-  settings.influenceWidth = influenceWidth;
-  settings.smooth = smooth != 0;
-  settings.twistSpread = twistSpread != 0;
-  settings.centres = centres != 0;
-  return wrap(gcs::buildGcs(rig->rig, settings));
+  return wrap(gcs::buildGcs(rig->rig, checked));
 }
 
 GcsDeformer* gcs_build_lbs(const GcsRig* rig) {

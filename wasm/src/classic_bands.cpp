@@ -243,15 +243,67 @@ void ClassicBuild::planBands() {
   }
 }
 
+// planBand's shared state: the end ring the band starts from, the loop's chart (angle about the
+// ring × height above it; beta and the loop's order are the plan's) and the columns of band
+// vertices raised above the ring's vertices.
+struct ClassicBuild::BandChart {
+  const ClassicContour& c;
+  glm::vec3 w;                        // the ring's second in-plane axis (normal × u)
+  float d;                            // towards the loop: 1 at a distal end, −1 at a proximal one
+  bool distal;
+  uint32_t k;                         // rays
+  const std::vector<float>* beta = nullptr;
+  size_t n = 0;                       // loop vertices
+  float step = 0.0f, turn = 0.0f, meanRadius = 0.0f, spacing = 0.0f;
+  std::vector<float> height;          // per loop vertex: its height above the ring
+  std::vector<uint8_t> stands;        // per ring index: a column stands there
+  std::vector<std::vector<BandVertex>> made;  // per ring index: its column's vertices, bottom up
+
+  BandChart(const ClassicContour& ring, const glm::vec3& axis, float towards, bool distalEnd, uint32_t rays)
+      : c(ring), w(axis), d(towards), distal(distalEnd), k(rays) {}
+  uint32_t rayOf(uint32_t i) const { return distal ? i % k : (k - i % k) % k; }  // ring index → ray
+  // Where the loop crosses ring index i's angle: the crossing count, the last crossing's loop
+  // edge and unwrapped angle, and how high a column there may rise: to its lowest crossing, or
+  // lower where the loop runs down the bone within kClearance spacings of its ray.
+  int column(uint32_t i, size_t& edge, float& angle, float& top) const {
+    const std::vector<float>& beta = *this->beta;
+    int count = 0;
+    top = INFINITY;
+    for (int lap = -1; lap <= 1; ++lap) {
+      const float x = float(i) * step + float(lap) * turn;
+      for (size_t j = 0; j < n; ++j) {
+        const float b0 = beta[j], b1 = beta[j + 1];
+        if (!(std::min(b0, b1) <= x && x < std::max(b0, b1))) continue;
+        ++count, edge = j, angle = x;
+        top = std::min(top, height[j] + (x - b0) / (b1 - b0) * (height[(j + 1) % n] - height[j]));
+      }
+    }
+    for (size_t j = 0; j < n; ++j)
+      if (std::fabs(wrapAngle(beta[j] - float(i) * step)) * meanRadius < kClearance * spacing &&
+          height[j] < top - kClearance * spacing)
+        return 0;
+    return count;
+  }
+};
+
 bool ClassicBuild::planBand(const Loop& L, BandPlan& plan) {
   ClassicModel& m = *model;
   const ClassicPart& P = m.parts[L.part];
   const ClassicContour& c = m.contours[L.distal ? P.contours.back() : P.contours.front()];
-  const float d = L.distal ? 1.0f : -1.0f;  // towards the loop
-  const glm::vec3 w = glm::cross(c.normal, c.u);
-  const size_t n = L.groups.size();
-  // The loop in the ring's turn (the carried triangles walk it the same way on an outward-wound
-  // mesh; an inward-wound input: backwards), from its vertex nearest ray 0, with unwrapped angles.
+  BandChart chart{c, glm::cross(c.normal, c.u), L.distal ? 1.0f : -1.0f, L.distal, k};
+  orderLoop(L, chart, plan);
+  if (!chartLoop(chart, plan)) return false;
+  raiseColumns(L, chart);
+  return layStrips(chart, plan);
+}
+
+// The loop in the ring's turn (the carried triangles walk it the same way on an outward-wound
+// mesh; an inward-wound input: backwards), from its vertex nearest ray 0, with unwrapped angles.
+void ClassicBuild::orderLoop(const Loop& L, BandChart& chart, BandPlan& plan) const {
+  const ClassicContour& c = chart.c;
+  const glm::vec3 w = chart.w;
+  const float d = chart.d;
+  const size_t n = chart.n = L.groups.size();
   auto angleOf = [&](uint32_t g) {
     glm::vec3 x = rig.positions[representative[g]] - c.centre;
     return d * std::atan2(glm::dot(x, w), glm::dot(x, c.u));
@@ -270,41 +322,42 @@ bool ClassicBuild::planBand(const Loop& L, BandPlan& plan) {
   plan.beta.resize(n + 1);
   plan.beta[0] = wrapAngle(angleOf(plan.loop[0]));
   for (size_t i = 1; i <= n; ++i) plan.beta[i] = plan.beta[i - 1] + wrapAngle(angleOf(plan.loop[i % n]) - angleOf(plan.loop[i - 1]));
-  const std::vector<float>& beta = plan.beta;
+  chart.beta = &plan.beta;
+}
 
-  // The chart: heights of the loop above the ring, a ring spacing as the row spacing.
-  const float step = 2.0f * kPi / float(k), turn = beta[n] - beta[0];
+// The chart: heights of the loop above the ring, a ring spacing as the row spacing. False where
+// it has no extent (no ring spacing, fewer than three loop vertices, a loop that does not turn).
+bool ClassicBuild::chartLoop(BandChart& chart, const BandPlan& plan) const {
+  ClassicModel& m = *model;
+  const ClassicContour& c = chart.c;
+  const float d = chart.d;
+  const size_t n = chart.n;
+  const std::vector<float>& beta = plan.beta;
+  const float step = chart.step = 2.0f * kPi / float(k), turn = chart.turn = beta[n] - beta[0];
   float meanRadius = 0.0f;
   for (uint32_t r = 0; r < k; ++r) meanRadius += m.radii[c.radii + r] / float(k);
-  const float spacing = meanRadius * step;
+  chart.meanRadius = meanRadius;
+  const float spacing = chart.spacing = meanRadius * step;
   if (!(spacing > 0.0f) || n < 3 || !(turn > 0.0f)) return false;
-  std::vector<float> height(n);
+  std::vector<float>& height = chart.height;
+  height.resize(n);
   for (size_t j = 0; j < n; ++j) height[j] = d * glm::dot(rig.positions[representative[plan.loop[j]]] - c.centre, c.normal);
-  auto rayOf = [&](uint32_t i) { return L.distal ? i % k : (k - i % k) % k; };  // ring index → ray
-  // Where the loop crosses ring index i's angle: the crossing count, the last crossing's loop
-  // edge and unwrapped angle, and how high a column there may rise: to its lowest crossing, or
-  // lower where the loop runs down the bone within kClearance spacings of its ray.
-  auto column = [&](uint32_t i, size_t& edge, float& angle, float& top) {
-    int count = 0;
-    top = INFINITY;
-    for (int lap = -1; lap <= 1; ++lap) {
-      const float x = float(i) * step + float(lap) * turn;
-      for (size_t j = 0; j < n; ++j) {
-        const float b0 = beta[j], b1 = beta[j + 1];
-        if (!(std::min(b0, b1) <= x && x < std::max(b0, b1))) continue;
-        ++count, edge = j, angle = x;
-        top = std::min(top, height[j] + (x - b0) / (b1 - b0) * (height[(j + 1) % n] - height[j]));
-      }
-    }
-    for (size_t j = 0; j < n; ++j)
-      if (std::fabs(wrapAngle(beta[j] - float(i) * step)) * meanRadius < kClearance * spacing &&
-          height[j] < top - kClearance * spacing)
-        return 0;
-    return count;
-  };
-  // The columns' vertices, ray by ray: one contour plane per row, cast against the part's triangles.
-  std::vector<uint8_t> stands(k, 0);
-  std::vector<std::vector<BandVertex>> made(k);
+  return true;
+}
+
+// The columns' vertices, ray by ray: one contour plane per row, cast against the part's triangles.
+void ClassicBuild::raiseColumns(const Loop& L, BandChart& chart) {
+  ClassicModel& m = *model;
+  const ClassicPart& P = m.parts[L.part];
+  const ClassicContour& c = chart.c;
+  const glm::vec3 w = chart.w;
+  const float d = chart.d, spacing = chart.spacing;
+  auto rayOf = [&](uint32_t i) { return chart.rayOf(i); };
+  auto column = [&](uint32_t i, size_t& edge, float& angle, float& top) { return chart.column(i, edge, angle, top); };
+  std::vector<uint8_t>& stands = chart.stands;
+  std::vector<std::vector<BandVertex>>& made = chart.made;
+  stands.assign(k, 0);
+  made.assign(k, {});
   std::vector<float> reach(k);
   std::vector<uint32_t> rows(k, 0);
   uint32_t levels = 0;
@@ -337,11 +390,25 @@ bool ClassicBuild::planBand(const Loop& L, BandPlan& plan) {
                                   &rig.indices[size_t(own.triangle[hit[r]]) * 3], P.joint, c.normal));
     }
   }
-  // Strips between neighbouring standing columns: ring below, the column on the right up, the
-  // loop back above (from the far end of the loop edge the right column crosses: that edge is
-  // this strip's), the column on the left down (counter-clockwise in the chart, the winding of
-  // the single zip's triangles). A column whose strip edges cross the loop in the chart (a loop
-  // that kinks back over it) is taken down, and the strips are laid again.
+}
+
+// Strips between neighbouring standing columns: ring below, the column on the right up, the
+// loop back above (from the far end of the loop edge the right column crosses: that edge is
+// this strip's), the column on the left down (counter-clockwise in the chart, the winding of
+// the single zip's triangles). A column whose strip edges cross the loop in the chart (a loop
+// that kinks back over it) is taken down, and the strips are laid again.
+bool ClassicBuild::layStrips(BandChart& chart, BandPlan& plan) {
+  ClassicModel& m = *model;
+  const ClassicContour& c = chart.c;
+  const glm::vec3 w = chart.w;
+  const size_t n = chart.n;
+  const std::vector<float>& beta = plan.beta;
+  const std::vector<float>& height = chart.height;
+  const float step = chart.step, turn = chart.turn, meanRadius = chart.meanRadius, spacing = chart.spacing;
+  std::vector<uint8_t>& stands = chart.stands;
+  const std::vector<std::vector<BandVertex>>& made = chart.made;
+  auto rayOf = [&](uint32_t i) { return chart.rayOf(i); };
+  auto column = [&](uint32_t i, size_t& edge, float& angle, float& top) { return chart.column(i, edge, angle, top); };
   std::vector<float> S(n + 2), H(n + 2);  // 0: the first column's crossing, 1…n: the loop, n + 1: its first vertex a turn on
   std::vector<int64_t> pos(k + 1);
   std::vector<ChartPoint> poly;

@@ -1,3 +1,6 @@
+// The classic model's build, steps 1–9 (classic_build.h lists them; the bands are
+// classic_bands.cpp). Longer than one job's file usually is: every step is a method over the one
+// build's shared state, read in order, and splitting them across files would only scatter that state.
 #include "classic_build.h"
 #include <algorithm>
 #include <cmath>

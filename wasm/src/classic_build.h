@@ -75,6 +75,11 @@ class ClassicBuild {
   void addCaps();            //    flat fans on closed ends that meet nothing
   void planBands();          //    band rows of new skin vertices between each end ring and its loop
   bool planBand(const Loop& loop, BandPlan& plan);
+  struct BandChart;          //    planBand's steps (classic_bands.cpp):
+  void orderLoop(const Loop& loop, BandChart& chart, BandPlan& plan) const;  // the loop in the ring's turn
+  bool chartLoop(BandChart& chart, const BandPlan& plan) const;              // its heights above the ring
+  void raiseColumns(const Loop& loop, BandChart& chart);                     // columns of band vertices
+  bool layStrips(BandChart& chart, BandPlan& plan);                          // strips between them, clipped
   BandVertex skinPoint(const glm::vec3& x, const glm::vec3* corner, const uint32_t* v, uint32_t fallbackJoint,
                        const glm::vec3& fallbackNormal) const;
   void copyCarriedVertices();// 6. carried input vertices, grouped by part

@@ -10,16 +10,22 @@
 
 namespace gcs {
 
-struct GcsSettings {
-  uint32_t sections = 6;                    // level of detail (see gcs_build_gcs)
-  GcsCriterion criterion = GCS_CRITERION_WEIGHTS;
-  float influenceWidth = 1.0f;              // (0, 1]
+// The settings a model is built with: the C API's GcsSettings once checked and their defaults
+// resolved (validateSettings). Zero until then: the defaults are the header's, stated nowhere else.
+struct ModelSettings {
+  uint32_t sections = 0;                    // level of detail (see GcsSettings)
+  GcsCriterion criterion = GCS_CRITERION_Y;
+  float influenceWidth = 0.0f;              // (0, 1]
   bool smooth = false;
   bool twistSpread = false;
   // Weights criterion: blended sections rotate about their centre of rotation (rotation_centres.h)
   // instead of moving by the dual-quaternion blend's translation.
   bool centres = false;
 };
+
+// Checks the C API's settings (gcs_skin.h GcsSettings: each field's range) and resolves smooth's
+// default into `settings`: the one check of a build's settings. False with the error recorded.
+bool validateSettings(const GcsSettings& given, ModelSettings& settings);
 
 // One generalized section: a run of output vertices that share one transform per frame.
 // Y/axial criteria: M = S_parent · D_part^(alpha, tau) · D_distal^beta (parent < 0: S_part · D_distal^beta).
@@ -65,7 +71,7 @@ class GcsDeformerImpl final : public Deformer {
   std::vector<float>* morphableRestNormals() override { return &restNormals; }
   float stat(GcsStat which) const override;
 
-  GcsSettings settings;
+  ModelSettings settings;
   std::vector<Section> sections;
   std::vector<PartInfo> parts;          // indexed by joint
   std::vector<glm::vec3> jointCentres;  // bind pose
@@ -133,6 +139,6 @@ class GcsDeformerImpl final : public Deformer {
 };
 
 // Builds the GCS model of a rig. Returns null with the error recorded on failure.
-GcsDeformerImpl* buildGcs(const Rig& rig, const GcsSettings& settings);
+GcsDeformerImpl* buildGcs(const Rig& rig, const ModelSettings& settings);
 
 }  // namespace gcs

@@ -21,7 +21,7 @@ bool reserveMemory(uint64_t bytes, const char* what) {
   return true;
 }
 
-// The estimates count every array a build holds at its peak (see rig.cpp, gcs_model.cpp,
+// The estimates count every array a build holds at its peak (see rig.cpp, gcs_build*.cpp,
 // reference_deformers.cpp, classic_model.cpp), with a 1.5× margin for vector growth and the heap.
 uint64_t rigPeakBytes(uint64_t v, uint64_t i, uint64_t j, uint64_t slots) {
   return (v * (12 + 12 + 8 * slots + 12) + i * 4 + j * (64 * 2 + 12 + 4)) * 3 / 2 + 65536;

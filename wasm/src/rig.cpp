@@ -24,12 +24,12 @@ bool allFinite(const float* values, size_t count) { return firstNonFinite(values
 
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative) {
   weldRig(rig);
-  representative = rig.weldRepresentative;
-  return rig.weldGroup;
+  representative = rig.cache.weldRepresentative;
+  return rig.cache.weldGroup;
 }
 
 void weldRig(const Rig& rig) {
-  if (rig.welded) return;
+  if (rig.cache.welded) return;
   std::vector<uint32_t> representative;
   // A sort of the exact position bits, not a hash: O(n log n) for any input (a hash of raw float
   // bits put integer grids of power-of-two sizes into a few buckets: quadratic).
@@ -71,17 +71,17 @@ void weldRig(const Rig& rig) {
     }
     group[v] = id;
   }
-  rig.weldGroup.swap(group);
-  rig.weldRepresentative.swap(representative);
-  rig.welded = true;  // (after both: a failed allocation leaves no half cache)
+  rig.cache.weldGroup.swap(group);
+  rig.cache.weldRepresentative.swap(representative);
+  rig.cache.welded = true;  // (after both: a failed allocation leaves no half cache)
 }
 
 const WeightGroups& weightGroupsOf(const Rig& rig) {
-  if (rig.weightGroups) return *rig.weightGroups;
+  if (rig.cache.weightGroups) return *rig.cache.weightGroups;
   weldRig(rig);
   auto groups = std::make_shared<WeightGroups>();
   WeightGroups& w = *groups;
-  const size_t G = rig.weldRepresentative.size(), slots = w.slots = rig.influenceSlots;
+  const size_t G = rig.cache.weldRepresentative.size(), slots = w.slots = rig.influenceSlots;
   w.joint.resize(G * slots);
   w.weight.resize(G * slots);
   w.count.resize(G);
@@ -90,7 +90,7 @@ const WeightGroups& weightGroupsOf(const Rig& rig) {
   for (size_t g = 0; g < G; ++g) {
     const uint32_t* joint = &w.joint[g * slots];
     const float* weight = &w.weight[g * slots];
-    const uint32_t n = w.count[g] = uint8_t(cleanWeights(rig, rig.weldRepresentative[g], &w.joint[g * slots], &w.weight[g * slots]));
+    const uint32_t n = w.count[g] = uint8_t(cleanWeights(rig, rig.cache.weldRepresentative[g], &w.joint[g * slots], &w.weight[g * slots]));
     if (n != 2) continue;
     const uint32_t d = weight[1] > weight[0] ? 1 : 0;  // the first of equal weights, as buildWeightNodes
     twoJoints.push_back({uint64_t(joint[d]) << 32 | joint[1 - d], uint32_t(g)});
@@ -101,8 +101,8 @@ const WeightGroups& weightGroupsOf(const Rig& rig) {
     if (i == 0 || pair != twoJoints[i - 1].first) w.pairs.push_back(glm::uvec2(uint32_t(pair >> 32), uint32_t(pair)));
     w.pairOf[twoJoints[i].second] = uint32_t(w.pairs.size() - 1);
   }
-  rig.weightGroups = std::move(groups);
-  return *rig.weightGroups;
+  rig.cache.weightGroups = std::move(groups);
+  return *rig.cache.weightGroups;
 }
 
 uint32_t Rig::dominantJoint(uint32_t v) const {

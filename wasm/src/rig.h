@@ -23,6 +23,19 @@ struct WeightGroups {
   std::vector<glm::uvec2> pairs;
 };
 
+// What the builds derive from a rig, computed by the first build that asks and kept: the rig never
+// changes once validated, and the sliders rebuild it again and again. A cache, not state: each
+// entry is a pure function of the rig (weldRig, weightGroupsOf, centreSurfaceOf fill it).
+struct RigCache {
+  // weldByPosition's result.
+  std::vector<uint32_t> weldGroup, weldRepresentative;
+  bool welded = false;
+  // What the weights criterion reads of each welded group (weightGroupsOf).
+  std::shared_ptr<const WeightGroups> weightGroups;
+  // The surface the centres of rotation integrate over (rotation_centres.h).
+  std::shared_ptr<const CentreSurface> centreSurface;
+};
+
 constexpr uint32_t kMaxInfluences = GCS_MAX_INFLUENCES;  // per vertex, and so per section
 
 struct Rig {
@@ -51,15 +64,8 @@ struct Rig {
   uint32_t jointAt(uint32_t v, uint32_t i) const { return i < 4 ? joints[v][int(i)] : joints1[v][int(i - 4)]; }
   float weightAt(uint32_t v, uint32_t i) const { return i < 4 ? weights[v][int(i)] : weights1[v][int(i - 4)]; }
 
-  // weldByPosition's result, computed by the first build that asks and kept: the positions never
-  // change, and the sliders rebuild the same rig again and again.
-  mutable std::vector<uint32_t> weldGroup, weldRepresentative;
-  mutable bool welded = false;
-  // What the weights criterion reads of each welded group (weightGroupsOf), kept like the weld.
-  mutable std::shared_ptr<const WeightGroups> weightGroups;
-  // The surface the centres of rotation integrate over (rotation_centres.h), built by the first
-  // build that asks and kept, like the weld.
-  mutable std::shared_ptr<const CentreSurface> centreSurface;
+  // What the builds derive from the rig and keep (see RigCache): the one mutable member of a const Rig.
+  mutable RigCache cache;
 };
 
 // Validates the raw arrays (see gcs_rig_create in gcs_skin.h) and fills `rig`.
@@ -78,7 +84,7 @@ void computeNormals(const std::vector<glm::vec3>& positions, const std::vector<u
 // each group). Both models group by it, so a seam can never open.
 // (Computed once per rig, then copied from its cache.)
 std::vector<uint32_t> weldByPosition(const Rig& rig, std::vector<uint32_t>& representative);
-// Fills the rig's weld cache (weldGroup, weldRepresentative) if it is not yet: the builds that
+// Fills the rig's weld cache (cache.weldGroup, cache.weldRepresentative) if it is not yet: the builds that
 // only read it take it from there without a copy.
 void weldRig(const Rig& rig);
 // The rig's WeightGroups, computed by the first call and kept.

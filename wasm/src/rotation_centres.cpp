@@ -162,8 +162,8 @@ glm::vec4 pairSum(const CentreSurface& s, uint32_t first, uint32_t end, float wj
 }  // namespace
 
 const CentreSurface* centreSurfaceOf(const Rig& rig) {
-  if (!rig.centreSurface) rig.centreSurface = buildCentreSurface(rig);
-  return rig.centreSurface.get();
+  if (!rig.cache.centreSurface) rig.cache.centreSurface = buildCentreSurface(rig);
+  return rig.cache.centreSurface.get();
 }
 
 bool rotationCentre(const CentreSurface& surface, const uint32_t* joints, const float* weights, uint32_t count,

@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import type { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type Stats from 'three/addons/libs/stats.module.js';
-import { CRITERIA, MAX_SECTIONS, MIN_SECTIONS, type ClassicReason, type Criterion, type GcsSkin } from '../lib/index.js';
+import { CLASSIC_DEFAULTS, CRITERIA, GCS_DEFAULTS, MAX_SECTIONS, MIN_SECTIONS, type ClassicReason, type Criterion, type GcsSkin } from '../lib/index.js';
 import { SkinDeformer } from '../lib/three.js';
 import type { DemoRenderer } from './renderer.js';
 import { FrameCost } from './cost.js';
@@ -56,21 +56,21 @@ const queryBool = (key: string, fallback: boolean) => (query.has(key) ? query.ge
 /** ?criterion=weights|y|axial (default weights, the library's default; any other value too). */
 function parseCriterion(value: string | null): Criterion {
   const v = (value ?? '').toLowerCase();
-  return CRITERIA.find((c) => c === v) ?? 'weights';
+  return CRITERIA.find((c) => c === v) ?? GCS_DEFAULTS.criterion;
 }
 
 /** What the GUI edits (lil-gui binds to these properties). */
 export const params = {
   // GCS model (left)
-  sections: Math.round(Math.min(MAX_SECTIONS, Math.max(MIN_SECTIONS, queryNumber('sections', 6)))), // the slider's range
+  sections: Math.round(Math.min(MAX_SECTIONS, Math.max(MIN_SECTIONS, queryNumber('sections', GCS_DEFAULTS.sections)))), // the slider's range
   criterion: parseCriterion(query.get('criterion')),
-  influenceWidth: 1,
-  smooth: queryBool('smooth', true), // the default: no steps (false: the stepped, faster level of detail)
-  twistSpread: queryBool('twist', false),
+  influenceWidth: GCS_DEFAULTS.influenceWidth,
+  smooth: queryBool('smooth', GCS_DEFAULTS.smooth(GCS_DEFAULTS.criterion)), // the default: no steps (false: the stepped, faster level of detail)
+  twistSpread: queryBool('twist', GCS_DEFAULTS.twistSpread),
   // classic model (right)
-  contours: 25,
-  rays: 20,
-  bulge: 0.3,
+  contours: CLASSIC_DEFAULTS.contours,
+  rays: CLASSIC_DEFAULTS.rays,
+  bulge: CLASSIC_DEFAULTS.bulge,
   // animation
   clip: query.get('clip') ?? 'walk',
   speed: 1,

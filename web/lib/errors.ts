@@ -1,41 +1,15 @@
-/** Error codes of the core (gcs_skin.h GcsError), as strings. */
+import { GcsErrorNames } from './boundary.generated.js';
+
+/** Error codes of the core (gcs_skin.h GcsError, generated), then those of the JavaScript side. */
 export type GcsErrorCode =
-  | 'INVALID_ARGUMENT'
-  | 'LENGTH_MISMATCH'
-  | 'INDEX_OUT_OF_RANGE'
-  | 'JOINT_OUT_OF_RANGE'
-  | 'NON_FINITE'
-  | 'BAD_WEIGHTS'
-  | 'SECTION_COUNT'
-  | 'ZERO_LENGTH_BONE'
-  | 'OUT_OF_RANGE'
-  | 'NO_SKIN'
-  | 'OUT_OF_MEMORY'
-  | 'DEGENERATE'
+  | Exclude<(typeof GcsErrorNames)[number], 'OK'>
   | 'UNKNOWN_CORE_ERROR' // the core reported a code this version of the wrapper does not know (a mismatched binary)
   | 'DISPOSED'
   | 'WASM_LOAD'
   | 'MISSING_PACKAGE'; // JS only: an optional package a function needs is not installed
 
-/**
- * The core's error codes by number (gcs_skin.h GcsError; tests/lib/boundary.test.ts checks this
- * table against the header). 0 is GCS_OK, never thrown.
- */
-export const CORE_ERROR_CODES: readonly (GcsErrorCode | null)[] = [
-  null,
-  'INVALID_ARGUMENT',
-  'LENGTH_MISMATCH',
-  'INDEX_OUT_OF_RANGE',
-  'JOINT_OUT_OF_RANGE',
-  'NON_FINITE',
-  'BAD_WEIGHTS',
-  'SECTION_COUNT',
-  'ZERO_LENGTH_BONE',
-  'OUT_OF_RANGE',
-  'NO_SKIN',
-  'OUT_OF_MEMORY',
-  'DEGENERATE',
-];
+/** The core's error codes by number (gcs_skin.h GcsError). 0 is GCS_OK, never thrown. */
+export const CORE_ERROR_CODES: readonly (GcsErrorCode | null)[] = GcsErrorNames.map((name) => (name === 'OK' ? null : name));
 
 /** Every failure of gcs-skin: a stable `code` and a sentence a user can act on. */
 export class GcsError extends Error {

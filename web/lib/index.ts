@@ -11,44 +11,54 @@
  * Every object that owns wasm memory has `dispose()`; using it afterwards throws GcsError
  * 'DISPOSED'. Every failure is a GcsError with a `code`.
  *
- * @module gcs-skin
+ * One file for the core's API, over 700 lines on purpose: GcsSkin, Rig, the deformers and the pose
+ * buffers share internal state (handles, views on wasm memory, raise()) that a split would have to
+ * export; the boundary itself is boundary.generated.ts, the measures measure/, the adapters three/.
  */
-import { DEFORMER_KINDS, STATS } from './core-enums.js';
+import {
+  GCS_CLASSIC_DEFAULT_BULGE, GCS_CLASSIC_DEFAULT_CONTOURS, GCS_CLASSIC_DEFAULT_RAYS, GCS_CLASSIC_MAX_BULGE, GCS_CLASSIC_MAX_CONTOURS,
+  GCS_CLASSIC_MAX_RAYS, GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_PART_INTS, GCS_DEFAULT_CENTRES, GCS_DEFAULT_CRITERION,
+  GCS_DEFAULT_INFLUENCE_WIDTH, GCS_DEFAULT_SECTIONS, GCS_DEFAULT_TWIST_SPREAD, GCS_GPU_TEXELS_PER_JOINT, GCS_GPU_TEXELS_PER_SECTION,
+  GCS_MAX_INFLUENCES, GCS_MAX_INSTANCES, GCS_MAX_SECTIONS, GCS_MIN_SECTIONS, GCS_SECTION_INFO_FLOATS, GCS_SMOOTH_BY_CRITERION,
+  GcsClassicPartField, GcsClassicReasonNames, GcsCriterionNames, GcsDeformerKindNames, GcsSectionInfoField, GcsSectionKind,
+  GcsSettingsBytes, GcsStat, weightGridSteps as gridSteps, writeGcsSettings,
+} from './boundary.generated.js';
 import { checkWasmSource, loadFailure } from './core-check.js';
 import { asGiven, GcsError, type GcsErrorCode } from './errors.js';
 import { instantiateCore, type CoreExports, type WasmSource } from './loader.js';
+import type { GcsSettings } from './boundary.generated.js';
 import { VERSION, versionNumber, versionString } from './version.js';
 
 export { asGiven, GcsError, type GcsErrorCode } from './errors.js';
 export type { WasmSource } from './loader.js';
 export { version } from './version.js';
 
+// The limits and defaults below are gcs_skin.h's (read from it by scripts/gen-boundary.mjs into
+// boundary.generated.ts): the header is the one statement of each.
 /** Fewest sections `buildGcs` takes (gcs_skin.h GCS_MIN_SECTIONS). */
-export const MIN_SECTIONS = 3;
+export const MIN_SECTIONS = GCS_MIN_SECTIONS;
 /** Most skin influences (joint, weight pairs) per vertex (gcs_skin.h GCS_MAX_INFLUENCES). */
-export const MAX_INFLUENCES = 8;
+export const MAX_INFLUENCES = GCS_MAX_INFLUENCES;
 /** Most sections `buildGcs` takes (gcs_skin.h GCS_MAX_SECTIONS). */
-export const MAX_SECTIONS = 256;
-/** GcsOptions.centres when not given. */
-const DEFAULT_CENTRES = false;
+export const MAX_SECTIONS = GCS_MAX_SECTIONS;
 /** The ranges `buildClassic` checks: contours per part, rays per contour, muscle bulge gain (gcs_skin.h). */
 export const CLASSIC_LIMITS = {
-  /** Fewest contours per resampled part. */ minContours: 2,
-  /** Most contours per resampled part. */ maxContours: 256,
-  /** Fewest rays per contour. */ minRays: 3,
-  /** Most rays per contour. */ maxRays: 256,
-  /** Largest muscle bulge gain. */ maxBulge: 4,
+  /** Fewest contours per resampled part. */ minContours: GCS_CLASSIC_MIN_CONTOURS,
+  /** Most contours per resampled part. */ maxContours: GCS_CLASSIC_MAX_CONTOURS,
+  /** Fewest rays per contour. */ minRays: GCS_CLASSIC_MIN_RAYS,
+  /** Most rays per contour. */ maxRays: GCS_CLASSIC_MAX_RAYS,
+  /** Largest muscle bulge gain. */ maxBulge: GCS_CLASSIC_MAX_BULGE,
 } as const;
 
 /**
  * Weights criterion: the steps of the weight grid at a section count, Q = 2·(sections − 2); node
- * weights are multiples of 1/Q (6 sections → eighths; docs/method.md §2). The core uses the same
- * formula (gcs_model.cpp); this is the one JavaScript copy.
+ * weights are multiples of 1/Q (6 sections → eighths; docs/method.md §2). gcs_skin.h's
+ * GCS_WEIGHT_GRID_STEPS, which the core uses too.
  */
 export function weightGridSteps(sections: number): number {
   if (typeof sections !== 'number' || !Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
     throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${asGiven(sections)}`);
-  return 2 * (sections - 2);
+  return gridSteps(sections);
 }
 
 type ArrayLikeNumbers = ArrayLike<number>;
@@ -84,54 +94,72 @@ export interface RigInput {
  * - 'y': the paper's criterion, bins of the bind-pose Y coordinate, its fractional-rotation rule.
  * - 'axial': the paper's rule, bins of the projection on the bone axis (for T-posed arms).
  */
-export type Criterion = 'weights' | 'y' | 'axial';
-/** The criteria in the order of their codes in the core (gcs_skin.h GcsCriterion). */
-export const CRITERIA: readonly Criterion[] = ['y', 'axial', 'weights'];
+export type Criterion = (typeof GcsCriterionNames)[number];
+/** The criteria in the order of their codes (GcsCriterion). */
+export const CRITERIA: readonly Criterion[] = GcsCriterionNames;
 
 /** Options of `Rig.buildGcs`: level of detail and how vertices are grouped into sections. */
 export interface GcsOptions {
   /**
-   * Level of detail, 3..256. Default 6. Weights criterion: the weight grid step is 1/(2·(sections−2))
+   * Level of detail, 3..256. Default `GCS_DEFAULTS.sections` (6). Weights criterion: the weight grid step is 1/(2·(sections−2))
    * (6 → eighths; 3 → rigid cores and even splits only). Y/axial: sections per part
    * (2 shared + sections−2 inner).
    */
   sections?: number;
-  /** The section criterion. Default 'weights'. */
+  /** The section criterion. Default `GCS_DEFAULTS.criterion` ('weights'). */
   criterion?: Criterion;
-  /** Y/axial only: fraction of a part over which joint influence ramps, (0, 1]. Default 1 (the paper). */
+  /** Y/axial only: fraction of a part over which joint influence ramps, (0, 1]. Default `GCS_DEFAULTS.influenceWidth` (1, the paper). */
   influenceWidth?: number;
   /**
    * Each vertex blends the transforms of the two sections around it (no steps between sections).
-   * Default true under 'weights' (sections are then nodes on the rays from each rigid core, docs/method.md
+   * Default `GCS_DEFAULTS.smooth(criterion)`: true under 'weights' (sections are then nodes on the rays from each rigid core, docs/method.md
    * §2: as smooth as DQS, measured by creases), false under the paper's 'y' and 'axial' (the paper's
    * method as published). `false` under 'weights' is the fastest, stepped level of detail.
    */
   smooth?: boolean;
-  /** Y/axial only: spread a joint's twist along the child part. Default false. */
+  /** Y/axial only: spread a joint's twist along the child part. Default `GCS_DEFAULTS.twistSpread` (false). */
   twistSpread?: boolean;
   /**
    * Weights criterion: each section of a bending pair (two joints, one the other's parent) turns by
    * its joints' blended rotation about its centre of rotation (Le & Hodgins 2016: the average of the
    * bind-pose surface whose weights resemble the section's, brought to within 1 % of the height of
    * the joint; computed once at build time), the centre moving by linear blend skinning: less of
-   * DQS's bulge at a bent joint, some volume lost. `false`: the dual-quaternion blend. Default false.
+   * DQS's bulge at a bent joint, some volume lost. `false`: the dual-quaternion blend. Default `GCS_DEFAULTS.centres` (false).
    * Ignored by 'y' and 'axial'.
    */
   centres?: boolean;
 }
 
+/** What buildGcs does with an option it is not given (gcs_skin.h GCS_DEFAULT_*). */
+export const GCS_DEFAULTS = {
+  sections: GCS_DEFAULT_SECTIONS,
+  criterion: CRITERIA[GCS_DEFAULT_CRITERION],
+  influenceWidth: GCS_DEFAULT_INFLUENCE_WIDTH,
+  /** smooth's default depends on the criterion (GCS_SMOOTH_BY_CRITERION): on under 'weights', off under 'y' and 'axial'. */
+  smooth: (criterion: Criterion): boolean => criterion === 'weights',
+  twistSpread: GCS_DEFAULT_TWIST_SPREAD !== 0,
+  centres: GCS_DEFAULT_CENTRES !== 0,
+} as const;
+
+/** What buildClassic does with an option it is not given (gcs_skin.h GCS_CLASSIC_DEFAULT_*). */
+export const CLASSIC_DEFAULTS = {
+  contours: GCS_CLASSIC_DEFAULT_CONTOURS,
+  rays: GCS_CLASSIC_DEFAULT_RAYS,
+  bulge: GCS_CLASSIC_DEFAULT_BULGE,
+} as const;
+
 /** Options of `Rig.buildClassic`: resampling density and muscle bulge. */
 export interface ClassicOptions {
-  /** Contours per resampled part, 2..256. Default 25. */
+  /** Contours per resampled part, 2..256. Default `CLASSIC_DEFAULTS.contours` (25). */
   contours?: number;
-  /** Rays per contour, 3..256. Default 20. */
+  /** Rays per contour, 3..256. Default `CLASSIC_DEFAULTS.rays` (20). */
   rays?: number;
-  /** Muscle bulge gain, 0..4. Default 0.3. */
+  /** Muscle bulge gain, 0..4. Default `CLASSIC_DEFAULTS.bulge` (0.3). */
   bulge?: number;
 }
 
 /** Which method a deformer runs: `'gcs'`, `'classic'`, `'lbs'` or `'dqs'`. */
-export type DeformerKind = (typeof DEFORMER_KINDS)[number];
+export type DeformerKind = (typeof GcsDeformerKindNames)[number];
 
 /** One GCS section as `GcsDeformer.sections()` reports it: its run of output vertices and what moves it. */
 export interface SectionInfo {
@@ -166,9 +194,9 @@ export interface SectionInfo {
  * build time: at a probe pose (every joint bent 35°) its tube stands off the skin it replaces by more than
  * 1 % of the height at p99 or 2.5 % at most, or its end cap would cut flat across a rounded end).
  */
-export type ClassicReason = 'resampled' | 'leaf' | 'branching' | 'too-short' | 'rays-miss' | 'bent' | 'seam' | 'trunk' | 'off-surface';
+export type ClassicReason = (typeof GcsClassicReasonNames)[number];
 /** The reasons in the order of their codes (GcsClassicReason). */
-export const CLASSIC_REASONS: readonly ClassicReason[] = ['resampled', 'leaf', 'branching', 'too-short', 'rays-miss', 'bent', 'seam', 'trunk', 'off-surface'];
+export const CLASSIC_REASONS: readonly ClassicReason[] = GcsClassicReasonNames;
 
 /** One part of the classic model (one joint's skin): resampled into a tube, or carried. */
 export interface ClassicPart {
@@ -400,6 +428,34 @@ function checkFlag(value: unknown, name: string): void {
     throw new GcsError('INVALID_ARGUMENT', `${name} must be true or false; got ${asGiven(value)}`);
 }
 
+/**
+ * GcsOptions as the core's GcsSettings, its defaults filled in. Only what cannot cross the boundary
+ * is refused here (a string for a number, a fraction for a count, an unknown criterion name, a
+ * flag that is not a boolean); the core checks every range, once (gcs_build_gcs).
+ */
+function settingsOf(options: GcsOptions): GcsSettings {
+  const sections = options.sections ?? GCS_DEFAULTS.sections;
+  const criterion = options.criterion ?? GCS_DEFAULTS.criterion;
+  const width = options.influenceWidth ?? GCS_DEFAULTS.influenceWidth;
+  if (typeof sections !== 'number' || !Number.isInteger(sections) || sections < 0 || sections > 0xffffffff)
+    throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${asGiven(sections)}`);
+  if (!CRITERIA.includes(criterion))
+    throw new GcsError('INVALID_ARGUMENT', `criterion must be 'weights', 'y' or 'axial'; got ${asGiven(criterion)}`);
+  if (typeof width !== 'number')
+    throw new GcsError('INVALID_ARGUMENT', `the influence width must be a number in (0, 1]; got ${asGiven(width)}`);
+  checkFlag(options.smooth, 'smooth');
+  checkFlag(options.twistSpread, 'twistSpread');
+  checkFlag(options.centres, 'centres');
+  return {
+    sections,
+    criterion: CRITERIA.indexOf(criterion),
+    influenceWidth: width,
+    smooth: options.smooth === undefined ? GCS_SMOOTH_BY_CRITERION : Number(options.smooth),
+    twistSpread: Number(options.twistSpread ?? GCS_DEFAULTS.twistSpread),
+    centres: Number(options.centres ?? GCS_DEFAULTS.centres),
+  };
+}
+
 /** A validated skinned mesh in wasm memory: the input every deformer is built from. */
 export class Rig {
   /** Number of vertices of the skinned mesh. */
@@ -435,20 +491,16 @@ export class Rig {
    */
   buildGcs(options: GcsOptions = {}): GcsDeformer {
     checkOptions(options, 'buildGcs');
-    const sections = options.sections ?? 6;
-    const criterion = options.criterion ?? 'weights';
-    const width = options.influenceWidth ?? 1;
-    if (!Number.isInteger(sections) || sections < MIN_SECTIONS || sections > MAX_SECTIONS)
-      throw new GcsError('SECTION_COUNT', `the section count must be a whole number between ${MIN_SECTIONS} and ${MAX_SECTIONS}; got ${asGiven(sections)}`);
-    if (!CRITERIA.includes(criterion))
-      throw new GcsError('INVALID_ARGUMENT', `criterion must be 'weights', 'y' or 'axial'; got ${asGiven(criterion)}`);
-    if (typeof width !== 'number' || !(width > 0 && width <= 1))
-      throw new GcsError(typeof width === 'number' ? 'OUT_OF_RANGE' : 'INVALID_ARGUMENT', `the influence width must be a number in (0, 1]; got ${asGiven(width)}`);
-    checkFlag(options.smooth, 'smooth');
-    checkFlag(options.twistSpread, 'twistSpread');
-    checkFlag(options.centres, 'centres');
-    const h = this.gcs.core.gcs_build_gcs(this.live(), sections, CRITERIA.indexOf(criterion), width,
-      (options.smooth ?? criterion === 'weights') ? 1 : 0, options.twistSpread ? 1 : 0, (options.centres ?? DEFAULT_CENTRES) ? 1 : 0);
+    const settings = settingsOf(options);
+    const ptr = this.gcs.core.gcs_alloc(GcsSettingsBytes);
+    if (!ptr) this.gcs.raise(`out of memory: could not allocate ${GcsSettingsBytes} bytes`);
+    let h: number;
+    try {
+      writeGcsSettings(this.gcs.memory.buffer, ptr, settings);
+      h = this.gcs.core.gcs_build_gcs(this.live(), ptr);
+    } finally {
+      this.gcs.core.gcs_free(ptr);
+    }
     if (!h) this.gcs.raise('the GCS model could not be built');
     return new GcsDeformer(this.gcs, h, this.jointCount);
   }
@@ -461,9 +513,9 @@ export class Rig {
    */
   buildClassic(options: ClassicOptions = {}): ClassicDeformer {
     checkOptions(options, 'buildClassic');
-    const contours = options.contours ?? 25;
-    const rays = options.rays ?? 20;
-    const bulge = options.bulge ?? 0.3;
+    const contours = options.contours ?? CLASSIC_DEFAULTS.contours;
+    const rays = options.rays ?? CLASSIC_DEFAULTS.rays;
+    const bulge = options.bulge ?? CLASSIC_DEFAULTS.bulge;
     const L = CLASSIC_LIMITS;
     if (!Number.isInteger(contours) || contours < L.minContours || contours > L.maxContours)
       throw new GcsError('OUT_OF_RANGE', `contours must be a whole number between ${L.minContours} and ${L.maxContours}; got ${asGiven(contours)}`);
@@ -508,6 +560,13 @@ export class Rig {
   }
 }
 
+/** J identity matrices: the skin matrices of the bind pose (what `deform` takes at rest). */
+export function identitySkin(jointCount: number): Float32Array {
+  const skin = new Float32Array(jointCount * 16);
+  for (let j = 0; j < jointCount; j++) skin[16 * j] = skin[16 * j + 5] = skin[16 * j + 10] = skin[16 * j + 15] = 1;
+  return skin;
+}
+
 /** A runtime deformer: owns its output mesh in wasm memory and fills it every frame. */
 export class Deformer {
   /** The method this deformer runs. */
@@ -538,7 +597,7 @@ export class Deformer {
   constructor(readonly gcs: GcsSkin, handle: number, jointCount: number) {
     const core = gcs.core;
     this.handle = handle;
-    this.kind = DEFORMER_KINDS[core.gcs_deformer_kind(handle)] ?? 'gcs';
+    this.kind = GcsDeformerKindNames[core.gcs_deformer_kind(handle)] ?? 'gcs';
     this.vertexCount = core.gcs_deformer_vertex_count(handle);
     this.jointCount = jointCount;
     this.positionsPtr = core.gcs_deformer_positions(handle);
@@ -755,11 +814,11 @@ export class Deformer {
 
   /** Sections (GCS) or contours (classic) in the model; 0 for LBS/DQS. */
   get sectionCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.sections);
+    return this.gcs.core.gcs_deformer_stat(this.live(), GcsStat.sections);
   }
   /** Parts (joints that own vertices) in the model; 0 for LBS/DQS. */
   get partCount(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.parts);
+    return this.gcs.core.gcs_deformer_stat(this.live(), GcsStat.parts);
   }
 
   /** Frees the deformer's wasm memory; its views must not be used afterwards. */
@@ -782,11 +841,11 @@ export class Deformer {
 export class GcsDeformer extends Deformer {
   /** Last frame: share of sections whose transform is not their part's rigid transform. */
   get adjustedShare(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedShare);
+    return this.gcs.core.gcs_deformer_stat(this.live(), GcsStat.adjustedShare);
   }
   /** Last frame: number of sections whose transform is not their part's rigid transform. */
   get adjustedSections(): number {
-    return this.gcs.core.gcs_deformer_stat(this.live(), STATS.adjustedSections);
+    return this.gcs.core.gcs_deformer_stat(this.live(), GcsStat.adjustedSections);
   }
   /** Section id of each output vertex (a copy). */
   sectionOfVertex(): Uint32Array {
@@ -797,12 +856,14 @@ export class GcsDeformer extends Deformer {
   sections(): SectionInfo[] {
     const h = this.live();
     const n = this.sectionCount;
-    const info = this.gcs.viewF32(this.gcs.core.gcs_gcs_section_info(h), n * 8);
+    const info = this.gcs.viewF32(this.gcs.core.gcs_gcs_section_info(h), n * GCS_SECTION_INFO_FLOATS);
+    const F = GcsSectionInfoField;
     const out: SectionInfo[] = [];
     for (let i = 0; i < n; i++) {
-      const o = i * 8;
-      out.push({ first: info[o], count: info[o + 1], part: info[o + 2], distal: info[o + 3], shared: info[o + 4] === 1,
-        rigid: info[o + 4] === 2, t: info[o + 5], alpha: info[o + 6], beta: info[o + 7] });
+      const o = i * GCS_SECTION_INFO_FLOATS;
+      out.push({ first: info[o + F.first], count: info[o + F.count], part: info[o + F.part], distal: info[o + F.distal],
+        shared: info[o + F.kind] === GcsSectionKind.shared, rigid: info[o + F.kind] === GcsSectionKind.rigid,
+        t: info[o + F.t], alpha: info[o + F.alpha], beta: info[o + F.beta] });
     }
     return out;
   }
@@ -897,11 +958,11 @@ export class GcsDeformer extends Deformer {
 }
 
 /** RGBA32F texels per GCS section in the GPU path's buffer (the rows of its affine 3×4 transform). */
-export const GPU_TEXELS_PER_SECTION = 3;
+export const GPU_TEXELS_PER_SECTION = GCS_GPU_TEXELS_PER_SECTION;
 /** RGBA32F texels per joint in the joint-level GPU path's buffer (the rows of S_j, its rotation quaternion). */
-export const GPU_TEXELS_PER_JOINT = 4;
+export const GPU_TEXELS_PER_JOINT = GCS_GPU_TEXELS_PER_JOINT;
 /** Most instances one computeSectionsAt call takes. */
-export const MAX_INSTANCES = 65536;
+export const MAX_INSTANCES = GCS_MAX_INSTANCES;
 
 /** The classic cross-section deformer (resampled contours). */
 export class ClassicDeformer extends Deformer {
@@ -911,13 +972,16 @@ export class ClassicDeformer extends Deformer {
     const n = this.gcs.core.gcs_classic_part_count(h);
     const ptr = this.gcs.core.gcs_classic_parts(h);
     if (!ptr) return [];
-    const a = this.gcs.viewI32(ptr, n * 5);
+    const a = this.gcs.viewI32(ptr, n * GCS_CLASSIC_PART_INTS);
+    const F = GcsClassicPartField;
     const out: ClassicPart[] = [];
-    for (let i = 0; i < n; i++)
+    for (let i = 0; i < n; i++) {
+      const o = i * GCS_CLASSIC_PART_INTS;
       out.push({
-        joint: a[5 * i], resampled: a[5 * i + 1] === 1, reason: CLASSIC_REASONS[a[5 * i + 4]] ?? 'leaf',
-        firstVertex: a[5 * i + 2], vertexCount: a[5 * i + 3],
+        joint: a[o + F.joint], resampled: a[o + F.resampled] === 1, reason: CLASSIC_REASONS[a[o + F.reason]] ?? 'leaf',
+        firstVertex: a[o + F.firstVertex], vertexCount: a[o + F.vertexCount],
       });
+    }
     return out;
   }
   /**

@@ -103,13 +103,29 @@ function transformPrim(pr: Primitive, fp: (p: Vec3) => Vec3, fd: (d: Vec3) => Ve
   return { ...pr, p };
 }
 
+/** The left arm's and leg's joints, ends and primitives (mirrored to the right by addMirrored). */
+interface LeftLimbs {
+  prims: Primitive[];
+  joints: [JointName, Vec3][];
+  ends: [JointName, Vec3][];
+}
+
 export function buildBodyModel(pose: Pose): BodyModel {
-  const J = (n: JointName) => jointIndex(n);
   const joints: Vec3[] = new Array(JOINT_NAMES.length);
   const ends = new Map<number, Vec3>();
   const prims: Primitive[] = [];
+  addTorsoAndHead(joints, ends, prims);
+  const left: LeftLimbs = { prims: [], joints: [], ends: [] };
+  addLeftArm(left, pose);
+  addLeftLeg(left);
+  addMirrored(left, joints, ends, prims);
+  const { mn, mx } = paddedBounds(prims);
+  return { pose, prims, joints, ends, densify: densifyPlanes(pose, joints), bboxMin: mn, bboxMax: mx };
+}
 
-  // ---- torso, neck, head (symmetric) ----
+/** Torso, neck and head (symmetric). */
+function addTorsoAndHead(joints: Vec3[], ends: Map<number, Vec3>, prims: Primitive[]): void {
+  const J = (n: JointName) => jointIndex(n);
   joints[J('Hips')] = [0, 0.96, 0];
   joints[J('Spine')] = [0, 1.06, 0];
   joints[J('Chest')] = [0, 1.22, 0];
@@ -133,65 +149,73 @@ export function buildBodyModel(pose: Pose): BodyModel {
     prims.push(ellipsoid(J('Head'), H, [sx * 0.075, 1.655, 0.0], [0.012, 0.03, 0.018])); // ears
     prims.push(ellipsoid(J('Head'), H, [sx * 0.036, 1.685, 0.075], [0.024, 0.012, 0.022])); // brow
   }
+}
 
-  // ---- left limbs (mirrored to the right) ----
-  const left: { prims: Primitive[]; joints: [JointName, Vec3][]; ends: [JointName, Vec3][] } = { prims: [], joints: [], ends: [] };
-  {
-    const LA = G_ARM_L, LL = G_LEG_L;
-    const sh: Vec3 = [0.195, 1.43, -0.01];
-    const d: Vec3 = [Math.sin(STAND_ARM_ANGLE), -Math.cos(STAND_ARM_ANGLE), 0];
-    const side: Vec3 = [Math.cos(STAND_ARM_ANGLE), Math.sin(STAND_ARM_ANGLE), 0]; // lateral, ⟂ arm
-    const fwd: Vec3 = [0, 0, 1];
-    const at = (o: Vec3, t: number, s = 0, f = 0): Vec3 => add(add(add(o, d, t), side, s), fwd, f);
-    const elbow = at(sh, 0.29);
-    const wrist = at(elbow, 0.25);
-    const tip = at(wrist, 0.185);
-    const clav: Vec3 = [0.035, 1.445, 0.02];
-    const armPrims: Primitive[] = [];
-    const A = jointIndex('LeftArm'), F = jointIndex('LeftForeArm'), Hd = jointIndex('LeftHand');
-    armPrims.push(ellipsoid(A, LA, at(sh, 0.045, 0.012), [0.052, 0.075, 0.056], d, fwd)); // deltoid
-    armPrims.push(cone(A, LA, sh, elbow, 0.046, 0.036));
-    armPrims.push(ellipsoid(A, LA, at(sh, 0.15, -0.002, 0.012), [0.04, 0.095, 0.043], d, fwd)); // biceps
-    armPrims.push(ellipsoid(A, LA, at(sh, 0.15, 0.0, -0.014), [0.038, 0.1, 0.038], d, fwd)); // triceps
-    armPrims.push(cone(F, LA, elbow, wrist, 0.036, 0.025));
-    armPrims.push(ellipsoid(F, LA, at(elbow, 0.075, 0.003, 0.004), [0.04, 0.085, 0.036], d, fwd)); // forearm muscles
-    // hand hanging with the palm towards the thigh: width along z, thickness along `side`
-    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.07, 0.002, 0.003), [0.021, 0.068, 0.044], d, fwd)); // palm
-    armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.135, 0.0, 0.0), [0.017, 0.055, 0.038], d, fwd)); // fingers
-    armPrims.push(cone(Hd, LA, at(wrist, 0.03, -0.008, 0.03), at(wrist, 0.1, -0.012, 0.05), 0.014, 0.01)); // thumb
-    left.ends.push(['LeftHand', tip]);
-    left.joints.push(['LeftShoulder', clav], ['LeftArm', sh], ['LeftForeArm', elbow], ['LeftHand', wrist]);
-    // clavicle / trapezius (part of the torso blend group)
-    left.prims.push(cone(jointIndex('LeftShoulder'), T, [0.04, 1.45, -0.02], [0.17, 1.44, -0.015], 0.05, 0.045));
+/** The left arm (hanging, or raised to horizontal for the T-pose) and the clavicle. */
+function addLeftArm(left: LeftLimbs, pose: Pose): void {
+  const T = G_TORSO;
+  const LA = G_ARM_L;
+  const sh: Vec3 = [0.195, 1.43, -0.01];
+  const d: Vec3 = [Math.sin(STAND_ARM_ANGLE), -Math.cos(STAND_ARM_ANGLE), 0];
+  const side: Vec3 = [Math.cos(STAND_ARM_ANGLE), Math.sin(STAND_ARM_ANGLE), 0]; // lateral, ⟂ arm
+  const fwd: Vec3 = [0, 0, 1];
+  const at = (o: Vec3, t: number, s = 0, f = 0): Vec3 => add(add(add(o, d, t), side, s), fwd, f);
+  const elbow = at(sh, 0.29);
+  const wrist = at(elbow, 0.25);
+  const tip = at(wrist, 0.185);
+  const clav: Vec3 = [0.035, 1.445, 0.02];
+  const armPrims: Primitive[] = [];
+  const A = jointIndex('LeftArm'), F = jointIndex('LeftForeArm'), Hd = jointIndex('LeftHand');
+  armPrims.push(ellipsoid(A, LA, at(sh, 0.045, 0.012), [0.052, 0.075, 0.056], d, fwd)); // deltoid
+  armPrims.push(cone(A, LA, sh, elbow, 0.046, 0.036));
+  armPrims.push(ellipsoid(A, LA, at(sh, 0.15, -0.002, 0.012), [0.04, 0.095, 0.043], d, fwd)); // biceps
+  armPrims.push(ellipsoid(A, LA, at(sh, 0.15, 0.0, -0.014), [0.038, 0.1, 0.038], d, fwd)); // triceps
+  armPrims.push(cone(F, LA, elbow, wrist, 0.036, 0.025));
+  armPrims.push(ellipsoid(F, LA, at(elbow, 0.075, 0.003, 0.004), [0.04, 0.085, 0.036], d, fwd)); // forearm muscles
+  // hand hanging with the palm towards the thigh: width along z, thickness along `side`
+  armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.07, 0.002, 0.003), [0.021, 0.068, 0.044], d, fwd)); // palm
+  armPrims.push(ellipsoid(Hd, LA, at(wrist, 0.135, 0.0, 0.0), [0.017, 0.055, 0.038], d, fwd)); // fingers
+  armPrims.push(cone(Hd, LA, at(wrist, 0.03, -0.008, 0.03), at(wrist, 0.1, -0.012, 0.05), 0.014, 0.01)); // thumb
+  left.ends.push(['LeftHand', tip]);
+  left.joints.push(['LeftShoulder', clav], ['LeftArm', sh], ['LeftForeArm', elbow], ['LeftHand', wrist]);
+  // clavicle / trapezius (part of the torso blend group)
+  left.prims.push(cone(jointIndex('LeftShoulder'), T, [0.04, 1.45, -0.02], [0.17, 1.44, -0.015], 0.05, 0.045));
 
-    if (pose === 'tpose') {
-      const ang = Math.PI / 2 - STAND_ARM_ANGLE; // rotate the arm up to horizontal (+X)
-      const fp = (p: Vec3) => rotZ(p, sh, ang);
-      const fd = (v: Vec3) => rotDirZ(v, ang);
-      for (const p of armPrims) left.prims.push(transformPrim(p, fp, fd));
-      for (const j of left.joints) if (j[0] !== 'LeftShoulder' && j[0] !== 'LeftArm') j[1] = fp(j[1]);
-      left.ends[0][1] = fp(left.ends[0][1]);
-    } else {
-      left.prims.push(...armPrims);
-    }
-
-    const hip: Vec3 = [0.09, 0.905, 0];
-    const knee: Vec3 = [0.095, 0.495, 0.0];
-    const ankle: Vec3 = [0.1, 0.085, -0.015];
-    const toe: Vec3 = [0.105, 0.025, 0.165];
-    const U = jointIndex('LeftUpLeg'), Lg = jointIndex('LeftLeg'), Ft = jointIndex('LeftFoot');
-    left.joints.push(['LeftUpLeg', hip], ['LeftLeg', knee], ['LeftFoot', ankle]);
-    left.ends.push(['LeftFoot', toe]);
-    left.prims.push(cone(U, LL, [0.088, 0.92, -0.005], knee, 0.088, 0.052));
-    left.prims.push(ellipsoid(U, LL, [0.098, 0.73, 0.012], [0.074, 0.17, 0.074], [0.01, 1, 0])); // quadriceps
-    left.prims.push(ellipsoid(U, LL, [0.092, 0.75, -0.02], [0.07, 0.15, 0.065])); // hamstrings
-    left.prims.push(cone(Lg, LL, knee, ankle, 0.05, 0.032));
-    left.prims.push(ellipsoid(Lg, LL, [0.098, 0.36, -0.02], [0.05, 0.115, 0.05])); // calf
-    left.prims.push(cone(Lg, LL, [0.095, 0.5, 0.022], [0.097, 0.45, 0.03], 0.032, 0.03)); // kneecap
-    left.prims.push(ellipsoid(Ft, LL, [0.1, 0.055, 0.045], [0.044, 0.042, 0.1], [0, 1, 0], [0.03, -0.12, 1])); // foot body
-    left.prims.push(cone(Ft, LL, [0.1, 0.045, -0.045], [0.1, 0.05, -0.01], 0.042, 0.04)); // heel
-    left.prims.push(cone(Ft, LL, [0.1, 0.035, 0.07], [0.107, 0.027, 0.165], 0.036, 0.026)); // forefoot/toes
+  if (pose === 'tpose') {
+    const ang = Math.PI / 2 - STAND_ARM_ANGLE; // rotate the arm up to horizontal (+X)
+    const fp = (p: Vec3) => rotZ(p, sh, ang);
+    const fd = (v: Vec3) => rotDirZ(v, ang);
+    for (const p of armPrims) left.prims.push(transformPrim(p, fp, fd));
+    for (const j of left.joints) if (j[0] !== 'LeftShoulder' && j[0] !== 'LeftArm') j[1] = fp(j[1]);
+    left.ends[0][1] = fp(left.ends[0][1]);
+  } else {
+    left.prims.push(...armPrims);
   }
+}
+
+/** The left leg. */
+function addLeftLeg(left: LeftLimbs): void {
+  const LL = G_LEG_L;
+  const hip: Vec3 = [0.09, 0.905, 0];
+  const knee: Vec3 = [0.095, 0.495, 0.0];
+  const ankle: Vec3 = [0.1, 0.085, -0.015];
+  const toe: Vec3 = [0.105, 0.025, 0.165];
+  const U = jointIndex('LeftUpLeg'), Lg = jointIndex('LeftLeg'), Ft = jointIndex('LeftFoot');
+  left.joints.push(['LeftUpLeg', hip], ['LeftLeg', knee], ['LeftFoot', ankle]);
+  left.ends.push(['LeftFoot', toe]);
+  left.prims.push(cone(U, LL, [0.088, 0.92, -0.005], knee, 0.088, 0.052));
+  left.prims.push(ellipsoid(U, LL, [0.098, 0.73, 0.012], [0.074, 0.17, 0.074], [0.01, 1, 0])); // quadriceps
+  left.prims.push(ellipsoid(U, LL, [0.092, 0.75, -0.02], [0.07, 0.15, 0.065])); // hamstrings
+  left.prims.push(cone(Lg, LL, knee, ankle, 0.05, 0.032));
+  left.prims.push(ellipsoid(Lg, LL, [0.098, 0.36, -0.02], [0.05, 0.115, 0.05])); // calf
+  left.prims.push(cone(Lg, LL, [0.095, 0.5, 0.022], [0.097, 0.45, 0.03], 0.032, 0.03)); // kneecap
+  left.prims.push(ellipsoid(Ft, LL, [0.1, 0.055, 0.045], [0.044, 0.042, 0.1], [0, 1, 0], [0.03, -0.12, 1])); // foot body
+  left.prims.push(cone(Ft, LL, [0.1, 0.045, -0.045], [0.1, 0.05, -0.01], 0.042, 0.04)); // heel
+  left.prims.push(cone(Ft, LL, [0.1, 0.035, 0.07], [0.107, 0.027, 0.165], 0.036, 0.026)); // forefoot/toes
+}
+
+/** The left limbs and their mirror images (x → −x, Left → Right, the left groups → the right ones). */
+function addMirrored(left: LeftLimbs, joints: Vec3[], ends: Map<number, Vec3>, prims: Primitive[]): void {
   const mir = (p: Vec3): Vec3 => [-p[0], p[1], p[2]];
   for (const [n, p] of left.joints) {
     joints[jointIndex(n)] = p;
@@ -207,8 +231,10 @@ export function buildBodyModel(pose: Pose): BodyModel {
     prims.push(p);
     prims.push({ ...transformPrim(p, mir, mir), bone: rightOf(p.bone), group: rightGroup(p.group) });
   }
+}
 
-  // densify around joints: along y for the vertical chains, along x for T-posed arms
+/** Where the mesh is densified around joints: along y for the vertical chains, along x for T-posed arms. */
+function densifyPlanes(pose: Pose, joints: Vec3[]): { x: number[]; y: number[]; z: number[] } {
   const ys = ['LeftFoot', 'LeftLeg', 'LeftUpLeg', 'Neck', 'LeftArm'].map((n) => joints[jointIndex(n as JointName)][1]);
   const xs: number[] = [];
   if (pose === 'stand') {
@@ -219,6 +245,11 @@ export function buildBodyModel(pose: Pose): BodyModel {
       xs.push(x, -x);
     }
   }
+  return { x: xs, y: ys, z: [] };
+}
+
+/** The primitives' bounding box, 3 cm larger on every side. */
+function paddedBounds(prims: Primitive[]): { mn: Vec3; mx: Vec3 } {
   let mn: Vec3 = [Infinity, Infinity, Infinity], mx: Vec3 = [-Infinity, -Infinity, -Infinity];
   for (const pr of prims) {
     const p = pr.p;
@@ -234,5 +265,5 @@ export function buildBodyModel(pose: Pose): BodyModel {
   }
   mn = add(mn, [-0.03, -0.03, -0.03]);
   mx = add(mx, [0.03, 0.03, 0.03]);
-  return { pose, prims, joints, ends, densify: { x: xs, y: ys, z: [] }, bboxMin: mn, bboxMax: mx };
+  return { mn, mx };
 }

@@ -71,76 +71,113 @@ interface Limb {
 const MIRROR_POINTS = 4;   // joints of each limb compared by the mirror test (fingers left out)
 const MIRROR_TOLERANCE = 0.2; // largest mirror error, as a fraction of the limb's length
 
+/** What the steps of findHinges read of the rig: joint centres, children, each vertex's dominant joint, reach. */
+interface Skeleton {
+  input: RigInput;
+  centres: Vec3[];
+  children: number[][];
+  dominant: Int32Array;
+  /** Reach of each joint (the longest path down its subtree), -1 until asked (reachOf). */
+  reach: Float64Array;
+}
+
 /**
- * Finds the knees and elbows of a skeleton from its layout (no names needed) and each one's hinge axis.
+ * Finds the knees and elbows of a rig from its skeleton's layout alone (the file's opening comment
+ * says how) and each one's hinge axis; `names` (the joints' names, when known) only label them.
+ * Returns the hinges found (left knee, right knee, left elbow, right elbow), the character's frame,
+ * and notes saying why something was not found or was guessed. Used by measureJoints.
  * @param input The rig (joint centres come from its inverse bind matrices and skin).
  * @param names Joint names, used only in the labels.
  * @returns The hinges found, the body frame, and notes on what was not found or guessed.
  */
 export function findHinges(input: RigInput, names?: readonly (string | undefined)[]): HingeSearch {
   const notes: string[] = [];
+  const skeleton = skeletonOf(input);
+  const limbs = limbPairs(skeleton, mirroredPairs(skeleton));
+  if (limbs.length < 2) {
+    notes.push(limbs.length ? 'one mirrored pair of limbs only (legs and arms need two, with skin on this mesh): no knee or elbow found'
+      : 'no mirrored pair of limbs in the skeleton: no knee or elbow found');
+    return { hinges: [], frame: null, notes };
+  }
+  const legsAndArms = legsAndArmsOf(skeleton, limbs, notes);
+  if (!legsAndArms) return { hinges: [], frame: null, notes };
+  const { legs, arms, down } = legsAndArms;
+  const frame = bodyFrame(skeleton, legs, down, notes);
+  const hinges: Hinge[] = [];
+  hingesOfPair(skeleton, legs, 'knee', frame, names, hinges, notes);
+  hingesOfPair(skeleton, arms, 'elbow', frame, names, hinges, notes);
+  return { hinges, frame, notes };
+}
+
+function skeletonOf(input: RigInput): Skeleton {
   const J = input.parents.length;
-  const centres = jointCentres(input);
   const children: number[][] = Array.from({ length: J }, () => []);
   for (let j = 0; j < J; j++) {
     const p = input.parents[j];
     if (p >= 0 && p < J) children[p].push(j);
   }
-  const dominant = dominantJoints(input);
-  const leafTip = (j: number): Vec3 | null => {
-    let best = -1, far: Vec3 | null = null;
-    const P = input.positions;
-    for (let v = 0; v < dominant.length; v++) {
-      if (dominant[v] !== j) continue;
-      const d = dist([P[3 * v], P[3 * v + 1], P[3 * v + 2]], centres[j]);
-      if (d > best) { best = d; far = [P[3 * v], P[3 * v + 1], P[3 * v + 2]]; }
-    }
-    return far;
-  };
-  // Reach of each joint: the longest path down its subtree (children have higher or lower ids: recurse).
-  const reach = new Float64Array(J).fill(-1);
-  const reachOf = (j: number): number => {
-    if (reach[j] >= 0) return reach[j];
-    reach[j] = 0; // a cycle in bad input ends here
-    let r = 0;
-    for (const c of children[j]) r = Math.max(r, dist(centres[c], centres[j]) + reachOf(c));
-    return (reach[j] = r);
-  };
-  const limbOf = (branch: number, root: number): Limb | null => {
-    const path = [root];
-    const seen = new Set(path);
-    for (let j = root; children[j].length;) {
-      let next = -1, best = -1;
-      for (const c of children[j]) {
-        const r = dist(centres[c], centres[j]) + reachOf(c);
-        if (r > best && !seen.has(c)) { best = r; next = c; }
-      }
-      if (next < 0) break;
-      path.push(next); seen.add(next); j = next;
-    }
-    // The hinge: the joint (not the limb's root) between its two longest consecutive segments.
-    let hinge = -1, score = 0, end: Vec3 | null = null;
-    for (let i = 1; i < path.length; i++) {
-      const after = i + 1 < path.length ? centres[path[i + 1]] : leafTip(path[i]);
-      if (!after) continue;
-      const s = Math.min(dist(centres[path[i]], centres[path[i - 1]]), dist(after, centres[path[i]]));
-      if (s > score) { score = s; hinge = i; end = after; }
-    }
-    if (hinge < 0 || !end) return null;
-    let length = dist(centres[root], centres[branch]);
-    for (let i = 1; i < Math.min(path.length, MIRROR_POINTS); i++) length += dist(centres[path[i]], centres[path[i - 1]]);
-    return { branch, path, hinge, end, length };
-  };
+  return { input, centres: jointCentres(input), children, dominant: dominantJoints(input), reach: new Float64Array(J).fill(-1) };
+}
 
-  // Mirrored pairs of limbs hanging off one branch joint.
+/** The skin point of joint j farthest from its centre (the far end of a leaf bone), or null when j holds no skin. */
+function leafTip(s: Skeleton, j: number): Vec3 | null {
+  let best = -1, far: Vec3 | null = null;
+  const P = s.input.positions;
+  for (let v = 0; v < s.dominant.length; v++) {
+    if (s.dominant[v] !== j) continue;
+    const d = dist([P[3 * v], P[3 * v + 1], P[3 * v + 2]], s.centres[j]);
+    if (d > best) { best = d; far = [P[3 * v], P[3 * v + 1], P[3 * v + 2]]; }
+  }
+  return far;
+}
+
+/** Reach of a joint: the longest path down its subtree (children have higher or lower ids: recurse). */
+function reachOf(s: Skeleton, j: number): number {
+  if (s.reach[j] >= 0) return s.reach[j];
+  s.reach[j] = 0; // a cycle in bad input ends here
+  let r = 0;
+  for (const c of s.children[j]) r = Math.max(r, dist(s.centres[c], s.centres[j]) + reachOf(s, c));
+  return (s.reach[j] = r);
+}
+
+/** The limb from `root` (a child of `branch`), following the farthest-reaching child, and its hinge. */
+function limbOf(s: Skeleton, branch: number, root: number): Limb | null {
+  const { centres, children } = s;
+  const path = [root];
+  const seen = new Set(path);
+  for (let j = root; children[j].length;) {
+    let next = -1, best = -1;
+    for (const c of children[j]) {
+      const r = dist(centres[c], centres[j]) + reachOf(s, c);
+      if (r > best && !seen.has(c)) { best = r; next = c; }
+    }
+    if (next < 0) break;
+    path.push(next); seen.add(next); j = next;
+  }
+  // The hinge: the joint (not the limb's root) between its two longest consecutive segments.
+  let hinge = -1, score = 0, end: Vec3 | null = null;
+  for (let i = 1; i < path.length; i++) {
+    const after = i + 1 < path.length ? centres[path[i + 1]] : leafTip(s, path[i]);
+    if (!after) continue;
+    const d = Math.min(dist(centres[path[i]], centres[path[i - 1]]), dist(after, centres[path[i]]));
+    if (d > score) { score = d; hinge = i; end = after; }
+  }
+  if (hinge < 0 || !end) return null;
+  let length = dist(centres[root], centres[branch]);
+  for (let i = 1; i < Math.min(path.length, MIRROR_POINTS); i++) length += dist(centres[path[i]], centres[path[i - 1]]);
+  return { branch, path, hinge, end, length };
+}
+
+/** Mirrored pairs of limbs hanging off one branch joint, the best-mirrored first at each branch. */
+function mirroredPairs(s: Skeleton): [Limb, Limb][] {
   const pairs: [Limb, Limb][] = [];
-  for (let b = 0; b < J; b++) {
-    if (children[b].length < 2) continue;
-    const limbs = children[b].map((c) => limbOf(b, c)).filter((l): l is Limb => l !== null);
+  for (let b = 0; b < s.children.length; b++) {
+    if (s.children[b].length < 2) continue;
+    const limbs = s.children[b].map((c) => limbOf(s, b, c)).filter((l): l is Limb => l !== null);
     const candidates: { a: Limb; b: Limb; error: number }[] = [];
     for (let i = 0; i < limbs.length; i++)
       for (let k = i + 1; k < limbs.length; k++) {
-        const error = mirrorError(limbs[i], limbs[k], centres);
+        const error = mirrorError(limbs[i], limbs[k], s.centres);
         if (error < MIRROR_TOLERANCE) candidates.push({ a: limbs[i], b: limbs[k], error });
       }
     candidates.sort((x, y) => x.error - y.error);
@@ -151,31 +188,36 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
       pairs.push([c.a, c.b]);
     }
   }
-  // Limbs, not fingers or ears: each pair as long as a fifth of the skeleton's extent at least, its
-  // hinges skinned on this mesh.
+  return pairs;
+}
+
+/** Limbs, not fingers or ears: each pair as long as a fifth of the skeleton's extent at least, its hinges skinned on this mesh. */
+function limbPairs(s: Skeleton, pairs: [Limb, Limb][]): [Limb, Limb][] {
   const lo: Vec3 = [Infinity, Infinity, Infinity], hi: Vec3 = [-Infinity, -Infinity, -Infinity];
-  for (const c of centres) for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], c[k]); hi[k] = Math.max(hi[k], c[k]); }
+  for (const c of s.centres) for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], c[k]); hi[k] = Math.max(hi[k], c[k]); }
   const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   const skinned = new Set<number>(); // joints with weight on some vertex of this mesh
-  for (let i = 0; i < input.weights.length; i++) if (input.weights[i] > 0) skinned.add(input.joints[i]);
-  const limbs = pairs.filter(([a, b]) => Math.min(a.length, b.length) >= 0.2 * extent &&
+  for (let i = 0; i < s.input.weights.length; i++) if (s.input.weights[i] > 0) skinned.add(s.input.joints[i]);
+  return pairs.filter(([a, b]) => Math.min(a.length, b.length) >= 0.2 * extent &&
     skinned.has(a.path[a.hinge]) && skinned.has(b.path[b.hinge]));
-  if (limbs.length < 2) {
-    notes.push(limbs.length ? 'one mirrored pair of limbs only (legs and arms need two, with skin on this mesh): no knee or elbow found'
-      : 'no mirrored pair of limbs in the skeleton: no knee or elbow found');
-    return { hinges: [], frame: null, notes };
-  }
+}
 
-  // Up: against the pair whose limbs reach furthest from their roots, taken together (the legs).
+/**
+ * Up is against the pair whose limbs reach furthest from their roots, taken together (`down`); the
+ * legs are the pair of the lowest branch, the arms the longest pair above them and outside them.
+ * Null (a note said why) when there is no telling.
+ */
+function legsAndArmsOf(s: Skeleton, limbs: [Limb, Limb][], notes: string[]): { legs: [Limb, Limb]; arms: [Limb, Limb]; down: Vec3 } | null {
+  const { centres } = s;
   const reachVector = ([a, b]: [Limb, Limb]): Vec3 =>
     add(sub(a.end, centres[a.path[0]]), sub(b.end, centres[b.path[0]]));
   const longest = limbs.reduce((x, y) => (norm(reachVector(y)) > norm(reachVector(x)) ? y : x));
   const down = reachVector(longest);
   if (!(norm(down) > 0)) {
     notes.push('the limbs reach nowhere: no knee or elbow found');
-    return { hinges: [], frame: null, notes };
+    return null;
   }
-  let up = scale(down, -1 / norm(down));
+  const up = scale(down, -1 / norm(down));
   const height = (j: number) => dot(centres[j], up);
   const legs = limbs.reduce((x, y) => (height(y[0].branch) < height(x[0].branch) ? y : x));
   // The arms hang off a branch above the legs' and outside them (not toes, not fingers of a hand).
@@ -185,11 +227,16 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
   if (!arms) {
     // Without a second pair there is no telling legs from arms (nor toes, fingers, ears).
     notes.push('no second pair of limbs above the first: no knee or elbow found');
-    return { hinges: [], frame: null, notes };
+    return null;
   }
+  return { legs, arms, down };
+}
 
-  // Forward: perpendicular to up and to the hips' left–right line; the sign from the feet.
+/** Forward: perpendicular to up and to the hips' left–right line; the sign from the feet (else the knees). */
+function bodyFrame(s: Skeleton, legs: [Limb, Limb], down: Vec3, notes: string[]): BodyFrame {
+  const { centres, children, dominant } = s;
   const across = normalize(sub(centres[legs[0].path[0]], centres[legs[1].path[0]]));
+  let up = scale(down, -1 / norm(down));
   up = normalize(sub(up, scale(across, dot(up, across))));
   let forward = normalize(cross(across, up));
   let ahead = 0, footSize = 0;
@@ -203,7 +250,7 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
     const ankle = leg.path[leg.hinge + 1];
     if (ankle === undefined) continue;
     const foot = subtree(ankle);
-    const P = input.positions;
+    const P = s.input.positions;
     let n = 0;
     const sum: Vec3 = [0, 0, 0];
     for (let v = 0; v < dominant.length; v++)
@@ -225,31 +272,30 @@ export function findHinges(input: RigInput, names?: readonly (string | undefined
     if (knees < 0) forward = scale(forward, -1);
     notes.push(knees !== 0 ? 'forward taken from the knees (no foot skin ahead of the ankles)' : 'forward is a guess: no foot skin and straight knees');
   }
-  const left = cross(up, forward);
-  const frame: BodyFrame = { up, forward, left };
+  return { up, forward, left: cross(up, forward) };
+}
 
-  const hinges: Hinge[] = [];
-  const addPair = (pair: [Limb, Limb], kind: Hinge['kind']) => {
-    const firstIsLeft = dot(sub(centres[pair[0].path[0]], centres[pair[1].path[0]]), left) >= 0;
-    const order: [Limb, Hinge['side']][] = firstIsLeft ? [[pair[0], 'left'], [pair[1], 'right']] : [[pair[1], 'left'], [pair[0], 'right']];
-    for (const [limb, side] of order) {
-      const joint = limb.path[limb.hinge];
-      const centre = centres[joint];
-      const along = normalize(sub(limb.end, centre));
-      // Flexion turns the bone's end toward −forward (knee) or +forward (elbow): axis × along points there.
-      const axis = kind === 'knee' ? cross(forward, along) : cross(along, forward);
-      const name = names?.[joint];
-      if (norm(axis) < 0.3) {
-        notes.push(`${side} ${kind}: the bone points along the forward direction, no hinge axis`);
-        continue;
-      }
-      hinges.push({ kind, side, label: `${side} ${kind}${name ? ` (${name})` : ''}`, joint, parent: limb.path[limb.hinge - 1],
-        centre, end: limb.end, axis: normalize(axis) });
+/** The pair's two hinges, left first, each with its axis signed so that a positive bend is flexion. */
+function hingesOfPair(s: Skeleton, pair: [Limb, Limb], kind: Hinge['kind'], frame: BodyFrame,
+  names: readonly (string | undefined)[] | undefined, hinges: Hinge[], notes: string[]): void {
+  const { centres } = s;
+  const { forward, left } = frame;
+  const firstIsLeft = dot(sub(centres[pair[0].path[0]], centres[pair[1].path[0]]), left) >= 0;
+  const order: [Limb, Hinge['side']][] = firstIsLeft ? [[pair[0], 'left'], [pair[1], 'right']] : [[pair[1], 'left'], [pair[0], 'right']];
+  for (const [limb, side] of order) {
+    const joint = limb.path[limb.hinge];
+    const centre = centres[joint];
+    const along = normalize(sub(limb.end, centre));
+    // Flexion turns the bone's end toward −forward (knee) or +forward (elbow): axis × along points there.
+    const axis = kind === 'knee' ? cross(forward, along) : cross(along, forward);
+    const name = names?.[joint];
+    if (norm(axis) < 0.3) {
+      notes.push(`${side} ${kind}: the bone points along the forward direction, no hinge axis`);
+      continue;
     }
-  };
-  addPair(legs, 'knee');
-  addPair(arms, 'elbow');
-  return { hinges, frame, notes };
+    hinges.push({ kind, side, label: `${side} ${kind}${name ? ` (${name})` : ''}`, joint, parent: limb.path[limb.hinge - 1],
+      centre, end: limb.end, axis: normalize(axis) });
+  }
 }
 
 /** Largest distance between one limb's joints mirrored across the plane between the two roots and the other's, over their length. */

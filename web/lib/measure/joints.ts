@@ -13,10 +13,11 @@
  */
 import type { ClassicDeformer, Deformer, Rig, RigInput } from '../index.js';
 import { GcsError } from '../errors.js';
-import {
-  METHOD_LABELS, boundsHeight, buildMethod, countCreases, dihedralCosines, errorInfo, identitySkin, interiorEdges, percentile, weldByPosition,
-  type BuildSettings, type MethodName,
-} from '../measure.js';
+import { identitySkin } from '../index.js';
+import { countCreases, dihedralCosines, interiorEdges } from './creases.js';
+import { boundsHeight, weldByPosition } from './mesh.js';
+import { METHOD_LABELS, buildMethod, errorInfo, type BuildSettings, type MethodName } from './methods.js';
+import { maxOf, percentile } from './statistics.js';
 import { findHinges, jointCentres, type BodyFrame, type Hinge, type Vec3 } from './hinges.js';
 import { intersectingPairs } from './self-intersection.js';
 
@@ -464,12 +465,6 @@ function faceNormals(p: ArrayLike<number>, tris: Uint32Array, out: Float64Array)
     const vx = p[c] - p[a], vy = p[c + 1] - p[a + 1], vz = p[c + 2] - p[a + 2];
     out[t] = uy * vz - uz * vy; out[t + 1] = uz * vx - ux * vz; out[t + 2] = ux * vy - uy * vx;
   }
-}
-
-function maxOf(a: Float64Array): number {
-  let m = -Infinity;
-  for (let i = 0; i < a.length; i++) if (!(a[i] <= m)) m = Number.isNaN(a[i]) ? Infinity : a[i];
-  return a.length ? m : NaN;
 }
 
 function minOf(a: Float64Array): number {

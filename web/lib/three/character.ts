@@ -6,6 +6,7 @@ import type { PendingBuild } from './build.js';
 import type { Backend, GcsCharacterOptions, RebuildOptions } from './options.js';
 import { checkGcsSkin } from './check-gcs.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
+import { SkeletonPoses } from './skeleton-poses.js';
 import { SkinDeformer } from './skin-deformer.js';
 
 /**
@@ -42,6 +43,9 @@ export class GcsCharacter {
   /** What update() refreshes: root, or a common ancestor of root and bones kept outside it. */
   private readonly scope: THREE.Object3D;
   private isDisposed = false;
+  /** Each skeleton posed once a frame, whatever the number of skins on it. */
+  private readonly poses = new SkeletonPoses();
+  private readonly skinUpdate = Object.freeze({ updateMatrixWorld: false, poses: this.poses });
 
   /**
    * @param gcs The core (`await initGcsSkin()`).
@@ -81,13 +85,15 @@ export class GcsCharacter {
 
   /**
    * Once per frame, after the mixer: one world-matrix update of the character (ancestors first),
-   * then every skin poses from its skeleton and deforms. No allocation.
+   * then each skeleton posed once (the skins sharing it read the same skin matrices) and every
+   * skin deforms. No allocation.
    */
   update(): void {
     if (this.isDisposed) throw new GcsError('DISPOSED', 'this GcsCharacter has been disposed');
     updateWorld(this.scope);
+    this.poses.nextFrame();
     const skins = this.skins;
-    for (let i = 0; i < skins.length; i++) skins[i].update(NO_WORLD_UPDATE);
+    for (let i = 0; i < skins.length; i++) skins[i].update(this.skinUpdate);
   }
 
   /**
@@ -129,4 +135,3 @@ export class GcsCharacter {
   }
 }
 
-const NO_WORLD_UPDATE = Object.freeze({ updateMatrixWorld: false });

@@ -15,6 +15,7 @@ import { keepAttributeLive } from './live-views.js';
 import type { Backend, RebuildOptions, SkinDeformerOptions } from './options.js';
 import { rigInputFromSkinnedMesh } from './rig-input.js';
 import { commonAncestor, updateWorld } from './scene-graph.js';
+import type { SkeletonPoses } from './skeleton-poses.js';
 import { writeSkinMatrices } from './skin-matrices.js';
 
 /**
@@ -270,7 +271,9 @@ export class SkinDeformer {
    * Poses from the skeleton and deforms. Call once per frame, after the mixer. By default it
    * first updates the world matrices of the smallest subtree holding the source and its bones
    * (and of their ancestors); pass `{ updateMatrixWorld: false }` when the caller has already
-   * done that this frame (GcsCharacter does, once for all its skins). In place, an invisible
+   * done that this frame (GcsCharacter does, once for all its skins), and `poses` to take the skin
+   * matrices from a SkeletonPoses (GcsCharacter's: each skeleton posed once a frame, not once per
+   * skin). In place, an invisible
    * source (`source.visible === false`) hides the mesh and skips the deform.
    *
    * Bounds for frustum culling, per frame from the bones rather than the output (a JavaScript
@@ -278,7 +281,7 @@ export class SkinDeformer {
    * O(joints): bounds.ts says why they hold). Raycasts get exact bounds instead (DeformedMesh).
    * No allocation: matrices, vectors and bounds are preallocated.
    */
-  update(options?: { updateMatrixWorld?: boolean }): void {
+  update(options?: { updateMatrixWorld?: boolean; poses?: SkeletonPoses }): void {
     this.live();
     if (this.retired) {
       this.retired.dispose();
@@ -292,7 +295,8 @@ export class SkinDeformer {
       if (!source.visible) return;
     }
     const skin = this.skin;
-    writeSkinMatrices(source, skin, 0, this.tmp);
+    if (options?.poses) skin.set(options.poses.skinOf(source)); // posed once for every skin of its skeleton
+    else writeSkinMatrices(source, skin, 0, this.tmp);
     const deformer = this.deformer;
     const gpu = this.gpu;
     let grow = 0; // how far the morphs can move a vertex this frame

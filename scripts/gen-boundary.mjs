@@ -1,0 +1,148 @@
+// The TypeScript side of the wasm boundary, generated from wasm/include/gcs_skin.h (the one
+// statement of the C API): every function with its arguments, which results are unsigned, every
+// numeric #define (limits, defaults), function-like macros (GCS_WEIGHT_GRID_STEPS), every enum in
+// the names the library uses, and the layout of every struct (with a writer for it).
+//   node scripts/gen-boundary.mjs           writes web/lib/boundary.generated.ts
+//   node scripts/gen-boundary.mjs --check   exits 1 when the committed file differs (drift)
+// tests/lib/boundary.test.ts runs generateBoundary() and compares it with the committed file.
+import { readFileSync, writeFileSync } from 'node:fs';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..');
+export const HEADER = join(root, 'wasm', 'include', 'gcs_skin.h');
+export const GENERATED = join(root, 'web', 'lib', 'boundary.generated.ts');
+
+/**
+ * How the library names each enum's values: the C name without the enum's common prefix, then
+ * 'upper' (INVALID_ARGUMENT), 'lower' (weights), 'kebab' (too-short) or 'camel' (adjustedShare).
+ */
+const ENUM_STYLE = {
+  GcsError: 'upper', GcsCriterion: 'lower', GcsDeformerKind: 'lower', GcsStat: 'camel', GcsClassicReason: 'kebab',
+  GcsSectionInfoField: 'camel', GcsSectionKind: 'lower', GcsClassicPartField: 'camel',
+};
+const STRUCT_TYPES = { uint32_t: ['u32', 'Uint32'], int32_t: ['i32', 'Int32'], float: ['f32', 'Float32'] };
+
+const camel = (s) => s.toLowerCase().replace(/_(\w)/g, (_, c) => c.toUpperCase());
+const styled = (s, style) =>
+  style === 'upper' ? s : style === 'lower' ? s.toLowerCase() : style === 'kebab' ? s.toLowerCase().replace(/_/g, '-') : camel(s);
+const prefixOf = (names) => {
+  let p = names[0];
+  for (const n of names) while (!n.startsWith(p)) p = p.slice(0, -1);
+  return p.slice(0, p.lastIndexOf('_') + 1);
+};
+
+/** What the header declares: functions, defines, macros, enums, structs. Throws on what it cannot read. */
+export function parseHeader(text) {
+  const code = text.replace(/\/\*[\s\S]*?\*\//g, '');
+  const enums = [];
+  for (const [, name, body] of code.matchAll(/typedef enum (\w+) \{([^}]*)\} \1;/g)) {
+    const values = [...body.matchAll(/(\w+)\s*=\s*(\d+)/g)].map(([, k, v]) => /** @type {[string, number]} */ ([k, Number(v)]));
+    if (values.length !== body.split(',').length) throw new Error(`gen-boundary: enum ${name}: every value needs '= number'`);
+    enums.push({ name, values, prefix: prefixOf(values.map(([k]) => k)) });
+  }
+  const constants = new Map(enums.flatMap((e) => e.values));
+  const defines = [];
+  const macros = [];
+  for (const [, name, params, value] of code.matchAll(/^#define (GCS_\w+)(\([\w, ]*\))?[ \t]+(.+?)\s*$/gm)) {
+    if (params) {
+      const args = params.slice(1, -1).split(',').map((s) => s.trim());
+      const body = value.replace(/\b\w+\b/g, (w) => (args.includes(w) || /^\d+$/.test(w) ? w : `?${w}`));
+      if (/\?|[^\w\s()+\-*/]/.test(body)) throw new Error(`gen-boundary: cannot read the macro ${name}${params} ${value}`);
+      macros.push({ name, args, body: value });
+      continue;
+    }
+    const expr = value.replace(/\b(GCS_\w+)\b/g, (_, n) => String(constants.get(n) ?? NaN)).replace(/(\d)f\b/g, '$1');
+    if (!/^[\d\s.+*()-]+$/.test(expr)) throw new Error(`gen-boundary: cannot read #define ${name} ${value}`);
+    const number = Function(`return (${expr});`)();
+    constants.set(name, number);
+    defines.push({ name, value: number });
+  }
+  const structs = [];
+  for (const [, name, body] of code.matchAll(/typedef struct (\w+) \{([^}]*)\} \1;/g)) {
+    const fields = body.split(';').map((s) => s.trim()).filter(Boolean).map((decl, i) => {
+      const m = /^(\w+)\s+(\w+)$/.exec(decl);
+      if (!m || !STRUCT_TYPES[m[1]]) throw new Error(`gen-boundary: struct ${name}: cannot lay out '${decl}' (4-byte scalars only)`);
+      return { type: m[1], name: m[2], offset: 4 * i };
+    });
+    structs.push({ name, fields, bytes: 4 * fields.length });
+  }
+  const functions = [];
+  for (const [, ret, name, params] of code.matchAll(/^((?:const\s+)?\w+\s*\**)\s*(gcs_\w+)\s*\(([^)]*)\)\s*;/gm)) {
+    const args = params.trim() === 'void' ? [] : params.split(',').map((p) => {
+      const m = /^(.*?)(\w+)$/.exec(p.replace(/\s+/g, ' ').trim());
+      if (!m) throw new Error(`gen-boundary: ${name}: cannot read the parameter '${p}'`);
+      return { type: m[1].trim(), name: m[2] };
+    });
+    const result = ret.replace(/\s+/g, ' ').replace(/ \*/g, '*').trim();
+    functions.push({ name, result, args, unsigned: result.includes('*') || result === 'uint32_t' });
+  }
+  return { functions, defines, macros, enums, structs };
+}
+
+/** The TypeScript source of web/lib/boundary.generated.ts for a header's text. */
+export function generateBoundary(text) {
+  const { functions, defines, macros, enums, structs } = parseHeader(text);
+  const out = [
+    '// Generated by scripts/gen-boundary.mjs from wasm/include/gcs_skin.h: do not edit. Run',
+    '// `npm run gen:boundary` after changing the header; tests/lib/boundary.test.ts fails on drift.',
+    '/* eslint-disable */',
+    '',
+    '/** The core\'s functions as the wasm exports them (pointers are byte offsets into its memory). */',
+    'export interface CoreFunctions {',
+  ];
+  for (const f of functions) {
+    out.push(`  /** ${f.result} ${f.name}(${f.args.map((a) => `${a.type} ${a.name}`).join(', ') || 'void'}) */`);
+    out.push(`  ${f.name}(${f.args.map((a) => `${a.name}: number`).join(', ')}): ${f.result === 'void' ? 'void' : 'number'};`);
+  }
+  out.push('}', '');
+  out.push('/** Each function\'s argument count. */');
+  out.push(`export const ARGUMENT_COUNTS = {\n${functions.map((f) => `  ${f.name}: ${f.args.length},`).join('\n')}\n} as const;`, '');
+  out.push('/** Functions whose result is a pointer or a uint32_t: wasm returns i32, read them with `>>> 0`. */');
+  out.push(`export const UNSIGNED_RESULTS = [\n${functions.filter((f) => f.unsigned).map((f) => `  '${f.name}',`).join('\n')}\n] as const;`, '');
+  out.push('// Every numeric #define.');
+  for (const d of defines) out.push(`export const ${d.name} = ${d.value};`);
+  out.push('');
+  for (const m of macros) {
+    const fn = camel(m.name.replace(/^GCS_/, ''));
+    out.push(`/** ${m.name}(${m.args.join(', ')}) */`);
+    out.push(`export function ${fn}(${m.args.map((a) => `${a}: number`).join(', ')}): number {\n  return ${m.body};\n}`, '');
+  }
+  for (const e of enums) {
+    const style = ENUM_STYLE[e.name] ?? 'upper';
+    const names = e.values.map(([k]) => styled(k.slice(e.prefix.length).replace(/^ERR_/, ''), style));
+    out.push(`/** ${e.name}: each value's number. */`);
+    out.push(`export const ${e.name} = { ${e.values.map(([, v], i) => `${/^[a-zA-Z_]\w*$/.test(names[i]) ? names[i] : `'${names[i]}'`}: ${v}`).join(', ')} } as const;`);
+    if (e.values.every(([, v], i) => v === i)) {
+      out.push(`/** ${e.name}: index = the value's number. */`);
+      out.push(`export const ${e.name}Names = [${names.map((n) => `'${n}'`).join(', ')}] as const;`);
+    }
+    out.push('');
+  }
+  for (const s of structs) {
+    out.push(`/** ${s.name}: ${s.bytes} bytes, each field a 4-byte scalar at its offset. */`);
+    out.push(`export interface ${s.name} {\n${s.fields.map((f) => `  ${f.name}: number;`).join('\n')}\n}`);
+    out.push(`export const ${s.name}Bytes = ${s.bytes};`);
+    out.push(`/** Writes a ${s.name} at byte offset \`ptr\` of \`memory\` (little-endian, as wasm). */`);
+    out.push(`export function write${s.name}(memory: ArrayBufferLike, ptr: number, value: ${s.name}): void {`);
+    out.push(`  const view = new DataView(memory, ptr, ${s.bytes});`);
+    for (const f of s.fields) out.push(`  view.set${STRUCT_TYPES[f.type][1]}(${f.offset}, value.${f.name}, true);`);
+    out.push('}', '');
+  }
+  return `${out.join('\n').trimEnd()}\n`;
+}
+
+if (process.argv[1] && fileURLToPath(import.meta.url) === process.argv[1]) {
+  const text = generateBoundary(readFileSync(HEADER, 'utf8'));
+  if (process.argv.includes('--check')) {
+    let committed = '';
+    try { committed = readFileSync(GENERATED, 'utf8'); } catch { /* missing: drift */ }
+    if (committed !== text) {
+      console.error('gen-boundary: web/lib/boundary.generated.ts is stale: run npm run gen:boundary');
+      process.exit(1);
+    }
+  } else {
+    writeFileSync(GENERATED, text);
+    console.log(`gen-boundary: wrote ${GENERATED}`);
+  }
+}

@@ -1,0 +1,40 @@
+// The methods the report, metrics and tests compare, built by name, and a build failure as data.
+import { GcsError } from '../errors.js';
+import type { Deformer, Rig } from '../index.js';
+
+/**
+ * The methods the report, metrics and tests compare: GCS with the weights criterion (the default),
+ * plain (its stepped level of detail, smooth: false), the paper's Y criterion and the axial variant (influence width 1), the classic
+ * cross-section model, LBS and DQS.
+ */
+export type MethodName = 'gcs' | 'gcs-plain' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
+export const METHODS: MethodName[] = ['gcs', 'gcs-plain', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
+export const METHOD_LABELS: Record<MethodName, string> = {
+  gcs: 'GCS (weights, default)', 'gcs-plain': 'GCS plain (weights, stepped)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
+  classic: 'classic', lbs: 'LBS', dqs: 'DQS',
+};
+
+export interface BuildSettings {
+  sections?: number;
+  contours?: number;
+  rays?: number;
+}
+
+/** Builds a deformer by method name. */
+export function buildMethod(rig: Rig, method: MethodName, settings: BuildSettings = {}): Deformer {
+  switch (method) {
+    case 'gcs': return rig.buildGcs({ sections: settings.sections });
+    case 'gcs-plain': return rig.buildGcs({ sections: settings.sections, smooth: false });
+    case 'gcs-y': return rig.buildGcs({ sections: settings.sections, criterion: 'y' });
+    case 'gcs-axial': return rig.buildGcs({ sections: settings.sections, criterion: 'axial' });
+    case 'classic': return rig.buildClassic({ contours: settings.contours, rays: settings.rays });
+    case 'lbs': return rig.buildLbs();
+    case 'dqs': return rig.buildDqs();
+  }
+}
+
+/** A build failure as data: the GcsError code and message (e.g. a method not in this binary). */
+export function errorInfo(e: unknown): { code: string; message: string } {
+  if (e instanceof GcsError) return { code: e.code, message: e.message };
+  return { code: 'ERROR', message: e instanceof Error ? e.message : String(e) };
+}

@@ -1,0 +1,45 @@
+// Statistics of the measures: median, percentiles (quickselect, no full sort) and the largest value.
+export function median(values: ArrayLike<number>): number {
+  return percentile(values, 50);
+}
+
+/**
+ * The p-th percentile (0..100, nearest rank on the sorted values, NaN sorting last); NaN for no
+ * values. By selection, not a sort: the fidelity probe takes it over a million distances.
+ */
+export function percentile(values: ArrayLike<number>, p: number): number {
+  const n = values.length;
+  if (!n) return NaN;
+  const rank = Math.min(n - 1, Math.max(0, Math.ceil((p / 100) * n) - 1));
+  const a = new Float64Array(n);
+  let m = 0;
+  for (let i = 0; i < n; i++) if (!Number.isNaN(values[i])) a[m++] = values[i];
+  return rank < m ? select(a, m, rank) : NaN;
+}
+
+/** The k-th smallest of a[0 … n−1] (no NaN), partly reordering a (Hoare's quickselect, median-of-three pivots). */
+function select(a: Float64Array, n: number, k: number): number {
+  let lo = 0, hi = n - 1;
+  while (hi > lo) {
+    const mid = (lo + hi) >> 1;
+    const x = a[lo], y = a[mid], z = a[hi];
+    const pivot = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+    let i = lo, j = hi;
+    while (i <= j) {
+      while (a[i] < pivot) i++;
+      while (a[j] > pivot) j--;
+      if (i <= j) { const t = a[i]; a[i] = a[j]; a[j] = t; i++; j--; }
+    }
+    if (k <= j) hi = j;
+    else if (k >= i) lo = i;
+    else return a[k];
+  }
+  return a[k];
+}
+
+/** The largest value (NaN counts as +∞); NaN for an empty array. */
+export function maxOf(a: ArrayLike<number>): number {
+  let m = -Infinity;
+  for (let i = 0; i < a.length; i++) if (!(a[i] <= m)) m = Number.isNaN(a[i]) ? Infinity : a[i];
+  return a.length ? m : NaN;
+}

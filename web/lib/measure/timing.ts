@@ -1,0 +1,83 @@
+// Timing a per-frame step: median and p95 milliseconds over enough samples, alone or interleaved
+// with other steps (so that they share the machine's state).
+import { median, percentile } from './statistics.js';
+
+export interface TimingOptions {
+  /** At least this many timed frames (default 200). */
+  minSamples?: number;
+  /** Keep timing until this much time has passed (default 150 ms)… */
+  minMs?: number;
+  /** …but stop after this much (default 3000 ms), whatever the sample count. */
+  maxMs?: number;
+  /** Frames run before timing (default: one pass over the frames). */
+  warmup?: number;
+  /**
+   * timeInterleaved: calls per timed sample, one number for every step or one per step (default
+   * 1); a sample's time is divided by it. For a coarse clock (a browser's 0.1 ms steps) a sample
+   * must last many clock steps: calls of 0.05 ms are timed 20 at a time, not one by one.
+   */
+  repeat?: number | readonly number[];
+}
+
+export interface Timing {
+  medianMs: number;
+  p95Ms: number;
+  samples: number;
+}
+
+/**
+ * Times `step(frameIndex)` once per frame, cycling over `frameCount` frames: the inputs are
+ * precomputed by the caller so only the step itself is timed. Returns median and p95 in ms.
+ */
+export function timeFrames(frameCount: number, step: (frame: number) => void, options: TimingOptions = {}): Timing {
+  const minSamples = options.minSamples ?? 200;
+  const minMs = options.minMs ?? 150;
+  const maxMs = options.maxMs ?? 3000;
+  const warmup = options.warmup ?? frameCount;
+  for (let i = 0; i < warmup; i++) step(i % frameCount);
+  const samples: number[] = [];
+  const start = performance.now();
+  for (let i = 0; ; i++) {
+    const t0 = performance.now();
+    step(i % frameCount);
+    const t1 = performance.now();
+    samples.push(t1 - t0);
+    const elapsed = t1 - start;
+    if ((samples.length >= minSamples && elapsed >= minMs) || elapsed >= maxMs) break;
+  }
+  return { medianMs: median(samples), p95Ms: percentile(samples, 95), samples: samples.length };
+}
+
+/**
+ * Times several steps in turn, one call each per round (or `repeat` calls), so that whatever else
+ * the machine does lands on all of them alike: their ratios hold on a shared, noisy host where
+ * timings taken one after the other do not. Each step cycles over `frameCount` frames, every step
+ * on the same frames in a round. Returns one Timing per step (ms per call).
+ */
+export function timeInterleaved(frameCount: number, steps: ((frame: number) => void)[], options: TimingOptions = {}): Timing[] {
+  const minSamples = options.minSamples ?? 200;
+  const minMs = options.minMs ?? 150;
+  const maxMs = options.maxMs ?? 3000;
+  const warmup = options.warmup ?? frameCount;
+  const repeat = steps.map((_, k) => {
+    const r = typeof options.repeat === 'number' ? options.repeat : options.repeat?.[k] ?? 1;
+    return Number.isInteger(r) && r >= 1 ? r : 1;
+  });
+  for (let i = 0; i < warmup; i++) for (const step of steps) step(i % frameCount);
+  const samples: number[][] = steps.map(() => []);
+  const stride = Math.max(...repeat);
+  const start = performance.now();
+  for (let first = 0; ; first += stride) {
+    let t1 = 0;
+    steps.forEach((step, k) => {
+      const n = repeat[k];
+      const t0 = performance.now();
+      for (let r = 0; r < n; r++) step((first + r) % frameCount);
+      t1 = performance.now();
+      samples[k].push((t1 - t0) / n);
+    });
+    const elapsed = t1 - start;
+    if ((samples[0].length >= minSamples && elapsed >= minMs) || elapsed >= maxMs) break;
+  }
+  return samples.map((s) => ({ medianMs: median(s), p95Ms: percentile(s, 95), samples: s.length }));
+}
