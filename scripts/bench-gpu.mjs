@@ -40,7 +40,7 @@ const server = await createServer({
   server: { host: '127.0.0.1', port: 0, fs: { allow: [root, models] }, hmr: false, watch: null },
 });
 await server.listen();
-const { port } = server.httpServer.address();
+const { port } = /** @type {import('node:net').AddressInfo} */ (server.httpServer.address());
 const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir(), 'gcs-chromium-')), {
   executablePath: chromiumPath, headless: true, viewport: { width: 1280, height: 720 },
   args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
@@ -56,8 +56,9 @@ try {
       const model = c.model === 'human' ? 'human' : `/@fs${c.model}`;
       const q = new URLSearchParams({ bench: 'gpu', model, n: String(c.n), w: String(w), h: String(h), frames: String(frames), ...(methods ? { methods } : {}) });
       await page.goto(`http://127.0.0.1:${port}/?${q}`);
-      await page.waitForFunction(() => window.__benchGpu !== undefined, null, { timeout: 120000 });
-      const r = await page.evaluate(() => window.__benchGpu);
+      // The page leaves its result on window.__benchGpu (web/demo/bench-gpu.ts).
+      await page.waitForFunction(() => /** @type {any} */ (window).__benchGpu !== undefined, null, { timeout: 120000 });
+      const r = await page.evaluate(() => /** @type {any} */ (window).__benchGpu);
       if (errors.length) console.log(errors.join('\n'));
       results.push(r);
       const name = c.model === 'human' ? 'human' : c.model.split('/').pop().replace(/\.glb$/, '');

@@ -2,7 +2,8 @@
 // deformer.setMorphTargets takes, with each target's largest delta (for the bounds).
 import type * as THREE from 'three';
 import { GcsError } from '../errors.js';
-import type { AnyAttribute } from './rig-input.js';
+
+type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
 
 /**
  * The one check of a geometry's morph targets, wherever it is read (the three.js adapters, the
