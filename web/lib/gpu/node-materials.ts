@@ -90,11 +90,7 @@ export const tslKit: GpuMaterialKit = {
     if (!pass) return { material, depth: null, distance: null };
     return {
       material, depth: null, distance: null,
-      beforeDraw(renderer: unknown): string | null {
-        const why = TslNodePass.unsupported(renderer);
-        if (!why) pass.render(renderer as THREE.WebGPURenderer);
-        return why;
-      },
+      beforeDraw: (renderer: unknown): string | null => pass.render(renderer),
       dispose: () => pass.dispose(),
     };
   },

@@ -19,7 +19,7 @@ import {
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
 import { COLLAPSED, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots } from './layout.js';
-import { FLOAT_TARGET_EXTENSION } from './node-pass.js';
+import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import type { GpuSections } from './sections.js';
 
 type Float = Node<'float'>;
@@ -183,8 +183,6 @@ function noFloatTargets(renderer: unknown): boolean {
   return backend?.isWebGLBackend === true && backend.extensions?.has(FLOAT_TARGET_EXTENSION) === false;
 }
 
-type Renderer = THREE.WebGPURenderer;
-
 /**
  * The pass: a QuadMesh over a RenderTarget of GPU_NODE_TEXTURES float textures, one texel per node
  * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide). Runs at the skin's
@@ -199,6 +197,10 @@ export class TslNodePass {
   private readonly material: THREE.NodeMaterial;
   /** The GpuSections.version the target holds (−1: none yet). */
   private drawn = -1;
+  /** What the vertex stage reads: one texture node per target. */
+  private readonly views: TextureNode[];
+  /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
+  private glsl: NodePass | null = null;
 
   constructor(readonly sections: GpuSections) {
     const S = sections.deformer.sectionCount, nodes = sections.instanceCount * S;
@@ -225,40 +227,59 @@ export class TslNodePass {
     this.material.depthWrite = false;
     this.material.blending = THREE.NoBlending;
     this.quad = new THREE.QuadMesh(this.material);
+    this.views = this.target.textures.map((t) => texture(t));
   }
 
-  /** The vertex stage's view of target i (0–2: rows of [M | T], 3: the normal texel). */
+  /** The vertex stage's view of target i (0–2: rows of [M | T], 3: the normal texel); one node per target, shared by every material. */
   textureNode(i: number): TextureNode {
-    return texture(this.target.textures[i]);
-  }
-
-  /** Why `renderer` cannot run the pass (WebGL2 without float render targets), or null. */
-  static unsupported(renderer: unknown): string | null {
-    return noFloatTargets(renderer) ? `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into` : null;
+    return this.views[i];
   }
 
   /**
    * Writes every node of every instance for the current joint poses, unless already written since
-   * the last GpuSections.update(). Restores the renderer's render target, cube face, mip level and MRT.
+   * the last GpuSections.update(); returns why `renderer` cannot, or null. WebGPURenderer: this
+   * pass (restoring the render target, cube face, mip level and MRT). A WebGLRenderer with
+   * three.js's WebGLNodesHandler: the GLSL pass (node-pass.ts), same layout, whose targets the
+   * views then show — while the targets are one row high: the handler's texture reads count rows
+   * from the top (WebGPU's convention) and the GLSL pass writes them from the bottom.
    */
-  render(renderer: Renderer): void {
+  render(renderer: unknown): string | null {
+    const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
+    if (r?.isWebGLRenderer) {
+      const why = NodePass.unsupported(renderer);
+      if (why) return why;
+      if (this.target.height > 1) return `a WebGLRenderer with WebGLNodesHandler reads the node pass's targets from the other end when they span more than one row (more than ${MAX_WIDTH} nodes)`;
+      this.glsl ??= new NodePass(this.sections);
+      this.show(this.glsl.target.textures);
+      this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
+      return null;
+    }
+    if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
+    this.show(this.target.textures);
     const version = this.sections.version;
-    if (this.drawn === version) return;
+    if (this.drawn === version) return null;
     this.drawn = version;
     this.runs++;
-    const target = renderer.getRenderTarget(), face = renderer.getActiveCubeFace(), level = renderer.getActiveMipmapLevel();
-    const outputMRT = renderer.getMRT(), autoClear = renderer.autoClear;
-    renderer.autoClear = false; // every texel is written
-    renderer.setMRT(null);
-    renderer.setRenderTarget(this.target);
-    this.quad.render(renderer);
-    renderer.setRenderTarget(target, face, level);
-    renderer.setMRT(outputMRT);
-    renderer.autoClear = autoClear;
+    const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
+    const outputMRT = r.getMRT(), autoClear = r.autoClear;
+    r.autoClear = false; // every texel is written
+    r.setMRT(null);
+    r.setRenderTarget(this.target);
+    this.quad.render(r);
+    r.setRenderTarget(target, face, level);
+    r.setMRT(outputMRT);
+    r.autoClear = autoClear;
+    return null;
+  }
+
+  /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
+  private show(textures: THREE.Texture[]): void {
+    this.views.forEach((view, i) => { if (view.value !== textures[i]) view.value = textures[i]; });
   }
 
   dispose(): void {
     this.target.dispose();
     this.material.dispose();
+    this.glsl?.dispose();
   }
 }
