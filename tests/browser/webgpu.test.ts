@@ -129,6 +129,27 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     expect(fixture.errors).toEqual([]);
   });
 
+  // LBS and DQS on the GPU backend: each vertex blends its own joints in TSL, as on the CPU.
+  for (const [name, model, missing, times, clip] of [
+    ['the human', 'human-morph', false, [0.3, 0.7], 'walk'],
+    ['CesiumMan.glb', `/@fs${cesium}`, noCesium, [0.5, 1.6], undefined],
+    ['Soldier.glb', `/@fs${soldier}`, noSoldier, [0.2, 0.55], 'Run'],
+  ] as const) {
+    for (const method of ['lbs', 'dqs'] as const) {
+      test.skipIf(missing)(`${name}, ${method.toUpperCase()} on the GPU backend = the CPU backend, posed`, async () => {
+        const r = await call<{ backends: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number; warnings: string[] }>('check', model, {}, times, clip, 'auto', method);
+        console.log(`${name} ${method}: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+        expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+        expect(r.notes.every((n) => !n)).toBe(true);
+        expect(r.warnings).toEqual([]);
+        expect(r.coverage).toBeGreaterThan(0.02);
+        for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+        for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+        expect(fixture.errors).toEqual([]);
+      });
+    }
+  }
+
   // The node pass (node-pass-tsl.ts): one fragment per node writes the four float targets; the
   // vertex stage only reads and blends. Its texels against the GLSL pass's (node-pass.ts, itself
   // checked against the CPU in tests/lib/gpu-joints.test.ts) from the same joint poses; a crowd

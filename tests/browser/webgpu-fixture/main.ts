@@ -1,6 +1,6 @@
 // The page of tests/browser/webgpu.test.ts: gcs-skin/webgpu on three.js's WebGPURenderer (its
 // WebGL2 backend here: forceWebGL, no GPU in headless Chromium), read back as pixels.
-//   check: GPU backend (TSL) vs CPU backend, same frames, same camera; the pose differs from the rest pose;
+//   check: GPU backend (TSL) vs CPU backend, same frames, same camera (GCS, LBS or DQS); the pose differs from the rest pose;
 //   glslVsTsl: the same pose drawn by gcs-skin/three (GLSL, WebGLRenderer) and gcs-skin/webgpu (TSL, WebGPURenderer);
 //   crowd: GcsCrowd on WebGPURenderer, drawn and moving, one draw call per skin;
 //   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials;
@@ -112,13 +112,13 @@ export interface CheckResult {
 }
 
 /** gcs-skin/webgpu's GPU backend against its CPU backend on WebGPURenderer, frame by frame. */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CheckResult> {
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto', method: 'gcs' | 'lbs' | 'dqs' = 'gcs'): Promise<CheckResult> {
   const gcs = await gcsReady;
   const renderer = await gpuRenderer();
   warnings.length = 0;
   const loaded = await load(model);
   const { scene, camera } = stage(loaded.root);
-  const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+  const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath, method });
   const result: CheckResult = {
     backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     vsCpu: [], vsRest: [], coverage: 0, warnings,

@@ -71,7 +71,7 @@ export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
 /** The TSL kit: what gcs-skin/webgpu draws with. */
 export const tslKit: GpuMaterialKit = {
   entry: 'gcs-skin/webgpu',
-  methods: new Set(['gcs']),
+  methods: new Set(['gcs', 'lbs', 'dqs']),
   support: nodeMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
     // Joint-level path: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.

@@ -141,7 +141,7 @@ const gcsNodeBlend = { 4: nodeBlendFunction(4), 8: nodeBlendFunction(8) } as con
 export interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
 
 /** Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion. */
-function jointPose(inputs: JointInputs, j: Int): Mat4 {
+export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
   const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
   return mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
 }
@@ -159,22 +159,32 @@ export function nodeTexels(inputs: JointInputs, s: Int): Mat4 {
     joints.push(texel(inputs.table, row.add(2 * g)).toVar());
     weights.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
   }
-  const lanes = ['x', 'y', 'z', 'w'] as const;
   const pose = jointPose(inputs, int(joints[0].x)).toVar();
   const out = mat4(pose).toVar();
   If(joints[0].y.greaterThanEqual(0), () => {
-    const poses: Mat4[] = [pose];
-    for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(joints[c >> 2][lanes[c & 3]], 0))));
-    // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
-    const used = weights.map((w, g) => step(vec4(0), joints[g]).mul(w));
     const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
-    out.assign(gcsNodeBlend[inputs.slots](...poses, ...used, centre));
+    out.assign(jointBlend(inputs, joints, weights, centre, pose));
   }).Else(() => {
     const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
     const k = gcsRotation(q, float(2)).transpose().mul(mat3(r0.xyz, r1.xyz, r2.xyz).transpose());
     out.assign(mat4(r0, r1, r2, gcsNormalTexel(k)));
   });
   return out;
+}
+
+const LANES = ['x', 'y', 'z', 'w'] as const;
+
+/**
+ * The blend of joints `ids` (per 4 slots a vec4; −1 past the last) at `weights`, about `centre`
+ * (w = 0: none), as a node's four texels (gcsNodeBlend): the section table's joints in the pass,
+ * a vertex's own joints for DQS. `first`: the first joint's pose when already read.
+ */
+export function jointBlend(inputs: Omit<JointInputs, 'table'>, ids: Vec4[], weights: Vec4[], centre: Vec4, first?: Mat4): Mat4 {
+  const poses: Mat4[] = [first ?? jointPose(inputs, int(max(ids[0].x, 0)))];
+  for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(ids[c >> 2][LANES[c & 3]], 0))));
+  // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
+  const used = weights.map((w, g) => step(vec4(0), ids[g]).mul(w));
+  return gcsNodeBlend[inputs.slots](...poses, ...used, centre);
 }
 
 /** Whether `renderer` draws through WebGL2 without float render targets (the pass cannot run there). */

@@ -14,15 +14,15 @@
  */
 import {
   abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, min, normalGeometry, normalLocal,
-  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
+  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
   uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
-  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_NODE_TEXTURES,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
   GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE,
 } from './layout.js';
-import { column, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
+import { column, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
@@ -195,6 +195,59 @@ function sectionVertex(sections: TextureNode, first: Int, smooth: boolean): Vert
   };
 }
 
+// ------------------------------------------------------------ LBS and DQS per vertex (backend 'gpu', method 'lbs' | 'dqs')
+
+/** LBS normals (the GLSL's gcsTurnLbs): by M, then unit length; where M collapses, by the first influence's rotation q. */
+const gcsTurnLbs = Fn(([v, m, q]: [Vec3, Mat3, Vec4]) => {
+  const n = m.mul(v).toVar();
+  const len2 = dot(n, n).toVar();
+  const out = vec3(0).toVar();
+  If(len2.greaterThan(1e-24).and(len2.lessThan(1e24)), () => {
+    out.assign(n.div(len2.sqrt()));
+  }).Else(() => {
+    const r = gcsRotation(q, float(2)).mul(v).toVar();
+    const l = length(r);
+    out.assign(select(l.greaterThan(0), r.div(l), v));
+  });
+  return out;
+}).setLayout({ name: 'gcsTurnLbs', type: 'vec3', inputs: [{ name: 'v', type: 'vec3' }, { name: 'm', type: 'mat3' }, { name: 'q', type: 'vec4' }] });
+
+/**
+ * Each vertex blends its own joints (4, or 8 with a second set) from the joint poses, at its own
+ * weights (the rig's, as the core normalises them; joint −1 where the weight is 0): LBS as the
+ * CPU's (M = Σ w S_j; normals by M, then unit length), DQS through the node maths (jointBlend) with
+ * no centre, normals as the joint-level path turns an unblended one.
+ */
+function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slots: 4 | 8): VertexTransform {
+  const ids: Vec4[] = [], weights: Vec4[] = [];
+  for (let g = 0; g < slots / 4; g++) {
+    ids.push(attribute<'vec4'>(INFLUENCE_ATTRIBUTES[g], 'vec4'));
+    weights.push(attribute<'vec4'>(WEIGHT_ATTRIBUTES[g], 'vec4'));
+  }
+  const inputs = { joints, first, slots };
+  if (method === 'dqs') {
+    const texels = jointBlend(inputs, ids, weights, vec4(0)).toVar();
+    const node = decodeNode(column(texels, 0), column(texels, 1), column(texels, 2), column(texels, 3));
+    return { position: (p) => node.m.mul(p).add(node.t), turn: (v) => gcsTurnJoint(v, node.n, bool(false), bool(false), node.renorm) };
+  }
+  const lanes = ['x', 'y', 'z', 'w'] as const;
+  const r0 = vec4(0).toVar(), r1 = vec4(0).toVar(), r2 = vec4(0).toVar();
+  let rest: Vec4 = vec4(0, 0, 0, 1);
+  for (let c = 0; c < slots; c++) {
+    const id = ids[c >> 2][lanes[c & 3]];
+    const w = weights[c >> 2][lanes[c & 3]].mul(step(0, id)).toVar(); // joint −1: weight 0
+    const pose = jointPose(inputs, int(id.max(0))).toVar();
+    r0.addAssign(column(pose, 0).mul(w));
+    r1.addAssign(column(pose, 1).mul(w));
+    r2.addAssign(column(pose, 2).mul(w));
+    // Where the blend collapses (bones scaled to 0): the first influence's rotation.
+    if (c === 0) rest = (select(w.greaterThan(0), column(pose, 3), vec4(0, 0, 0, 1)) as unknown as Vec4).toVar();
+  }
+  const m = mat3(r0.xyz, r1.xyz, r2.xyz).transpose().toVar(), t = vec3(r0.w, r1.w, r2.w).toVar();
+  const q = rest;
+  return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnLbs(v, m, q) };
+}
+
 /** Whether this build writes velocity (three.js asks for previous positions then). */
 const needsPreviousData = (builder: NodeBuilder): boolean => (builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData();
 
@@ -216,6 +269,7 @@ export function previousPositionNode(): Node<'vec3'> {
  * poses (`perFrame`, `first` this instance's first joint texel).
  */
 function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: TslNodePass | null, nodeFirst: Int): VertexTransform {
+  if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
   if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
   if (pass) {
     const inputs: NodeInputs = { nodes: Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i)), first: nodeFirst };
