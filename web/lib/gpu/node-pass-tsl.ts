@@ -284,7 +284,7 @@ export class TslNodePass {
 
   /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
   private show(textures: THREE.Texture[]): void {
-    this.views.forEach((view, i) => { if (view.value !== textures[i]) view.value = textures[i]; });
+    for (let i = 0; i < this.views.length; i++) if (this.views[i].value !== textures[i]) this.views[i].value = textures[i];
   }
 
   dispose(): void {
