@@ -1,10 +1,12 @@
 // gcs-skin/webgpu on three.js's WebGPURenderer in headless Chromium. There is no GPU here, so
 // WebGPURenderer runs its WebGL2 backend (`forceWebGL: true`, SwiftShader); real WebGPU is not
 // exercised by these tests. Pictures are read back from render targets (webgpu-fixture):
-//   GPU backend (TSL) vs CPU backend on CesiumMan and Soldier at fixed clip times, both GPU paths,
-//   plain and smooth: ≤ 1 % of the pixels differ by more than 8/255, and the pose differs from
-//   the rest pose; GLSL (gcs-skin/three, WebGLRenderer) vs TSL (gcs-skin/webgpu, WebGPURenderer)
-//   on the same pose; a crowd drawn and moving in one draw call; and each "never silently wrong"
+//   GPU backend (TSL) vs CPU backend on CesiumMan, Soldier and the human at fixed clip times,
+//   both GPU paths, plain and smooth, with and without centres of rotation: ≤ 1 % of the pixels
+//   differ by more than 8/255, and the pose differs from the rest pose; GLSL (gcs-skin/three,
+//   WebGLRenderer) vs TSL (gcs-skin/webgpu, WebGPURenderer) on the same pose; the node pass
+//   (joint-level path) read back against the GLSL pass, run once per frame, the vertex shader free
+//   of node maths; a crowd drawn and moving in one draw call; and each "never silently wrong"
 //   case: it works, or runs on the CPU with a note and one warning, or throws a GcsError. With 8
 //   influences per vertex (CesiumMan's weights spread onto 5–8 joints, JOINTS_1/WEIGHTS_1): the TSL
 //   GPU backend and a TSL crowd = the CPU backend, and ≠ the same file read without its second set.
@@ -85,6 +87,15 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     });
   }
 
+  test('default human with a morph target, joints path, centres of rotation: GPU backend = CPU backend', async () => {
+    const r = await call<{ backends: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number }>('check', 'human-morph', { smooth: true, centres: true }, [0.3, 0.7], 'walk', 'joints');
+    console.log(`human + morph, centres: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+    expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+    for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+    for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+    expect(fixture.errors).toEqual([]);
+  });
+
   const cesium = join(MODELS_DIR, 'CesiumMan.glb');
   const soldier = join(MODELS_DIR, 'Soldier.glb');
   const noCesium = !existsSync(cesium), noSoldier = !existsSync(soldier);
@@ -117,6 +128,52 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     expect(r.bytesPerFrame).toBeLessThan(16 * r.jointCount * 64 + 2048 * 16);
     expect(fixture.errors).toEqual([]);
   });
+
+  // LBS and DQS on the GPU backend: each vertex blends its own joints in TSL, as on the CPU.
+  for (const [name, model, missing, times, clip] of [
+    ['the human', 'human-morph', false, [0.3, 0.7], 'walk'],
+    ['CesiumMan.glb', `/@fs${cesium}`, noCesium, [0.5, 1.6], undefined],
+    ['Soldier.glb', `/@fs${soldier}`, noSoldier, [0.2, 0.55], 'Run'],
+  ] as const) {
+    for (const method of ['lbs', 'dqs'] as const) {
+      test.skipIf(missing)(`${name}, ${method.toUpperCase()} on the GPU backend = the CPU backend, posed`, async () => {
+        const r = await call<{ backends: string[]; notes: string[]; vsCpu: Diff[]; vsRest: Diff[]; coverage: number; warnings: string[] }>('check', model, {}, times, clip, 'auto', method);
+        console.log(`${name} ${method}: GPU vs CPU ${r.vsCpu.map(pct).join('; ')}; vs the rest pose ${r.vsRest.map(pct).join('; ')}`);
+        expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
+        expect(r.notes.every((n) => !n)).toBe(true);
+        expect(r.warnings).toEqual([]);
+        expect(r.coverage).toBeGreaterThan(0.02);
+        for (const d of r.vsCpu) expect(d.image).toBeLessThanOrEqual(PIXEL_SHARE);
+        for (const d of r.vsRest) expect(d.covered).toBeGreaterThan(0.05);
+        expect(fixture.errors).toEqual([]);
+      });
+    }
+  }
+
+  // The node pass (node-pass-tsl.ts): one fragment per node writes the four float targets; the
+  // vertex stage only reads and blends. Its texels against the GLSL pass's (node-pass.ts, itself
+  // checked against the CPU in tests/lib/gpu-joints.test.ts) from the same joint poses; a crowd
+  // wide enough to span several rows of the targets.
+  interface NodePassResult { nodes: number; rows: number; largest: number; scale: number; runs: number[]; vertexNodeMaths: boolean; vertexLoads: number; drawCalls: number; coverage: number }
+  for (const [name, model, missing, count, clip, centres] of [
+    ['the human', 'human-morph', false, 1, 'walk', false],
+    ['the human, centres of rotation', 'human-morph', false, 1, 'walk', true],
+    ['CesiumMan ×24', `/@fs${cesium}`, noCesium, 24, undefined, false],
+    ['Soldier ×16, centres of rotation', `/@fs${soldier}`, noSoldier, 16, 'Run', true],
+  ] as const) {
+    test.skipIf(missing)(`node pass, ${name}: once per frame, TSL texels = GLSL texels, no node maths per vertex`, async () => {
+      const r = await call<NodePassResult>('nodePass', model, count, { smooth: true, centres }, clip);
+      console.log(`node pass ${name}: ${r.nodes} nodes in ${r.rows} row(s); TSL vs GLSL texels within ${r.largest.toExponential(2)} (translations up to ${r.scale.toFixed(3)}); runs ${r.runs.join(', ')}; vertex shader: node maths ${r.vertexNodeMaths}, ${r.vertexLoads} texel loads; ${r.drawCalls} draw call(s)`);
+      expect(r.runs).toEqual([1, 1, 2]); // first frame, the same frame drawn again, the next frame
+      expect(r.vertexNodeMaths).toBe(false);
+      expect(r.vertexLoads).toBeGreaterThan(0);
+      expect(r.drawCalls).toBe(1);
+      expect(r.coverage).toBeGreaterThan(0.01);
+      expect(r.scale).toBeGreaterThan(0);
+      expect(r.largest).toBeLessThanOrEqual(1e-5 * Math.max(1, r.scale));
+      expect(fixture.errors).toEqual([]);
+    });
+  }
 
   interface Fallback { before: string; after: string; note: string; warnings: string[]; vsCpu: Diff; firstVsCpu: Diff; firstCoverage: number; error: string }
   const fallback = (which: string) => call<Fallback>('fallback', `/@fs${cesium}`, which);

@@ -1,10 +1,12 @@
 /**
  * gcs-skin/webgpu: GcsCharacter and GcsCrowd for three.js's WebGPURenderer (`three/webgpu`; real
  * WebGPU, or its WebGL2 fallback). Same constructor options, properties and behaviour as
- * gcs-skin/three and gcs-skin/crowd; with `backend: 'gpu'` (and always for a crowd) GCS runs in
- * the vertex stage through TSL: each source material becomes its node equivalent (maps, colours
+ * gcs-skin/three and gcs-skin/crowd; with `backend: 'gpu'` (and always for a crowd) GCS, LBS or
+ * DQS runs on the GPU through TSL: each source material becomes its node equivalent (maps, colours
  * and flags kept) with GCS as its `positionNode`, which also turns normals and tangents; shadows
  * use the same node (`castShadowPositionNode`); morph targets apply first, as three.js orders them.
+ * On the joint-level path a node pass computes every node once per frame (node-pass-tsl.ts) and
+ * each vertex reads its 1–3 nodes and blends them.
  *
  *   import * as THREE from 'three/webgpu';
  *   import { GcsCharacter } from 'gcs-skin/webgpu';

@@ -1,6 +1,6 @@
 // The page of tests/browser/webgpu.test.ts: gcs-skin/webgpu on three.js's WebGPURenderer (its
 // WebGL2 backend here: forceWebGL, no GPU in headless Chromium), read back as pixels.
-//   check: GPU backend (TSL) vs CPU backend, same frames, same camera; the pose differs from the rest pose;
+//   check: GPU backend (TSL) vs CPU backend, same frames, same camera (GCS, LBS or DQS); the pose differs from the rest pose;
 //   glslVsTsl: the same pose drawn by gcs-skin/three (GLSL, WebGLRenderer) and gcs-skin/webgpu (TSL, WebGPURenderer);
 //   crowd: GcsCrowd on WebGPURenderer, drawn and moving, one draw call per skin;
 //   the "never silently wrong" cases: each entry drawn by the other renderer, custom and node materials;
@@ -16,6 +16,8 @@ import { bakeClip, GcsCharacter, GcsCrowd, writeSkinMatrices } from '../../../we
 import { mrt, output, pass, velocity as velocityNode } from 'three/tsl';
 import type { GpuPath } from '../../../web/lib/gpu.js';
 import { load, stage as stageAt, type Loaded } from '../fixture-scene.js';
+import { NodePass } from '../../../web/lib/gpu/node-pass.js';
+import type { TslNodePass } from '../../../web/lib/gpu/node-pass-tsl.js';
 
 const W = 384, H = 384;
 const stage = (root: THREE.Object3D) => stageAt(root, W, H);
@@ -110,13 +112,13 @@ export interface CheckResult {
 }
 
 /** gcs-skin/webgpu's GPU backend against its CPU backend on WebGPURenderer, frame by frame. */
-async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CheckResult> {
+async function check(model: string, gcsOptions: GcsOptions, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto', method: 'gcs' | 'lbs' | 'dqs' = 'gcs'): Promise<CheckResult> {
   const gcs = await gcsReady;
   const renderer = await gpuRenderer();
   warnings.length = 0;
   const loaded = await load(model);
   const { scene, camera } = stage(loaded.root);
-  const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath });
+  const character = new GcsCharacter(gcs, loaded.root, { gcs: gcsOptions, backend: 'gpu', gpuPath, method });
   const result: CheckResult = {
     backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     vsCpu: [], vsRest: [], coverage: 0, warnings,
@@ -175,10 +177,21 @@ async function glslVsTsl(model: string, gcsOptions: GcsOptions, time: number, cl
 
 export interface CrowdResult { drawCalls: number; coverage: number; moving: number; bytesPerFrame: number; jointCount: number; path: string }
 
-/** `count` instances of a character on WebGPURenderer, each at its own clip time; two frames. */
-async function crowd(model: string, count: number, clipName?: string): Promise<CrowdResult> {
+/** The WebGL2 backend keeps no draw-call count: counts the backend's draws of `mesh` until stop(). */
+function countDraws(renderer: THREE.WebGPURenderer, mesh: THREE.Object3D): { count: number; stop(): void } {
+  const backend = (renderer as unknown as { backend: { draw(o: { object: THREE.Object3D }, ...rest: unknown[]): void } }).backend;
+  const backendDraw = backend.draw;
+  const counter = { count: 0, stop: () => { backend.draw = backendDraw; } };
+  backend.draw = function (renderObject, ...rest) {
+    if (renderObject.object === mesh) counter.count++;
+    return backendDraw.call(this, renderObject, ...rest);
+  };
+  return counter;
+}
+
+/** A GcsCrowd of `count` of a character's first skin, set out in a grid in view, and its clip baked. */
+async function crowdScene(model: string, count: number, clipName?: string, gcsOptions: GcsOptions = {}) {
   const gcs = await gcsReady;
-  const renderer = await gpuRenderer();
   const loaded = await load(model);
   let source: THREE.SkinnedMesh | null = null;
   loaded.root.traverse((o) => { if (!source && (o as THREE.SkinnedMesh).isSkinnedMesh) source = o as THREE.SkinnedMesh; });
@@ -186,7 +199,7 @@ async function crowd(model: string, count: number, clipName?: string): Promise<C
   const clip = loaded.clips.find((c) => c.name === clipName) ?? loaded.clips[0];
   const baked = bakeClip(skinned, clip, 30);
   const group = new THREE.Group();
-  const c = new GcsCrowd(gcs, skinned, count);
+  const c = new GcsCrowd(gcs, skinned, count, { gcs: gcsOptions });
   group.add(c.mesh);
   loaded.root.updateMatrixWorld(true);
   const height = new THREE.Box3().setFromObject(skinned).getSize(new THREE.Vector3()).y || 1;
@@ -199,23 +212,23 @@ async function crowd(model: string, count: number, clipName?: string): Promise<C
   c.mesh.instanceMatrix.needsUpdate = true;
   const { scene, camera } = stage(group);
   camera.position.multiplyScalar(1.2);
+  return { c, baked, scene, camera };
+}
+
+/** `count` instances of a character on WebGPURenderer, each at its own clip time; two frames. */
+async function crowd(model: string, count: number, clipName?: string): Promise<CrowdResult> {
+  const renderer = await gpuRenderer();
+  const { c, baked, scene, camera } = await crowdScene(model, count, clipName);
   const frame = async (t: number) => {
     for (let i = 0; i < count; i++) c.setBakedPose(i, baked, t + i * 0.13);
     c.update();
     return draw(renderer, scene, camera);
   };
-  // The WebGL2 backend keeps no draw-call count: count the backend's draws of the crowd's mesh.
-  const backend = (renderer as unknown as { backend: { draw(o: { object: THREE.Object3D }, ...rest: unknown[]): void } }).backend;
-  const backendDraw = backend.draw;
-  let calls = 0;
-  backend.draw = function (renderObject, ...rest) {
-    if (renderObject.object === c.mesh) calls++;
-    return backendDraw.call(this, renderObject, ...rest);
-  };
+  const calls = countDraws(renderer, c.mesh);
   const a = await frame(0.2);
-  backend.draw = backendDraw;
+  calls.stop();
   const b = await frame(0.6);
-  const result = { drawCalls: calls, coverage: coverage(a), moving: differing(a, b).image, bytesPerFrame: c.bytesPerFrame, jointCount: c.jointCount, path: c.sections.path };
+  const result = { drawCalls: calls.count, coverage: coverage(a), moving: differing(a, b).image, bytesPerFrame: c.bytesPerFrame, jointCount: c.jointCount, path: c.sections.path };
   c.dispose();
   return result;
 }
@@ -550,7 +563,74 @@ async function normalMapped(model: string, which: 'webgl' | 'webgpu', time: numb
   return result;
 }
 
-declare global {
-  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences; velocity: typeof velocity; normalMapped: typeof normalMapped } }
+export interface NodePassResult {
+  nodes: number; rows: number;
+  /** the largest difference of a texel entry, TSL pass vs GLSL pass, and the largest translation (scale) */
+  largest: number; scale: number;
+  /** node-pass runs: after the first frame, that frame drawn again, the next frame */
+  runs: number[];
+  /** the crowd's vertex shader: whether it still holds the node maths, and how many texels it loads */
+  vertexNodeMaths: boolean; vertexLoads: number;
+  drawCalls: number; coverage: number;
 }
-window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences, velocity, normalMapped };
+
+/**
+ * A crowd of `count` on WebGPURenderer, every instance at its own clip time: the TSL node pass's
+ * four targets read back against the GLSL node pass (node-pass.ts, on a WebGLRenderer) from the
+ * same joint poses, node by node (the TSL targets' rows count from the top on the WebGL2 backend,
+ * WebGPU's convention; the GLSL pass's from the bottom); how often the pass runs; what the vertex
+ * shader still computes.
+ */
+async function nodePass(model: string, count: number, gcsOptions: GcsOptions, clipName?: string): Promise<NodePassResult> {
+  const renderer = await gpuRenderer();
+  const { c, baked, scene, camera } = await crowdScene(model, count, clipName, gcsOptions);
+  const pass = (Array.isArray(c.mesh.material) ? c.mesh.material[0] : c.mesh.material).userData.gcsNodePass as TslNodePass;
+  const calls = countDraws(renderer, c.mesh);
+  const runs: number[] = [];
+  const pose = (t: number) => { for (let i = 0; i < count; i++) c.setBakedPose(i, baked, t + i * 0.13); c.update(); };
+  pose(0.3);
+  const picture = await draw(renderer, scene, camera);
+  calls.stop();
+  runs.push(pass.runs);
+  await draw(renderer, scene, camera);
+  runs.push(pass.runs);
+  pose(0.7);
+  await draw(renderer, scene, camera);
+  runs.push(pass.runs);
+  const { vertexShader } = await renderer.debug.getShaderAsync(scene, camera, c.mesh);
+  // The GLSL pass from the same GpuSections (joint poses of the last update()), on a WebGLRenderer.
+  const gl = glRenderer();
+  const glsl = new NodePass(c.sections);
+  glsl.render(gl);
+  const { width, height: rows } = pass.target;
+  let largest = 0, scale = 0;
+  const nodes = count * c.sections.deformer.sectionCount;
+  for (let t = 0; t < 4; t++) {
+    const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
+    const theirs = new Float32Array(4 * width * rows);
+    gl.readRenderTargetPixels(glsl.target, 0, 0, width, rows, theirs, undefined, t);
+    for (let n = 0; n < nodes; n++) {
+      const x = n % width, y = Math.floor(n / width);
+      const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);
+      for (let k = 0; k < 4; k++) {
+        largest = Math.max(largest, Math.abs(ours[a + k] - theirs[b + k]));
+        if (t < 3 && k === 3) scale = Math.max(scale, Math.abs(theirs[b + k]));
+      }
+    }
+  }
+  glsl.dispose();
+  gl.dispose();
+  c.dispose();
+  return {
+    nodes, rows, largest, scale, runs,
+    vertexNodeMaths: /gcsNodeBlend|gcsRotation|gcsNormalTexel/.test(vertexShader),
+    vertexLoads: (vertexShader.match(/texelFetch/g) ?? []).length,
+    drawCalls: calls.count, coverage: coverage(picture),
+  };
+}
+
+declare global {
+  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences; velocity: typeof velocity; normalMapped: typeof normalMapped; nodePass: typeof nodePass } }
+}
+window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences, velocity, normalMapped, nodePass };
+

@@ -7,6 +7,7 @@
 import * as THREE from 'three/webgpu';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
 import type { GpuSections } from './sections.js';
+import { TslNodePass } from './node-pass-tsl.js';
 import { gcsPositionNode, previousPositionNode } from './tsl.js';
 
 /** Built-in material type → its node material (the ones WebGPURenderer converts). */
@@ -70,19 +71,28 @@ export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
 /** The TSL kit: what gcs-skin/webgpu draws with. */
 export const tslKit: GpuMaterialKit = {
   entry: 'gcs-skin/webgpu',
-  methods: new Set(['gcs']),
+  methods: new Set(['gcs', 'lbs', 'dqs']),
   support: nodeMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
+    // Joint-level path: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
+    const pass = sections.method === 'gcs' && sections.path === 'joints' ? new TslNodePass(sections) : null;
     const convert = (m: THREE.Material) => {
       const material = toNodeMaterial(m);
-      material.positionNode = gcsPositionNode(sections, instances !== null);
+      material.positionNode = gcsPositionNode(sections, instances !== null, pass);
       material.castShadowPositionNode = material.positionNode;
       material.name = m.name;
       material.userData.gcsSource = m;
+      if (pass) material.userData.gcsNodePass = pass; // what its vertex stage reads (tests read the pass back)
       Object.assign(material, { ...NOTHING, uniforms: placeholderUniforms() });
       return material;
     };
-    return { material: Array.isArray(source) ? source.map(convert) : convert(source), depth: null, distance: null };
+    const material = Array.isArray(source) ? source.map(convert) : convert(source);
+    if (!pass) return { material, depth: null, distance: null };
+    return {
+      material, depth: null, distance: null,
+      beforeDraw: (renderer: unknown): string | null => pass.render(renderer),
+      dispose: () => pass.dispose(),
+    };
   },
   mismatch(renderer: unknown, material: THREE.Material): string | null {
     const r = renderer as { isWebGLRenderer?: boolean };

@@ -5,133 +5,37 @@
  * accessors, `If` where the GLSL chunk (glsl.ts) branches, both from the same constants
  * (layout.ts). `gcsPositionNode` is a node material's `positionNode`: it returns the deformed
  * position and turns `normalLocal` (and `tangentLocal` where the geometry has tangents) on the way
- * — after the morph targets, so morphs apply first, as on the CPU.
+ * — after the morph targets, so morphs apply first, as on the CPU. The joint-level path's node
+ * maths runs in the node pass (node-pass-tsl.ts), once per node and frame; here each vertex reads
+ * its 1–3 nodes and blends them.
  *
  * The laid-out functions take values only: a shader function is built once per renderer and
  * reused by every material, so it must not name a texture or uniform of one skin.
  */
 import {
-  abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, mat4, max, min, normalGeometry, normalLocal,
+  abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, min, normalGeometry, normalLocal,
   OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
   uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
-  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
+  GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE,
 } from './layout.js';
+import { column, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
-type Float = Node<'float'>;
 type Int = Node<'int'>;
 type Vec3 = Node<'vec3'>;
 type Vec4 = Node<'vec4'>;
 type Mat3 = Node<'mat3'>;
 type Mat4 = Node<'mat4'>;
 
-/** Column c of a matrix (its `[c]`: the typings index arrays, not matrices). */
-const column = <T extends Mat3 | Mat4>(m: T, c: number): T extends Mat3 ? Vec3 : Vec4 =>
-  (m as unknown as { element(i: number): T extends Mat3 ? Vec3 : Vec4 }).element(c);
-
-/** The largest absolute entry of a 3×3 matrix. */
-function largest(m: Mat3): Float {
-  const e = max(max(abs(column(m, 0)), abs(column(m, 1))), abs(column(m, 2)));
-  return max(max(e.x, e.y), e.z);
-}
-
-// ------------------------------------------------------------ shader functions (values in, value out)
-
-/** The rotation matrix of quaternion q (x, y, z, w) scaled by k2 = 2 / |q|² (2 for a unit quaternion). */
-const gcsRotation = Fn(([q, k2]: [Vec4, Float]) => {
-  const xx = q.x.mul(q.x), yy = q.y.mul(q.y), zz = q.z.mul(q.z), xy = q.x.mul(q.y), xz = q.x.mul(q.z), yz = q.y.mul(q.z);
-  const wx = q.w.mul(q.x), wy = q.w.mul(q.y), wz = q.w.mul(q.z);
-  return mat3(
-    vec3(float(1).sub(k2.mul(yy.add(zz))), k2.mul(xy.add(wz)), k2.mul(xz.sub(wy))),
-    vec3(k2.mul(xy.sub(wz)), float(1).sub(k2.mul(xx.add(zz))), k2.mul(yz.add(wx))),
-    vec3(k2.mul(xz.add(wy)), k2.mul(yz.sub(wx)), float(1).sub(k2.mul(xx.add(yy)))),
-  );
-}).setLayout({ name: 'gcsRotation', type: 'mat3', inputs: [{ name: 'q', type: 'vec4' }, { name: 'k2', type: 'float' }] });
-
-/** The CPU's test: k is a positive uniform scale, every entry within UNIFORM_SCALE_TOLERANCE × s of s·I. */
-const gcsUniformScale = Fn(([k]: [Mat3]) => {
-  const s = column(k, 0).x.add(column(k, 1).y).add(column(k, 2).z).div(3).toVar();
-  const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
-  return s.greaterThan(0).and(deviation.lessThanEqual(s.mul(UNIFORM_SCALE_TOLERANCE)));
-}).setLayout({ name: 'gcsUniformScale', type: 'bool', inputs: [{ name: 'k', type: 'mat3' }] });
-
-/**
- * The CPU's normalMatrix: r when k is a positive uniform scale, else r · cof(k) scaled to entries
- * ≤ 1 (k divided by its largest entry first, so ×1e20 scales do not overflow); r alone when k has
- * collapsed.
- */
-const gcsNormalMatrix = Fn(([r, k, uniformScale]: [Mat3, Mat3, Bool]) => {
-  const n = r.toVar();
-  If(uniformScale.not(), () => {
-    const kbig = largest(k).toVar();
-    If(kbig.greaterThan(COLLAPSED), () => {
-      const a = k.mul(float(1).div(kbig)).toVar();
-      const a0 = column(a, 0), a1 = column(a, 1), a2 = column(a, 2);
-      const cof = mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1)).toVar();
-      const big = largest(cof).toVar();
-      If(big.greaterThan(COLLAPSED), () => {
-        n.assign(r.mul(cof.mul(float(1).div(big))));
-      });
-    });
-  });
-  return n;
-}).setLayout({ name: 'gcsNormalMatrix', type: 'mat3', inputs: [{ name: 'r', type: 'mat3' }, { name: 'k', type: 'mat3' }, { name: 'uniformScale', type: 'bool' }] });
-
 /** Σ of the entrywise products of two matrices: 1 + 2 cos θ for rotations θ apart. */
 const gcsTrace = Fn(([a, b]: [Mat3, Mat3]) =>
   dot(column(a, 0), column(b, 0)).add(dot(column(a, 1), column(b, 1))).add(dot(column(a, 2), column(b, 2))),
 ).setLayout({ name: 'gcsTrace', type: 'float', inputs: [{ name: 'a', type: 'mat3' }, { name: 'b', type: 'mat3' }] });
-
-/**
- * A section's blended pose, in a joint's texel layout: columns 0–2 the rows of [M | t], column 3
- * the blended rotation quaternion (not normalised). The dual-quaternion blend of `slots` joint
- * poses at their weights (a joint past the last has weight 0: it adds nothing), each joint's scale
- * part K_j = R_jᵀ S_j blended linearly and applied first: M = R·K, the CPU's blendPoses. With a
- * centre of rotation p (`centre`, w = 1; w = 0: none) it turns about p, moved where LBS moves it:
- * t = Σ w_i (S_i p + t_i − p) − (M p − p).
- */
-function sectionBlendFunction(slots: TableSlots) {
-  const lanes = ['x', 'y', 'z', 'w'] as const;
-  const inputs = [
-    ...Array.from({ length: slots }, (_, c) => ({ name: `p${c}`, type: 'mat4' })),
-    ...Array.from({ length: slots / 4 }, (_, g) => ({ name: `w${g}`, type: 'vec4' })),
-    { name: 'centre', type: 'vec4' },
-  ];
-  return Fn((args: Node[]) => {
-    const all = [...args]; // TSL hands the parameters as an iterable proxy
-    const poses = all.slice(0, slots) as Mat4[], weights = all.slice(slots, slots + slots / 4) as Vec4[];
-    const centre = all[slots + slots / 4] as Vec4;
-    const pivot = column(poses[0], 3);
-    const br = vec4(0).toVar(), bd = vec4(0).toVar();
-    const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
-    const moved = vec3(0).toVar();
-    for (let c = 0; c < slots; c++) {
-      const p = poses[c], w = weights[c >> 2][lanes[c & 3]];
-      const r0 = column(p, 0), r1 = column(p, 1), r2 = column(p, 2), q = column(p, 3);
-      const s = mat3(r0.xyz, r1.xyz, r2.xyz).transpose(), t = vec3(r0.w, r1.w, r2.w);
-      const d = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
-      const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
-      br.addAssign(q.mul(sw));
-      bd.addAssign(d.mul(sw));
-      k.addAssign(gcsRotation(q, float(2)).transpose().mul(s).mul(w));
-      moved.addAssign(s.mul(centre.xyz).add(t).sub(centre.xyz).mul(w));
-    }
-    const inv2 = float(1).div(dot(br, br)).toVar();
-    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
-    const m = gcsRotation(br, inv2.mul(2)).mul(k).toVar();
-    If(centre.w.greaterThan(0.5), () => {
-      t.assign(moved.sub(m.mul(centre.xyz).sub(centre.xyz)));
-    });
-    const rows = m.transpose().toVar();
-    return mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), br);
-  }).setLayout({ name: `gcsSectionBlend${slots}`, type: 'mat4', inputs });
-}
-const gcsSectionBlend = { 4: sectionBlendFunction(4), 8: sectionBlendFunction(8) } as const;
 
 /**
  * A normal or tangent as the CPU turns it (joint-level path): blended (smooth) normals are left as
@@ -186,72 +90,55 @@ const gcsTurn = Fn(([v, rows]: [Vec3, Mat3]) => {
 
 // ------------------------------------------------------------ accessors (texel reads, per skin)
 
-/** Texel i of a float texture read with integer coordinates (row-major, the texture's width). */
-function texel(tex: TextureNode, i: Int): Vec4 {
-  const w = int((textureSize(tex) as unknown as Node<'ivec2'>).x);
-  const y = i.div(w);
-  return tex.load(ivec2(i.sub(y.mul(w)), y));
-}
-
 /** How one vertex moves: its position, and a function turning its normal (or tangent). */
 interface VertexTransform { position(p: Vec3): Vec3; turn(v: Vec3): Vec3 }
 
-/** The joint-level path's inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
-interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
-
-/** Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion. */
-function jointPose(inputs: JointInputs, j: Int): Mat4 {
-  const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
-  return mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
-}
-
-/** One section's transform x ↦ M x + T, its normal matrix N and whether normals renormalise. */
+/** One node's transform x ↦ M x + T, its normal matrix N and whether normals renormalise. */
 interface Section { m: Mat3; t: Vec3; n: Mat3; renorm: Bool }
 
 /**
- * Section s (the GLSL's gcsSectionBlend): a rigid core moves with its joint; otherwise its joints'
- * poses blended (gcsSectionBlend). Its normal matrix from the pose's rotation R and scale part K = Rᵀ M.
+ * A node from its four texels as the node pass writes them (the GLSL's gcsNode): the rows of
+ * [M | T], and the normal texel n from which N = cof(M·n.x)·n.y; n.w < 0 where normals renormalise.
  */
-function section(inputs: JointInputs, s: Int): Section {
-  // Per 4 slots, a texel of joints (−1 past the last) then one of weights; last, the centre.
-  const texels = tableTexelsPerSection(inputs.slots);
-  const row = s.mul(texels).toVar();
-  const joints: Vec4[] = [], weights: Vec4[] = [];
-  for (let g = 0; g < inputs.slots / 4; g++) {
-    joints.push(texel(inputs.table, row.add(2 * g)).toVar());
-    weights.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
-  }
-  const lanes = ['x', 'y', 'z', 'w'] as const;
-  const pose = jointPose(inputs, int(joints[0].x)).toVar();
-  If(joints[0].y.greaterThanEqual(0), () => {
-    const poses: Mat4[] = [pose];
-    for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(joints[c >> 2][lanes[c & 3]], 0))));
-    // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
-    const used = weights.map((w, g) => step(vec4(0), joints[g]).mul(w));
-    const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
-    pose.assign(gcsSectionBlend[inputs.slots](...poses, ...used, centre));
-  });
-  const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
+function decodeNode(r0: Vec4, r1: Vec4, r2: Vec4, n: Vec4): Section {
   const m = mat3(r0.xyz, r1.xyz, r2.xyz).transpose().toVar();
-  const rotation = gcsRotation(q, float(2).div(dot(q, q))).toVar();
-  const k = rotation.transpose().mul(m).toVar();
-  const uniformScale = gcsUniformScale(k).toVar();
-  return { m, t: vec3(r0.w, r1.w, r2.w).toVar(), n: gcsNormalMatrix(rotation, k, uniformScale).toVar(), renorm: uniformScale.not().toVar() };
+  const a = m.mul(n.x).toVar();
+  const a0 = column(a, 0), a1 = column(a, 1), a2 = column(a, 2);
+  return { m, t: vec3(r0.w, r1.w, r2.w).toVar(), n: mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1)).mul(n.y).toVar(), renorm: n.w.lessThan(0).toVar() };
+}
+
+/** Where a skin's nodes come from: the node pass's textures (one texel per node and target), this instance's first node. */
+interface NodeInputs { nodes: TextureNode[]; first: Int }
+
+/** Node s of this instance, read from the node pass's targets. */
+function passNode(inputs: NodeInputs, s: Int): Section {
+  const i = inputs.first.add(s).toVar();
+  const w = int((textureSize(inputs.nodes[0]) as unknown as Node<'ivec2'>).x);
+  const y = i.div(w);
+  const at = ivec2(i.sub(y.mul(w)), y).toVar();
+  const [r0, r1, r2, n] = inputs.nodes.map((t) => t.load(at).toVar());
+  return decodeNode(r0, r1, r2, n);
+}
+
+/** Node s computed here from the joint poses (a velocity pass's previous frame only: the pass holds this frame's). */
+function computedNode(inputs: JointInputs, s: Int): Section {
+  const texels = nodeTexels(inputs, s);
+  return decodeNode(column(texels, 0), column(texels, 1), column(texels, 2), column(texels, 3));
 }
 
 /** The joint-level path per vertex (the GLSL's JOINT_BASE): the third section only where there is one. */
-function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
+function jointVertex(section: (s: Int) => Section, smooth: boolean): VertexTransform {
   if (!smooth) {
-    const a = section(inputs, int(attribute<'float'>(SECTION_ATTRIBUTE, 'float').add(0.5)));
+    const a = section(int(attribute<'float'>(SECTION_ATTRIBUTE, 'float').add(0.5)));
     return { position: (p) => a.m.mul(p).add(a.t), turn: (v) => gcsTurnJoint(v, a.n, bool(false), bool(false), a.renorm) };
   }
   const blend = attribute<'vec3'>(BLEND_ATTRIBUTE, 'vec3'), third = attribute<'vec2'>(BLEND_THIRD_ATTRIBUTE, 'vec2');
   const sa = int(blend.x.add(0.5)).toVar(), sb = int(blend.y.add(0.5)).toVar(), sc = int(third.x.add(0.5)).toVar();
-  const a = section(inputs, sa);
+  const a = section(sa);
   const m = a.m.toVar(), t = a.t.toVar(), n = a.n.toVar();
   const near = bool(false).toVar(), almostEqual = bool(false).toVar(), normalise = a.renorm.toVar();
   If(sb.notEqual(sa), () => {
-    const b = section(inputs, sb);
+    const b = section(sb);
     const f = blend.z;
     const trace = gcsTrace(a.n, b.n).toVar();
     m.assign(a.m.add(b.m.sub(a.m).mul(f)));
@@ -259,7 +146,7 @@ function jointVertex(inputs: JointInputs, smooth: boolean): VertexTransform {
     n.assign(a.n.add(b.n.sub(a.n).mul(f)));
     If(sc.notEqual(sa), () => {
       // A three-joint lattice cell: + g·(C − A); the least pairwise trace decides the fix.
-      const c = section(inputs, sc);
+      const c = section(sc);
       const g = third.y;
       m.addAssign(c.m.sub(a.m).mul(g));
       t.addAssign(c.t.sub(a.t).mul(g));
@@ -308,6 +195,59 @@ function sectionVertex(sections: TextureNode, first: Int, smooth: boolean): Vert
   };
 }
 
+// ------------------------------------------------------------ LBS and DQS per vertex (backend 'gpu', method 'lbs' | 'dqs')
+
+/** LBS normals (the GLSL's gcsTurnLbs): by M, then unit length; where M collapses, by the first influence's rotation q. */
+const gcsTurnLbs = Fn(([v, m, q]: [Vec3, Mat3, Vec4]) => {
+  const n = m.mul(v).toVar();
+  const len2 = dot(n, n).toVar();
+  const out = vec3(0).toVar();
+  If(len2.greaterThan(1e-24).and(len2.lessThan(1e24)), () => {
+    out.assign(n.div(len2.sqrt()));
+  }).Else(() => {
+    const r = gcsRotation(q, float(2)).mul(v).toVar();
+    const l = length(r);
+    out.assign(select(l.greaterThan(0), r.div(l), v));
+  });
+  return out;
+}).setLayout({ name: 'gcsTurnLbs', type: 'vec3', inputs: [{ name: 'v', type: 'vec3' }, { name: 'm', type: 'mat3' }, { name: 'q', type: 'vec4' }] });
+
+/**
+ * Each vertex blends its own joints (4, or 8 with a second set) from the joint poses, at its own
+ * weights (the rig's, as the core normalises them; joint −1 where the weight is 0): LBS as the
+ * CPU's (M = Σ w S_j; normals by M, then unit length), DQS through the node maths (jointBlend) with
+ * no centre, normals as the joint-level path turns an unblended one.
+ */
+function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slots: 4 | 8): VertexTransform {
+  const ids: Vec4[] = [], weights: Vec4[] = [];
+  for (let g = 0; g < slots / 4; g++) {
+    ids.push(attribute<'vec4'>(INFLUENCE_ATTRIBUTES[g], 'vec4'));
+    weights.push(attribute<'vec4'>(WEIGHT_ATTRIBUTES[g], 'vec4'));
+  }
+  const inputs = { joints, first, slots };
+  if (method === 'dqs') {
+    const texels = jointBlend(inputs, ids, weights, vec4(0)).toVar();
+    const node = decodeNode(column(texels, 0), column(texels, 1), column(texels, 2), column(texels, 3));
+    return { position: (p) => node.m.mul(p).add(node.t), turn: (v) => gcsTurnJoint(v, node.n, bool(false), bool(false), node.renorm) };
+  }
+  const lanes = ['x', 'y', 'z', 'w'] as const;
+  const r0 = vec4(0).toVar(), r1 = vec4(0).toVar(), r2 = vec4(0).toVar();
+  let rest: Vec4 = vec4(0, 0, 0, 1);
+  for (let c = 0; c < slots; c++) {
+    const id = ids[c >> 2][lanes[c & 3]];
+    const w = weights[c >> 2][lanes[c & 3]].mul(step(0, id)).toVar(); // joint −1: weight 0
+    const pose = jointPose(inputs, int(id.max(0))).toVar();
+    r0.addAssign(column(pose, 0).mul(w));
+    r1.addAssign(column(pose, 1).mul(w));
+    r2.addAssign(column(pose, 2).mul(w));
+    // Where the blend collapses (bones scaled to 0): the first influence's rotation.
+    if (c === 0) rest = (select(w.greaterThan(0), column(pose, 3), vec4(0, 0, 0, 1)) as unknown as Vec4).toVar();
+  }
+  const m = mat3(r0.xyz, r1.xyz, r2.xyz).transpose().toVar(), t = vec3(r0.w, r1.w, r2.w).toVar();
+  const q = rest;
+  return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnLbs(v, m, q) };
+}
+
 /** Whether this build writes velocity (three.js asks for previous positions then). */
 const needsPreviousData = (builder: NodeBuilder): boolean => (builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData();
 
@@ -322,11 +262,21 @@ export function previousPositionNode(): Node<'vec3'> {
   })();
 }
 
-/** How each vertex moves under one per-frame texture (joint poses or section transforms). */
-function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int): VertexTransform {
-  return sections.path === 'joints'
-    ? jointVertex({ joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first }, sections.smooth)
-    : sectionVertex(perFrame, first, sections.smooth);
+/**
+ * How each vertex moves: path 'sections' from the section transforms; path 'joints' from the node
+ * pass's targets (`pass`, `nodeFirst` this instance's first node), or, without one (a velocity
+ * pass's previous frame, or a caller that built no pass), from nodes computed here from the joint
+ * poses (`perFrame`, `first` this instance's first joint texel).
+ */
+function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: TslNodePass | null, nodeFirst: Int): VertexTransform {
+  if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
+  if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
+  if (pass) {
+    const inputs: NodeInputs = { nodes: Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i)), first: nodeFirst };
+    return jointVertex((s) => passNode(inputs, s), sections.smooth);
+  }
+  const inputs: JointInputs = { joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first };
+  return jointVertex((s) => computedNode(inputs, s), sections.smooth);
 }
 
 /**
@@ -336,11 +286,15 @@ function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: In
  * instance by then, so it starts from the bind-pose attributes and places the instance itself
  * with the mesh's own `instanceMatrix` (each instance's pose at `instanceIndex`).
  *
+ * Path 'joints': each vertex reads its 1–3 nodes from `pass` (TslNodePass, run once per frame
+ * before the draws) and blends them; without a pass it computes them itself (slow: a node per
+ * vertex that uses it).
+ *
  * Velocity (a render pass whose MRT has `velocity`): `positionPrevious` gets the same vertex under
  * the previous frame's texels (GpuSections.previousTexture), as three.js's skinning does with its
  * previous bone matrices; a crowd places it with the current instance matrix.
  */
-export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node<'vec3'> {
+export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass: TslNodePass | null = null): Node<'vec3'> {
   const perFrame = texture(sections.texture);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);
@@ -348,12 +302,14 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean): Node
   return Fn((builder: NodeBuilder) => {
     const has = (name: string) => builder.geometry?.getAttribute(name) !== undefined;
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
-    const vertex = vertexTransform(sections, perFrame, first);
+    const sectionCount = sections.deformer.sectionCount;
+    const nodeFirst = (instanced ? int(instanceIndex).mul(sectionCount) : int(0)).toVar();
+    const vertex = vertexTransform(sections, perFrame, first, pass, nodeFirst);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
     if (needsPreviousData(builder)) {
       OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
-      const previous = vertexTransform(sections, texture(sections.previousTexture()), first);
+      const previous = vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
     }
     if (has('normal')) {

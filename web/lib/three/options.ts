@@ -40,7 +40,7 @@ export interface SkinDeformerOptions {
    * 'gpu': the mesh stays on the GPU in the bind pose; per frame wasm computes only the joint
    * poses (weights criterion; about 1 KB) or the section transforms (a few KB), into a float
    * texture, and the vertex shader of a patched clone of the material applies them (docs/gpu.md;
-   * see gpuPath). GCS, LBS and DQS (gcs-skin/webgpu: GCS): the classic model, materials that cannot
+   * see gpuPath). GCS, LBS and DQS: the classic model, materials that cannot
    * be patched (ShaderMaterial, node materials) and a patched shader that fails to compile fall back
    * to 'cpu' — `backend` tells which runs, `backendNote` why, and one console warning says so. The
    * same happens at the first draw by a WebGPURenderer, which never runs the patch: gcs-skin/webgpu

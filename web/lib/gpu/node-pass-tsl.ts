@@ -1,0 +1,295 @@
+/**
+ * The node pass for WebGPURenderer (joint-level path; real WebGPU and its WebGL2 fallback): once
+ * per frame, every node's transform and normal texel from the joint poses, for every instance in
+ * one draw, into four float targets that the vertex stage reads (tsl.ts) — the TSL twin of
+ * node-pass.ts, in the same texel layout (layout.ts, GPU_NODE_TEXTURES).
+ *
+ * A render-to-texture pass (a QuadMesh whose fragment is one node, written through `mrt()`), not
+ * a compute node: on the WebGL2 fallback three.js runs compute through transform feedback into
+ * vertex buffers, which the vertex stage could only read as storage attributes; a render target
+ * runs the same way on both backends and is read with `textureLoad`, as the GLSL path reads it.
+ *
+ * The node maths lives here once, as small laid-out functions (like three.js's Skinning.js):
+ * `nodeTexels` is called by the pass's fragment and, for the previous frame of a velocity pass
+ * only, by the vertex stage.
+ */
+import * as THREE from 'three/webgpu';
+import {
+  abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mrt, screenCoordinate, select, step, texture, textureSize, vec3, vec4,
+} from 'three/tsl';
+import type { DataTexture, Node, TextureNode } from 'three/webgpu';
+import { COLLAPSED, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots } from './layout.js';
+import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
+import type { GpuSections } from './sections.js';
+
+type Float = Node<'float'>;
+type Int = Node<'int'>;
+type Vec4 = Node<'vec4'>;
+type Mat3 = Node<'mat3'>;
+type Mat4 = Node<'mat4'>;
+
+/** The widest row of the node textures: WebGL2's guaranteed 2048. */
+const MAX_WIDTH = 2048;
+
+/** Names of the four targets, in GPU_NODE_TEXTURES order: the rows of [M | T], then the normal texel. */
+const OUTPUTS = ['gcsRow0', 'gcsRow1', 'gcsRow2', 'gcsNormal'] as const;
+
+/** Column c of a matrix (its `[c]`: the typings index arrays, not matrices). */
+export const column = <T extends Mat3 | Mat4>(m: T, c: number): T extends Mat3 ? Node<'vec3'> : Vec4 =>
+  (m as unknown as { element(i: number): T extends Mat3 ? Node<'vec3'> : Vec4 }).element(c);
+
+/** The largest absolute entry of a 3×3 matrix. */
+export function largest(m: Mat3): Float {
+  const e = max(max(abs(column(m, 0)), abs(column(m, 1))), abs(column(m, 2)));
+  return max(max(e.x, e.y), e.z);
+}
+
+/** Texel i of a float texture read with integer coordinates (row-major, the texture's width). */
+export function texel(tex: TextureNode, i: Int): Vec4 {
+  const w = int((textureSize(tex) as unknown as Node<'ivec2'>).x);
+  const y = i.div(w);
+  return tex.load(ivec2(i.sub(y.mul(w)), y));
+}
+
+// ------------------------------------------------------------ shader functions (values in, value out)
+
+/** The rotation matrix of quaternion q (x, y, z, w) scaled by k2 = 2 / |q|² (2 for a unit quaternion). */
+export const gcsRotation = Fn(([q, k2]: [Vec4, Float]) => {
+  const xx = q.x.mul(q.x), yy = q.y.mul(q.y), zz = q.z.mul(q.z), xy = q.x.mul(q.y), xz = q.x.mul(q.z), yz = q.y.mul(q.z);
+  const wx = q.w.mul(q.x), wy = q.w.mul(q.y), wz = q.w.mul(q.z);
+  return mat3(
+    vec3(float(1).sub(k2.mul(yy.add(zz))), k2.mul(xy.add(wz)), k2.mul(xz.sub(wy))),
+    vec3(k2.mul(xy.sub(wz)), float(1).sub(k2.mul(xx.add(zz))), k2.mul(yz.add(wx))),
+    vec3(k2.mul(xz.add(wy)), k2.mul(yz.sub(wx)), float(1).sub(k2.mul(xx.add(yy)))),
+  );
+}).setLayout({ name: 'gcsRotation', type: 'mat3', inputs: [{ name: 'q', type: 'vec4' }, { name: 'k2', type: 'float' }] });
+
+/**
+ * The CPU's normalMatrix as one texel (x, y, 0, flag), from which the vertex stage takes
+ * N = cof(M·x)·y (M = R·K, cof(R) = R), the GLSL's gcsNormalTexel: (1/s, 1, 0, 0) when K is a
+ * positive uniform scale s·I (every entry within UNIFORM_SCALE_TOLERANCE × s); else
+ * (1/kbig, 1/big, 0, −1), R·cof(K/kbig)/big with entries ≤ 1, normals renormalised; a collapsed
+ * K gives (0, 0, 0, −1): N = 0, the normal keeps its rest direction.
+ */
+const gcsNormalTexel = Fn(([k]: [Mat3]) => {
+  const s = column(k, 0).x.add(column(k, 1).y).add(column(k, 2).z).div(3).toVar();
+  const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
+  const out = vec4(0, 0, 0, -1).toVar();
+  If(s.greaterThan(0).and(deviation.lessThanEqual(s.mul(UNIFORM_SCALE_TOLERANCE))), () => {
+    out.assign(vec4(float(1).div(s), 1, 0, 0));
+  }).Else(() => {
+    const kbig = largest(k).toVar();
+    If(kbig.greaterThan(COLLAPSED), () => {
+      const a = k.mul(float(1).div(kbig)).toVar();
+      const a0 = column(a, 0), a1 = column(a, 1), a2 = column(a, 2);
+      const big = largest(mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1))).toVar();
+      If(big.greaterThan(COLLAPSED), () => out.assign(vec4(float(1).div(kbig), float(1).div(big), 0, -1)));
+    });
+  });
+  return out;
+}).setLayout({ name: 'gcsNormalTexel', type: 'vec4', inputs: [{ name: 'k', type: 'mat3' }] });
+
+/**
+ * A node's four texels (matrix columns: the rows of [M | T], then the normal texel) from up to
+ * `slots` joint poses at their weights (a joint past the last has weight 0: it adds nothing): the
+ * dual-quaternion blend, each joint's scale part K_j = R_jᵀ S_j blended linearly and applied
+ * first, M = R·K, the CPU's blendPoses. With a centre of rotation p (`centre`, w = 1; w = 0:
+ * none) it turns about p, moved where LBS moves it: T = Σ w_i (S_i p + t_i − p) − (M p − p).
+ * Each pose: columns 0–2 the rows of [S_j | t_j], column 3 its rotation quaternion.
+ */
+function nodeBlendFunction(slots: TableSlots) {
+  const lanes = ['x', 'y', 'z', 'w'] as const;
+  const inputs = [
+    ...Array.from({ length: slots }, (_, c) => ({ name: `p${c}`, type: 'mat4' })),
+    ...Array.from({ length: slots / 4 }, (_, g) => ({ name: `w${g}`, type: 'vec4' })),
+    { name: 'centre', type: 'vec4' },
+  ];
+  return Fn((args: Node[]) => {
+    const all = [...args]; // TSL hands the parameters as an iterable proxy
+    const poses = all.slice(0, slots) as Mat4[], weights = all.slice(slots, slots + slots / 4) as Vec4[];
+    const centre = all[slots + slots / 4] as Vec4;
+    const pivot = column(poses[0], 3);
+    const br = vec4(0).toVar(), bd = vec4(0).toVar();
+    const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
+    const moved = vec3(0).toVar();
+    for (let c = 0; c < slots; c++) {
+      const p = poses[c], w = weights[c >> 2][lanes[c & 3]];
+      const r0 = column(p, 0), r1 = column(p, 1), r2 = column(p, 2), q = column(p, 3);
+      const s = mat3(r0.xyz, r1.xyz, r2.xyz).transpose(), t = vec3(r0.w, r1.w, r2.w);
+      const d = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
+      const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
+      br.addAssign(q.mul(sw));
+      bd.addAssign(d.mul(sw));
+      k.addAssign(gcsRotation(q, float(2)).transpose().mul(s).mul(w));
+      moved.addAssign(s.mul(centre.xyz).add(t).sub(centre.xyz).mul(w));
+    }
+    const inv2 = float(1).div(dot(br, br)).toVar();
+    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
+    const m = gcsRotation(br, inv2.mul(2)).mul(k).toVar();
+    If(centre.w.greaterThan(0.5), () => {
+      t.assign(moved.sub(m.mul(centre.xyz).sub(centre.xyz)));
+    });
+    const rows = m.transpose().toVar();
+    return mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), gcsNormalTexel(k));
+  }).setLayout({ name: `gcsNodeBlend${slots}`, type: 'mat4', inputs });
+}
+const gcsNodeBlend = { 4: nodeBlendFunction(4), 8: nodeBlendFunction(8) } as const;
+
+// ------------------------------------------------------------ accessors (texel reads, per skin)
+
+/** The node maths' inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
+export interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
+
+/** Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion. */
+export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
+  const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
+  return mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
+}
+
+/**
+ * Node s's four texels (the GLSL's gcsSectionBlend): a rigid core is its joint's pose (normal
+ * texel from K = Rᵀ S); otherwise its joints' poses blended (gcsNodeBlend).
+ */
+export function nodeTexels(inputs: JointInputs, s: Int): Mat4 {
+  // Per 4 slots, a texel of joints (−1 past the last) then one of weights; last, the centre.
+  const texels = tableTexelsPerSection(inputs.slots);
+  const row = s.mul(texels).toVar();
+  const joints: Vec4[] = [], weights: Vec4[] = [];
+  for (let g = 0; g < inputs.slots / 4; g++) {
+    joints.push(texel(inputs.table, row.add(2 * g)).toVar());
+    weights.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
+  }
+  const pose = jointPose(inputs, int(joints[0].x)).toVar();
+  const out = mat4(pose).toVar();
+  If(joints[0].y.greaterThanEqual(0), () => {
+    const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
+    out.assign(jointBlend(inputs, joints, weights, centre, pose));
+  }).Else(() => {
+    const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
+    const k = gcsRotation(q, float(2)).transpose().mul(mat3(r0.xyz, r1.xyz, r2.xyz).transpose());
+    out.assign(mat4(r0, r1, r2, gcsNormalTexel(k)));
+  });
+  return out;
+}
+
+const LANES = ['x', 'y', 'z', 'w'] as const;
+
+/**
+ * The blend of joints `ids` (per 4 slots a vec4; −1 past the last) at `weights`, about `centre`
+ * (w = 0: none), as a node's four texels (gcsNodeBlend): the section table's joints in the pass,
+ * a vertex's own joints for DQS. `first`: the first joint's pose when already read.
+ */
+export function jointBlend(inputs: Omit<JointInputs, 'table'>, ids: Vec4[], weights: Vec4[], centre: Vec4, first?: Mat4): Mat4 {
+  const poses: Mat4[] = [first ?? jointPose(inputs, int(max(ids[0].x, 0)))];
+  for (let c = 1; c < inputs.slots; c++) poses.push(jointPose(inputs, int(max(ids[c >> 2][LANES[c & 3]], 0))));
+  // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early break).
+  const used = weights.map((w, g) => step(vec4(0), ids[g]).mul(w));
+  return gcsNodeBlend[inputs.slots](...poses, ...used, centre);
+}
+
+/** Whether `renderer` draws through WebGL2 without float render targets (the pass cannot run there). */
+function noFloatTargets(renderer: unknown): boolean {
+  const backend = (renderer as { backend?: { isWebGLBackend?: boolean; extensions?: { has(name: string): boolean } } })?.backend;
+  return backend?.isWebGLBackend === true && backend.extensions?.has(FLOAT_TARGET_EXTENSION) === false;
+}
+
+/**
+ * The pass: a QuadMesh over a RenderTarget of GPU_NODE_TEXTURES float textures, one texel per node
+ * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide). Runs at the skin's
+ * first draw after `GpuSections.update()` (shadow or colour pass): every pass of that frame reads
+ * the same texels, and a frame drawn twice computes them once.
+ */
+export class TslNodePass {
+  readonly target: THREE.RenderTarget;
+  /** Times the pass has run (once per GpuSections.update() that was drawn). */
+  runs = 0;
+  private readonly quad: THREE.QuadMesh;
+  private readonly material: THREE.NodeMaterial;
+  /** The GpuSections.version the target holds (−1: none yet). */
+  private drawn = -1;
+  /** What the vertex stage reads: one texture node per target. */
+  private readonly views: TextureNode[];
+  /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
+  private glsl: NodePass | null = null;
+
+  constructor(readonly sections: GpuSections) {
+    const S = sections.deformer.sectionCount, nodes = sections.instanceCount * S;
+    const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
+    this.target = new THREE.RenderTarget(width, height, {
+      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
+    });
+    this.target.textures.forEach((t, i) => { t.name = OUTPUTS[i]; });
+    // One fragment per texel: its node from the fragment's position (texels past the last repeat the last node).
+    const joints = texture(sections.texture), table = texture(sections.table as DataTexture), stride = sections.uniforms.gcsStride.value;
+    const texels = Fn(() => {
+      const at = ivec2(screenCoordinate);
+      const node = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
+      const instance = node.div(S).toVar();
+      const inputs: JointInputs = { joints, table, slots: sections.tableSlots, first: instance.mul(stride) };
+      return nodeTexels(inputs, node.sub(instance.mul(S)));
+    })().toVar() as unknown as Mat4;
+    this.material = new THREE.NodeMaterial();
+    this.material.name = 'gcsNodePass';
+    // The fragment is the four outputs (an output struct: no lighting, fog or colour transform).
+    this.material.fragmentNode = mrt(Object.fromEntries(OUTPUTS.map((name, i) => [name, column(texels, i)])));
+    this.material.depthTest = false;
+    this.material.depthWrite = false;
+    this.material.blending = THREE.NoBlending;
+    this.quad = new THREE.QuadMesh(this.material);
+    this.views = this.target.textures.map((t) => texture(t));
+  }
+
+  /** The vertex stage's view of target i (0–2: rows of [M | T], 3: the normal texel); one node per target, shared by every material. */
+  textureNode(i: number): TextureNode {
+    return this.views[i];
+  }
+
+  /**
+   * Writes every node of every instance for the current joint poses, unless already written since
+   * the last GpuSections.update(); returns why `renderer` cannot, or null. WebGPURenderer: this
+   * pass (restoring the render target, cube face, mip level and MRT). A WebGLRenderer with
+   * three.js's WebGLNodesHandler: the GLSL pass (node-pass.ts), same layout, whose targets the
+   * views then show — while the targets are one row high: the handler's texture reads count rows
+   * from the top (WebGPU's convention) and the GLSL pass writes them from the bottom.
+   */
+  render(renderer: unknown): string | null {
+    const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
+    if (r?.isWebGLRenderer) {
+      const why = NodePass.unsupported(renderer);
+      if (why) return why;
+      if (this.target.height > 1) return `a WebGLRenderer with WebGLNodesHandler reads the node pass's targets from the other end when they span more than one row (more than ${MAX_WIDTH} nodes)`;
+      this.glsl ??= new NodePass(this.sections);
+      this.show(this.glsl.target.textures);
+      this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
+      return null;
+    }
+    if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
+    this.show(this.target.textures);
+    const version = this.sections.version;
+    if (this.drawn === version) return null;
+    this.drawn = version;
+    this.runs++;
+    const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
+    const outputMRT = r.getMRT(), autoClear = r.autoClear;
+    r.autoClear = false; // every texel is written
+    r.setMRT(null);
+    r.setRenderTarget(this.target);
+    this.quad.render(r);
+    r.setRenderTarget(target, face, level);
+    r.setMRT(outputMRT);
+    r.autoClear = autoClear;
+    return null;
+  }
+
+  /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
+  private show(textures: THREE.Texture[]): void {
+    for (let i = 0; i < this.views.length; i++) if (this.views[i].value !== textures[i]) this.views[i].value = textures[i];
+  }
+
+  dispose(): void {
+    this.target.dispose();
+    this.material.dispose();
+    this.glsl?.dispose();
+  }
+}
