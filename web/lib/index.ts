@@ -14,6 +14,8 @@
  * One file for the core's API, over 700 lines on purpose: GcsSkin, Rig, the deformers and the pose
  * buffers share internal state (handles, views on wasm memory, raise()) that a split would have to
  * export; the boundary itself is boundary.generated.ts, the measures measure/, the adapters three/.
+ *
+ * @module gcs-skin
  */
 import {
   GCS_CLASSIC_DEFAULT_BULGE, GCS_CLASSIC_DEFAULT_CONTOURS, GCS_CLASSIC_DEFAULT_RAYS, GCS_CLASSIC_MAX_BULGE, GCS_CLASSIC_MAX_CONTOURS,
@@ -132,19 +134,27 @@ export interface GcsOptions {
 
 /** What buildGcs does with an option it is not given (gcs_skin.h GCS_DEFAULT_*). */
 export const GCS_DEFAULTS = {
+  /** Level of detail (6). */
   sections: GCS_DEFAULT_SECTIONS,
+  /** The section criterion ('weights'). */
   criterion: CRITERIA[GCS_DEFAULT_CRITERION],
+  /** Y/axial only: fraction of a part over which joint influence ramps (1, the paper). */
   influenceWidth: GCS_DEFAULT_INFLUENCE_WIDTH,
   /** smooth's default depends on the criterion (GCS_SMOOTH_BY_CRITERION): on under 'weights', off under 'y' and 'axial'. */
   smooth: (criterion: Criterion): boolean => criterion === 'weights',
+  /** Y/axial only: spread a joint's twist along the child part (false). */
   twistSpread: GCS_DEFAULT_TWIST_SPREAD !== 0,
+  /** Weights criterion: turn bending sections about their centres of rotation (false). */
   centres: GCS_DEFAULT_CENTRES !== 0,
 } as const;
 
 /** What buildClassic does with an option it is not given (gcs_skin.h GCS_CLASSIC_DEFAULT_*). */
 export const CLASSIC_DEFAULTS = {
+  /** Contours per resampled part (25). */
   contours: GCS_CLASSIC_DEFAULT_CONTOURS,
+  /** Rays per contour (20). */
   rays: GCS_CLASSIC_DEFAULT_RAYS,
+  /** Muscle bulge gain (0.3). */
   bulge: GCS_CLASSIC_DEFAULT_BULGE,
 } as const;
 

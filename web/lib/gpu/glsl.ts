@@ -284,7 +284,12 @@ void main() {
 const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
 
 /** The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots). */
-export function nodePassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
+export function nodePassShaders(slots: TableSlots): {
+  /** GLSL 3 vertex shader: one triangle covering the target. */
+  vertexShader: string;
+  /** GLSL 3 fragment shader: one fragment per node, writing the rows of [M | T] and the normal texel to the four node textures. */
+  fragmentShader: string;
+} {
   if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
 }

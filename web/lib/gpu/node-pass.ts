@@ -25,8 +25,14 @@ export type NodeUniforms = GcsUniforms;
 
 type Renderer = THREE.WebGLRenderer;
 
+/**
+ * Computes every node's transform and normal matrix once per frame into float render targets that
+ * the joint-level vertex stage reads (see the module comment).
+ */
 export class NodePass {
+  /** The float render target (GPU_NODE_TEXTURES textures, one texel per node of every instance) the pass draws into. */
   readonly target: THREE.WebGLRenderTarget;
+  /** The uniforms the vertex stage reads: the target's textures as gcsNodes0…, gcsBase and gcsStride. */
   readonly uniforms: NodeUniforms;
   private readonly material: THREE.ShaderMaterial;
   private readonly scene = new THREE.Scene();
@@ -35,6 +41,9 @@ export class NodePass {
   /** The GpuSections.version the target holds (−1: none yet). */
   private drawn = -1;
 
+  /**
+   * @param sections The GPU sections whose joint poses and section table the pass reads.
+   */
   constructor(readonly sections: GpuSections) {
     const deformer = sections.deformer, S = deformer.sectionCount, N = sections.instanceCount;
     const nodes = N * S;
@@ -87,6 +96,7 @@ export class NodePass {
     renderer.autoClear = autoClear;
   }
 
+  /** Frees the render target, the pass's material and its geometry. */
   dispose(): void {
     this.target.dispose();
     this.material.dispose();

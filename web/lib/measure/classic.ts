@@ -10,15 +10,21 @@ import { maxOf, percentile } from './statistics.js';
 
 /** What the classic model makes of a rig at one setting (the paper's Fig. 5 comparison). */
 export interface ClassicFigures {
+  /** Contours per part at this setting. */
   contours: number;
+  /** Rays per contour at this setting. */
   rays: number;
+  /** Vertices of the classic model's output mesh. */
   outputVertices: number;
   /** Parts resampled (chain parts, and trunk parts along the spine) and carried. */
   resampled: number;
+  /** Trunk parts resampled along the spine. */
   trunk: number;
+  /** Parts carried (their own triangles, skinned by DQS). */
   carried: number;
   /** Detail loss, % of the mesh's height (ClassicDeformer.detailLoss). */
   rms: number;
+  /** Largest detail loss, % of the mesh's height. */
   max: number;
   /** Welded border edges of the output at rest (equal to the input's: no gap where tubes meet carried skin). */
   border: number;
@@ -67,23 +73,31 @@ export function classicAtBudget(rig: Rig): ClassicFigures {
 
 /** How far one part of a classic model's output lies from the DQS-posed source surface (% of height). */
 export interface OffSurfacePart {
+  /** The part's joint. */
   joint: number;
+  /** Whether the part is resampled (false: carried). */
   resampled: boolean;
+  /** Why it is resampled or carried. */
   reason: ClassicReason;
   /** Output vertices of the part (a shared joint ring counts for both parts). */
   vertices: number;
+  /** 99th percentile of its vertices' distances over the frames, % of height. */
   p99: number;
+  /** Largest distance, % of height. */
   max: number;
   /** Where the max is: the frame (index into the frames given) and the output vertex. */
   worstFrame: number;
+  /** The output vertex of the largest distance. */
   worstVertex: number;
 }
 
 /** The classic model against the skin it replaces (docs/method.md §9, "classic off-surface"). */
 export interface ClassicOffSurface {
+  /** Frames measured. */
   frames: number;
   /** Over every output vertex and frame, % of height. */
   p99: number;
+  /** Largest distance over every output vertex and frame, % of height. */
   max: number;
   /** Per part, in the order of `deformer.parts`. */
   parts: OffSurfacePart[];
@@ -166,14 +180,19 @@ export interface BandQuality {
   triangles: number;
   /** Smallest interior angle (degrees): the minimum, the 1st percentile and the median over triangles. */
   minAngle: number;
+  /** 1st percentile of the smallest angle, degrees. */
   minAngleP1: number;
+  /** Median of the smallest angle, degrees. */
   minAngleMedian: number;
   /** Triangles with an angle under 5° and under 10°. */
   under5: number;
+  /** Triangles with an angle under 10°. */
   under10: number;
   /** Aspect ratio longest edge × perimeter / (4√3 × area): 1 for an equilateral triangle; max, p99, median. */
   aspectMax: number;
+  /** 99th percentile of the aspect ratio. */
   aspectP99: number;
+  /** Median aspect ratio. */
   aspectMedian: number;
 }
 

@@ -13,7 +13,12 @@ export const CREASE_DEGREES = 20;
  * weldByPosition of `rest`, when the caller has it.
  */
 export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>,
-  weld: ArrayLike<number> = weldByPosition(rest)): { a: Uint32Array; b: Uint32Array } {
+  weld: ArrayLike<number> = weldByPosition(rest)): {
+  /** Per edge, its first triangle. */
+  a: Uint32Array;
+  /** Per edge, its second triangle. */
+  b: Uint32Array;
+} {
   const n = Math.floor(rest.length / 3);
   // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
   const first = new Map<number, number>();
@@ -64,7 +69,12 @@ export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32A
  * of its rest angle a0 is the cosine within [cos(a0 + limit), cos(a0 − limit)] (cos falls on
  * [0, π]), so a frame compares cosines instead of taking an acos per edge.
  */
-export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): { lo: Float64Array; hi: Float64Array } {
+export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): {
+  /** Per edge, the lowest cosine without a crease. */
+  lo: Float64Array;
+  /** Per edge, the highest cosine without a crease. */
+  hi: Float64Array;
+} {
   const limit = degrees * Math.PI / 180;
   const lo = new Float64Array(restCos.length), hi = new Float64Array(restCos.length);
   for (let i = 0; i < restCos.length; i++) {

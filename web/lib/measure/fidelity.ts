@@ -11,6 +11,7 @@ import { dist2, faceNormal, len3 } from './vectors.js';
 
 /** Fidelity of one method over a set of frames (docs/method.md §9). Distances in % of `height`. */
 export interface Fidelity {
+  /** Frames measured. */
   frames: number;
   /** Largest distance of a vertex bound ≥ 0.999 to one joint from S_j·x; null: no such vertex or no source map. */
   rigidError: number | null;
@@ -18,6 +19,7 @@ export interface Fidelity {
   rigidVertices: number;
   /** Distance from the reference DQS over every vertex and frame: 95th percentile and max; null without a source map. */
   dqsP95: number | null;
+  /** Largest distance from the reference DQS; null without a source map. */
   dqsMax: number | null;
   /** Triangles whose normal turned against their rest normal carried by their dominant joint, summed over frames. */
   flipped: number;
@@ -37,6 +39,7 @@ export interface Fidelity {
   seamGap: number;
 }
 
+/** Options of `FidelityProbe` and `classicOffSurface`. */
 export interface FidelityOptions {
   /**
    * The character's height in the units of the deformers' OUTPUT (posed mesh space). Default: the
@@ -52,7 +55,9 @@ export interface FidelityOptions {
  * `measure(deformer)` for each method.
  */
 export class FidelityProbe {
+  /** The height distances are divided by (output units). */
   readonly height: number;
+  /** Vertices of the rig. */
   readonly vertexCount: number;
   private readonly reference: Float32Array[] = [];
   private readonly rigid: Int32Array; // per rig vertex: its joint when bound ≥ 0.999, else -1
@@ -60,6 +65,11 @@ export class FidelityProbe {
   private readonly dominant: Int32Array; // per rig vertex: the joint of largest weight
   private readonly rotations: Float64Array[] = []; // per frame: J × 9 rotations
 
+  /**
+   * @param input The rig, as given to `createRig`.
+   * @param frames Skin matrices per frame (J × 16 each).
+   * @param options The character's height in output units.
+   */
   constructor(readonly input: RigInput, readonly frames: readonly Float32Array[], options: FidelityOptions = {}) {
     const n = Math.floor(input.positions.length / 3);
     this.vertexCount = n;

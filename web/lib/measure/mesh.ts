@@ -55,7 +55,12 @@ export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): numbe
  * or an overlap glued on). A closed manifold mesh has both 0; a closed input deformed into an
  * output with a gap or a torn seam has open > 0.
  */
-export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): { open: number; overused: number } {
+export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): {
+  /** Edges used by one triangle. */
+  open: number;
+  /** Edges used by more than two triangles. */
+  overused: number;
+} {
   const vertexCount = Math.floor(positions.length / 3);
   const pairs = coincidentPairs(positions);
   const weld = new Uint32Array(vertexCount);

@@ -8,15 +8,21 @@ import type { Deformer, Rig } from '../index.js';
  * cross-section model, LBS and DQS.
  */
 export type MethodName = 'gcs' | 'gcs-plain' | 'gcs-y' | 'gcs-axial' | 'classic' | 'lbs' | 'dqs';
+/** Every method the measures know, in the order the tables print them. */
 export const METHODS: MethodName[] = ['gcs', 'gcs-plain', 'gcs-y', 'gcs-axial', 'classic', 'lbs', 'dqs'];
+/** How the tables name each method. */
 export const METHOD_LABELS: Record<MethodName, string> = {
   gcs: 'GCS (weights, default)', 'gcs-plain': 'GCS plain (weights, stepped)', 'gcs-y': 'GCS paper (Y)', 'gcs-axial': 'GCS paper (axial)',
   classic: 'classic', lbs: 'LBS', dqs: 'DQS',
 };
 
+/** Settings of `buildMethod`: the GCS section count and the classic model's density. */
 export interface BuildSettings {
+  /** GCS sections (default 6). */
   sections?: number;
+  /** Classic contours per part (default 25). */
   contours?: number;
+  /** Classic rays per contour (default 20). */
   rays?: number;
 }
 
@@ -34,7 +40,12 @@ export function buildMethod(rig: Rig, method: MethodName, settings: BuildSetting
 }
 
 /** A build failure as data: the GcsError code and message (e.g. a method not in this binary). */
-export function errorInfo(e: unknown): { code: string; message: string } {
+export function errorInfo(e: unknown): {
+  /** The GcsError's code, or 'ERROR' for any other exception. */
+  code: string;
+  /** Its sentence. */
+  message: string;
+} {
   if (e instanceof GcsError) return { code: e.code, message: e.message };
   return { code: 'ERROR', message: e instanceof Error ? e.message : String(e) };
 }

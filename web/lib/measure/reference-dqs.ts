@@ -17,6 +17,12 @@ export interface SplitMatrix {
   dq: Float64Array;
 }
 
+/**
+ * Splits the skin matrix at `offset` into a rotation, a scale and a unit dual quaternion (SplitMatrix).
+ * @param s Skin matrices, 16 column-major numbers each.
+ * @param offset Where the matrix starts in `s`.
+ * @returns Its rotation R, scale K and dual quaternion.
+ */
 export function splitSkinMatrix(s: ArrayLike<number>, offset = 0): SplitMatrix {
   const col = (c: number) => [s[offset + 4 * c], s[offset + 4 * c + 1], s[offset + 4 * c + 2]];
   const cols = [col(0), col(1), col(2)];

@@ -1,4 +1,9 @@
 // Statistics of the measures: median, percentiles (quickselect, no full sort) and the largest value.
+/**
+ * The median (the 50th percentile, nearest rank); NaN for no values.
+ * @param values The numbers (not changed).
+ * @returns Their median.
+ */
 export function median(values: ArrayLike<number>): number {
   return percentile(values, 50);
 }

@@ -2,6 +2,7 @@
 // with other steps (so that they share the machine's state).
 import { median, percentile } from './statistics.js';
 
+/** How long and how often `timeFrames` and `timeInterleaved` time. */
 export interface TimingOptions {
   /** At least this many timed frames (default 200). */
   minSamples?: number;
@@ -19,9 +20,13 @@ export interface TimingOptions {
   repeat?: number | readonly number[];
 }
 
+/** What a timing gives: milliseconds per call. */
 export interface Timing {
+  /** Median time of one call, ms. */
   medianMs: number;
+  /** 95th percentile of one call's time, ms. */
   p95Ms: number;
+  /** Number of timed samples. */
   samples: number;
 }
 
