@@ -21,7 +21,7 @@ import {
   GCS_CLASSIC_DEFAULT_BULGE, GCS_CLASSIC_DEFAULT_CONTOURS, GCS_CLASSIC_DEFAULT_RAYS, GCS_CLASSIC_MAX_BULGE, GCS_CLASSIC_MAX_CONTOURS,
   GCS_CLASSIC_MAX_RAYS, GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_PART_INTS, GCS_DEFAULT_CENTRES, GCS_DEFAULT_CRITERION,
   GCS_DEFAULT_INFLUENCE_WIDTH, GCS_DEFAULT_SECTIONS, GCS_DEFAULT_TWIST_SPREAD, GCS_GPU_TEXELS_PER_JOINT, GCS_GPU_TEXELS_PER_SECTION,
-  GCS_MAX_INFLUENCES, GCS_MAX_INSTANCES, GCS_MAX_SECTIONS, GCS_MIN_SECTIONS, GCS_SECTION_INFO_FLOATS, GCS_SMOOTH_BY_CRITERION,
+  GCS_MAX_INFLUENCES, GCS_MAX_INSTANCES, GCS_MAX_JOINTS, GCS_MAX_SECTIONS, GCS_MIN_SECTIONS, GCS_SECTION_INFO_FLOATS, GCS_SMOOTH_BY_CRITERION,
   GcsClassicPartField, GcsClassicReasonNames, GcsCriterionNames, GcsDeformerKindNames, GcsSectionInfoField, GcsSectionKind,
   GcsSettingsBytes, GcsStat, weightGridSteps as gridSteps, writeGcsSettings,
 } from './boundary.generated.js';
@@ -572,6 +572,8 @@ export class Rig {
 
 /** J identity matrices: the skin matrices of the bind pose (what `deform` takes at rest). */
 export function identitySkin(jointCount: number): Float32Array {
+  if (typeof jointCount !== 'number' || !Number.isInteger(jointCount) || jointCount < 0 || jointCount > GCS_MAX_JOINTS)
+    throw new GcsError('OUT_OF_RANGE', `the joint count must be a whole number between 0 and ${GCS_MAX_JOINTS}; got ${asGiven(jointCount)}`);
   const skin = new Float32Array(jointCount * 16);
   for (let j = 0; j < jointCount; j++) skin[16 * j] = skin[16 * j + 5] = skin[16 * j + 10] = skin[16 * j + 15] = 1;
   return skin;
