@@ -67,8 +67,9 @@ describe.skipIf(!!reason)('crowd mode', () => {
     expect(gpu.bytesPerFrame).toBeGreaterThanOrEqual(24 * gpu.joints * 64);
     expect(gpu.bytesPerFrame).toBeLessThan(24 * gpu.joints * 64 + 2048 * 16);
     expect(gpu.bytesPerFrame / 24).toBeLessThanOrEqual(8 * 1024); // the target
-    // The first readouts: what runs, and "warming up" (the first frames upload whole buffers); steady figures: the GUI's test.
-    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/24 characters .*GPU backend \(joint poses\).*warming up…/);
+    // The first readouts: what runs, and "warming up" (the first frames upload whole buffers) or, once the
+    // page has timed a few frames (within 3 s, however slow they are), its figure; steady figures: the GUI's test.
+    expect(await page.evaluate(() => window.__crowd.readout())).toMatch(/24 characters .*GPU backend \(joint poses\).*(warming up…|skinning CPU [\d.]+ ms\/frame)/);
     // Every character is on screen and moving: pixels of the skin colour, changing between frames.
     const region = { x: 0, y: 0, width: 1280 - 300, height: 720 };
     const a = await page.screenshot();
