@@ -9,6 +9,7 @@ import { beforeAll, describe, expect, test } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
 import { GltfError } from '../../web/lib/gltf/error.js';
+import { ReportError } from '../../packages/cli/src/report.js';
 import { createHuman, type Human } from '../../web/lib/human/index.js';
 
 const root = fileURLToPath(new URL('../../', import.meta.url));
@@ -52,7 +53,7 @@ async function judge(call: string, run: () => unknown): Promise<Outcome | null> 
     if (result && typeof (result as Promise<unknown>).then === 'function') await result;
     return null;
   } catch (e) {
-    const ours = e instanceof GcsError || e instanceof GltfError;
+    const ours = e instanceof GcsError || e instanceof GltfError || e instanceof ReportError;
     if (!ours) {
       const outcome = { call, problem: `threw ${(e as Error)?.name ?? typeof e}: ${(e as Error)?.message ?? String(e)}` };
       if (process.env.HOSTILE_FAILURES) appendFileSync(process.env.HOSTILE_FAILURES, `${call}\t${outcome.problem.slice(0, 120)}\n`);
@@ -94,7 +95,7 @@ const INTERNAL_CONSTRUCTORS = new Set(['GcsSkin', 'Rig', 'Deformer', 'GcsDeforme
  * node pass) and the report's formatting functions. Listed by name so that they fail here the
  * day they are fixed (then this list shrinks); everything else must hold now.
  */
-const NOT_YET = new Set(['gcs-skin/gpu', 'gcs-skin/webgpu', '@gcs-skin/cli/report']);
+const NOT_YET = new Set(['@gcs-skin/cli/report']);
 
 let gcs: GcsSkin;
 let human: Human;
