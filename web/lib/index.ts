@@ -1069,7 +1069,7 @@ export abstract class PoseTexels {
     if (!(deformer instanceof GcsDeformer)) throw new GcsError('INVALID_ARGUMENT', 'section transforms and joint poses need a GCS deformer (rig.buildGcs)');
     if (deformer.disposed) throw new GcsError('DISPOSED', 'the GCS deformer has been disposed');
     if (!Number.isInteger(instanceCount) || instanceCount < 1 || instanceCount > MAX_INSTANCES)
-      throw new GcsError('OUT_OF_RANGE', `the instance count must be a whole number from 1 to ${MAX_INSTANCES}; got ${instanceCount}`);
+      throw new GcsError('OUT_OF_RANGE', `the instance count must be a whole number from 1 to ${MAX_INSTANCES}; got ${asGiven(instanceCount)}`);
     if (!Number.isInteger(maxWidth) || maxWidth < unit)
       throw new GcsError('OUT_OF_RANGE', `maxWidth must be a whole number ≥ ${unit}; got ${maxWidth}`);
     this.instanceCount = instanceCount;

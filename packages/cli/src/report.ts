@@ -9,7 +9,7 @@
 // Progress on stderr when it is a terminal. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
 import { setConsoleFunction } from 'three';
-import { GcsError } from '../../../web/lib/errors.js';
+import { asGiven, GcsError } from '../../../web/lib/errors.js';
 import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
 import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
@@ -25,8 +25,12 @@ export const FRAME_BUDGET = 64;
 export const MIN_FRAMES_PER_CLIP = 8;
 export const DEFAULT_TIME_MS = 1200;
 
-/** Frames sampled per clip when --frames is not given: 60 for one clip, fewer for many. */
+/**
+ * Frames sampled per clip when --frames is not given: 60 for one clip, fewer for many.
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export function defaultFramesPerClip(clipCount: number): number {
+  given(typeof clipCount === 'number' && Number.isInteger(clipCount) && clipCount >= 0, 'defaultFramesPerClip: the clip count must be a whole number ≥ 0', clipCount);
   return Math.max(MIN_FRAMES_PER_CLIP, Math.min(60, Math.round(FRAME_BUDGET / Math.max(1, clipCount))));
 }
 
@@ -131,12 +135,32 @@ export interface Report {
  */
 export class ReportError extends Error {
   readonly code: string;
+  /**
+   * @param message The one line printed on stderr.
+   * @param code A GltfError or GcsError code, NO_SKINNED_MESH, NO_CLIP or USAGE (the default).
+   * @param options `cause`: the error this one reports.
+   * @throws ReportError `USAGE` when the message or the code is not a string or the options not an object.
+   */
   constructor(message: string, code = 'USAGE', options?: { cause?: unknown }) {
+    given(typeof message === 'string', 'ReportError: the message must be a string', message);
+    given(typeof code === 'string' && code !== '', 'ReportError: the code must be a non-empty string', code);
+    given(options === undefined || isRecord(options), 'ReportError: options must be an object', options);
     super(message, options);
     this.name = 'ReportError';
     this.code = code;
   }
 }
+
+/**
+ * The argument checks of this module's functions: a ReportError 'USAGE' saying what `what` must be
+ * and the value as given (asGiven) when `ok` is false.
+ */
+function given(ok: boolean, what: string, value: unknown): void {
+  if (!ok) throw new ReportError(`${what}; got ${asGiven(value)}`, 'USAGE');
+}
+
+/** An object (not null, not an array). */
+const isRecord = (value: unknown): value is Record<string, unknown> => value !== null && typeof value === 'object' && !Array.isArray(value);
 
 /** One printable line: a message's line breaks (engine messages have some) become spaces, other controls escapes. */
 const oneLine = (s: string) => printable(s.replace(/\s*\n\s*/g, ' ').trim());
@@ -144,8 +168,14 @@ const oneLine = (s: string) => printable(s.replace(/\s*\n\s*/g, ' ').trim());
 const round = (x: number, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)) : x);
 const roundOrNull = (x: number | null) => (x === null ? null : round(x));
 
-/** Builds the report of a file (throws ReportError for an unreadable or unskinned file). */
+/**
+ * Builds the report of a file (throws ReportError for an unreadable or unskinned file).
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export async function report(file: string, options: ReportOptions = {}, gcs?: GcsSkin): Promise<Report> {
+  given(typeof file === 'string', 'report: the file must be a path (a string)', file);
+  given(isRecord(options), 'report: options must be an object', options);
+  given(gcs === undefined || isRecord(gcs), 'report: gcs must be a GcsSkin (initGcsSkin) or absent', gcs);
   const sections = options.sections ?? 6;
   const progress = options.onProgress ?? (() => {});
   const model = await readModel(file, progress);
@@ -336,8 +366,12 @@ function roundJoints(m: JointsMeasure): JointsMeasure {
   };
 }
 
-/** How many vertices have more than 4 influences (weights > 0). */
+/**
+ * How many vertices have more than 4 influences (weights > 0).
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export function verticesOverFourInfluences(input: RigInput): number {
+  given(isRecord(input) && (Array.isArray(input.weights) || ArrayBuffer.isView(input.weights)), 'verticesOverFourInfluences: input must be a RigInput (weights an array)', input);
   const K = input.influences ?? 4;
   if (K <= 4) return 0;
   let count = 0;
@@ -349,8 +383,17 @@ export function verticesOverFourInfluences(input: RigInput): number {
   return count;
 }
 
-/** The methods that produced non-finite values, per mesh (empty: none). */
+/** A Report as report() makes it: an object whose file is a string and whose meshes are an array of objects. */
+function checkReport(r: unknown, fn: string): void {
+  given(isRecord(r) && typeof r.file === 'string' && Array.isArray(r.meshes) && r.meshes.every(isRecord), `${fn}: the report must be one report() made`, r);
+}
+
+/**
+ * The methods that produced non-finite values, per mesh (empty: none).
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export function nonFiniteMethods(r: Report): { mesh: string; method: MethodName; count: number }[] {
+  checkReport(r, 'nonFiniteMethods');
   const out: { mesh: string; method: MethodName; count: number }[] = [];
   for (const m of r.meshes)
     for (const name of METHODS) {
@@ -363,8 +406,13 @@ export function nonFiniteMethods(r: Report): { mesh: string; method: MethodName;
 const fmt = (x: number | null | undefined, digits = 3) =>
   x === null || x === undefined ? 'n/a' : Number.isFinite(x) ? (x === 0 ? '0' : Math.abs(x) < 10 ** -digits ? x.toExponential(1) : x.toFixed(digits)) : String(x);
 
-/** `text` cut to `max` columns with an ellipsis when longer. */
+/**
+ * `text` cut to `max` columns with an ellipsis when longer.
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export function shortened(text: string, max: number): string {
+  given(typeof text === 'string', 'shortened: the text must be a string', text);
+  given(typeof max === 'number' && !Number.isNaN(max), 'shortened: max must be a number of columns', max);
   return text.length <= max ? text : `${text.slice(0, Math.max(0, max - 1))}…`;
 }
 
@@ -418,8 +466,12 @@ export const REPORT_COLUMNS = 120;
 /** The narrowest layout: a terminal narrower than this still gets 80 columns. */
 export const MIN_TERMINAL_COLUMNS = 80;
 
-/** The width of the text report on `stream`: REPORT_COLUMNS in a pipe or a file, the terminal's (at least 80) on a terminal. */
+/**
+ * The width of the text report on `stream`: REPORT_COLUMNS in a pipe or a file, the terminal's (at least 80) on a terminal.
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
+ */
 export function reportColumns(stream: { isTTY?: boolean; columns?: number }): number {
+  given(isRecord(stream), 'reportColumns: the stream must be an object', stream);
   return stream.isTTY ? Math.max(MIN_TERMINAL_COLUMNS, stream.columns || MIN_TERMINAL_COLUMNS) : REPORT_COLUMNS;
 }
 
@@ -440,8 +492,11 @@ function rigidJoint(rows: string[][]): boolean {
 /**
  * The human-readable report: a table per mesh within `columns` (default REPORT_COLUMNS; columns
  * left out, and long names shortened with an ellipsis, when narrower); `wide`: every column and the clips.
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
  */
 export function formatReport(r: Report, options: { wide?: boolean; columns?: number } = {}): string {
+  checkReport(r, 'formatReport');
+  given(isRecord(options), 'formatReport: options must be an object', options);
   const wide = options.wide ?? false;
   const columns = wide ? Infinity : Math.max(MIN_TERMINAL_COLUMNS, options.columns ?? REPORT_COLUMNS);
   const out: string[] = [];
@@ -559,8 +614,11 @@ function parseArgs(argv: string[]): { file?: string; json: boolean; wide: boolea
 /**
  * Whether to show progress on `stream`: only on a terminal (a pipe or a file gets the report and
  * nothing else), not a dumb one, and not when GCS_SKIN_PROGRESS=0; GCS_SKIN_PROGRESS=1 forces it.
+ * @throws ReportError `USAGE` when an argument is not of its kind (a string, a number, an object, a report() result where one is expected).
  */
 export function wantsProgress(stream: { isTTY?: boolean }, env: Record<string, string | undefined>): boolean {
+  given(isRecord(stream), 'wantsProgress: the stream must be an object', stream);
+  given(isRecord(env), 'wantsProgress: env must be an object (process.env)', env);
   if (env.GCS_SKIN_PROGRESS === '1') return true;
   if (env.GCS_SKIN_PROGRESS === '0') return false;
   return stream.isTTY === true && env.TERM !== 'dumb';

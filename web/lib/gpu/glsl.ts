@@ -3,7 +3,8 @@
  * material replaced by GCS's (patched through onBeforeCompile, webgl-materials.ts). The same maths
  * as the TSL function (tsl.ts), from the same layout constants (layout.ts); docs/gpu.md.
  */
-import { GcsError } from '../errors.js';
+import { checkString } from '../arguments.js';
+import { asGiven, GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
   GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, type GpuMethod, type GpuPath, type TableSlots,
@@ -283,14 +284,32 @@ void main() {
 
 const tableDefines = (slots: TableSlots): string => `#define GCS_TABLE_SLOTS ${slots}\n#define GCS_TABLE_TEXELS ${tableTexelsPerSection(slots)}\n`;
 
-/** The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots). */
+/** Slots of the section table: 4 or 8 joints per section. */
+function checkSlots(slots: unknown, fn: string): void {
+  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `${fn}: the section table has 4 or 8 joints per section; got ${asGiven(slots)}`);
+}
+
+/**
+ * The variant of a patched shader: path 'joints' | 'sections', method 'gcs' | 'lbs' | 'dqs', slots 4 | 8.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
+ */
+export function checkVariant(path: unknown, method: unknown, slots: unknown, fn: string): void {
+  if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `${fn}: the GPU path must be 'joints' or 'sections'; got ${asGiven(path)}`);
+  if (method !== 'gcs' && method !== 'lbs' && method !== 'dqs') throw new GcsError('INVALID_ARGUMENT', `${fn}: the GPU backend runs 'gcs', 'lbs' or 'dqs'; got ${asGiven(method)}`);
+  checkSlots(slots, fn);
+}
+
+/**
+ * The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
+ */
 export function nodePassShaders(slots: TableSlots): {
   /** GLSL 3 vertex shader: one triangle covering the target. */
   vertexShader: string;
   /** GLSL 3 fragment shader: one fragment per node, writing the rows of [M | T] and the normal texel to the four node textures. */
   fragmentShader: string;
 } {
-  if (slots !== 4 && slots !== 8) throw new GcsError('INVALID_ARGUMENT', `the section table has 4 or 8 joints per section; got ${String(slots)}`);
+  checkSlots(slots, 'nodePassShaders');
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
 }
 
@@ -463,8 +482,11 @@ const HOOKS = ['#include <skinning_pars_vertex>', '#include <skinbase_vertex>', 
  * material compiles `skinbase_vertex` out (MeshBasicMaterial keeps it under
  * `USE_ENVMAP || USE_SKINNING`), the transform is read in `skinning_vertex` instead. Throws GcsError
  * 'INVALID_ARGUMENT' when the shader lacks the chunks (a ShaderMaterial written without them).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
 export function patchVertexShader(source: string, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): string {
+  checkString(source, 'source', 'patchVertexShader');
+  checkVariant(path, method, slots, 'patchVertexShader');
   for (const hook of HOOKS)
     if (!source.includes(hook)) throw new GcsError('INVALID_ARGUMENT', `this vertex shader has no '${hook}': gcs-skin/gpu patches three.js's skinning chunks`);
   if (path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);

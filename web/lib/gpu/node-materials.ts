@@ -5,6 +5,8 @@
  * node (`castShadowPositionNode`), so shadows follow the skin.
  */
 import * as THREE from 'three/webgpu';
+import { checkMaterial } from '../arguments.js';
+import { GcsError } from '../errors.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
 import type { GpuSections } from './sections.js';
 import { TslNodePass } from './node-pass-tsl.js';
@@ -43,8 +45,12 @@ function placeholderUniforms(): Record<string, { value: unknown }> {
 
 type Nodes = { positionNode?: unknown; vertexNode?: unknown; castShadowPositionNode?: unknown };
 
-/** Why `material` cannot run GCS as a node material, or null when it can. */
+/**
+ * Why `material` cannot run GCS as a node material, or null when it can.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
+ */
 export function nodeMaterialSupport(material: THREE.Material): string | null {
+  checkMaterial(material, 'material', 'nodeMaterialSupport');
   const m = material as THREE.Material & { isShaderMaterial?: boolean; isNodeMaterial?: boolean } & Nodes;
   if (m.isShaderMaterial) return `${material.type} is a custom shader: gcs-skin/webgpu runs GCS in node materials (use a built-in or node material)`;
   if (m.isNodeMaterial) {
@@ -56,10 +62,15 @@ export function nodeMaterialSupport(material: THREE.Material): string | null {
   return null;
 }
 
-/** The node equivalent of a built-in material (textures shared), or a clone of a node material. */
+/**
+ * The node equivalent of a built-in material (textures shared), or a clone of a node material.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
+ */
 export function toNodeMaterial(source: THREE.Material): THREE.NodeMaterial {
+  checkMaterial(source, 'source', 'toNodeMaterial');
   if ((source as THREE.NodeMaterial).isNodeMaterial) return (source as THREE.NodeMaterial).clone();
   const Node = NODE_MATERIALS[source.type];
+  if (!Node) throw new GcsError('INVALID_ARGUMENT', `toNodeMaterial: ${nodeMaterialSupport(source) ?? 'this material has no node material equivalent'}`);
   const material = new Node();
   const from = source as unknown as Record<string, unknown>, to = material as unknown as Record<string, unknown>;
   for (const key in source) if (!NOT_CARRIED(key)) to[key] = from[key];

@@ -10,6 +10,7 @@
  * computes it once.
  */
 import * as THREE from 'three';
+import { checkObject } from '../arguments.js';
 import { nodePassShaders } from './glsl.js';
 import { GPU_NODE_TEXTURES } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
@@ -43,8 +44,11 @@ export class NodePass {
 
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
+   * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
   constructor(readonly sections: GpuSections) {
+    checkObject(sections, 'sections', 'NodePass');
+    checkObject(sections.deformer, 'sections.deformer', 'NodePass');
     const deformer = sections.deformer, S = deformer.sectionCount, N = sections.instanceCount;
     const nodes = N * S;
     const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);

@@ -4,6 +4,7 @@
  * table, and the per-vertex section attributes (layout.ts; docs/gpu.md).
  */
 import * as THREE from 'three';
+import { checkMethods, checkObject } from '../arguments.js';
 import { GcsError } from '../errors.js';
 import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
 import { keepLive } from '../three/live-views.js';
@@ -84,8 +85,10 @@ export class GpuSections {
    * @param path 'joints' or 'sections' (default: 'joints' for the weights criterion, else 'sections').
    * @throws GcsError `INVALID_ARGUMENT` for 'joints' on a 'y' or 'axial' model, `OUT_OF_RANGE` for a bad count or width.
    * @param skinning LBS or DQS of each vertex's own joints instead of GCS (the deformer is then kept for its joint poses only, and freed with this).
+   * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
   constructor(readonly deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, path?: GpuPath, skinning?: SkinningOptions) {
+    checkObject(deformer, 'deformer', 'GpuSections');
     if (path !== undefined && path !== 'joints' && path !== 'sections') throw new GcsError('INVALID_ARGUMENT', `the GPU path must be 'joints' or 'sections'; got '${String(path)}'`);
     this.method = skinning?.method ?? 'gcs';
     this.ownsDeformer = skinning !== undefined;
@@ -219,8 +222,10 @@ export interface SectionAttribute {
  * Static per-vertex section data of a GCS deformer's output mesh, as float attributes:
  * `gcsSection` (plain mode), or `gcsBlend` = (section, other section, factor) and `gcsBlendThird`
  * = (third section, factor) (smooth mode).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
 export function sectionAttributes(deformer: GcsDeformer): SectionAttribute[] {
+  checkMethods(deformer, 'deformer', 'sectionAttributes', ['sectionOfVertex', 'blendOther', 'blendFactor', 'blendThird', 'blendThirdFactor']);
   const section = deformer.sectionOfVertex();
   const other = deformer.blendOther(), factor = deformer.blendFactor();
   const third = deformer.blendThird(), thirdFactor = deformer.blendThirdFactor();

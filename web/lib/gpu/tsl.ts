@@ -24,6 +24,7 @@ import {
 } from './layout.js';
 import { column, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
+import { checkObject } from '../arguments.js';
 
 type Bool = Node<'bool'>;
 type Int = Node<'int'>;
@@ -293,8 +294,12 @@ function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: In
  * Velocity (a render pass whose MRT has `velocity`): `positionPrevious` gets the same vertex under
  * the previous frame's texels (GpuSections.previousTexture), as three.js's skinning does with its
  * previous bone matrices; a crowd places it with the current instance matrix.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
 export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass: TslNodePass | null = null): Node<'vec3'> {
+  checkObject(sections, 'sections', 'gcsPositionNode');
+  checkObject(sections.uniforms, 'sections.uniforms', 'gcsPositionNode');
+  if (pass !== null) checkObject(pass, 'pass', 'gcsPositionNode');
   const perFrame = texture(sections.texture);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);

@@ -4,14 +4,19 @@
  */
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
-import { patchVertexShader } from './glsl.js';
+import { checkMaterial, checkObject } from '../arguments.js';
+import { checkVariant, patchVertexShader } from './glsl.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
 import type { GpuMethod, GpuPath, TableSlots } from './layout.js';
 import { NodePass } from './node-pass.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
-/** Why a material cannot draw a GCS mesh on the GPU, or null when it can. */
+/**
+ * Why a material cannot draw a GCS mesh on the GPU, or null when it can.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
+ */
 export function gpuMaterialSupport(material: THREE.Material): string | null {
+  checkMaterial(material, 'material', 'gpuMaterialSupport');
   const m = material as THREE.Material & { isShaderMaterial?: boolean; isNodeMaterial?: boolean };
   if (m.isNodeMaterial) return `${material.type} is a node material (WebGPU / TSL): gcs-skin/three patches WebGLRenderer's GLSL materials; gcs-skin/webgpu runs GCS in node materials`;
   if (m.isShaderMaterial) return `${material.type} is a custom shader: the GPU backend patches three.js's built-in materials`;
@@ -23,8 +28,12 @@ export function gpuMaterialSupport(material: THREE.Material): string | null {
  * read from `uniforms`: path 'sections', GpuSections.uniforms; path 'joints', the node pass's
  * (NodePass.uniforms: each node's transform, computed once per frame from the joint poses). The
  * source's own onBeforeCompile, if any, runs first.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
 export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): M {
+  checkMaterial(source, 'source', 'gcsMaterial');
+  checkObject(uniforms, 'uniforms', 'gcsMaterial');
+  checkVariant(path, method, slots, 'gcsMaterial');
   const reason = gpuMaterialSupport(source);
   if (reason) throw new GcsError('INVALID_ARGUMENT', reason);
   const material = source.clone() as M;
@@ -45,6 +54,7 @@ export function gcsMaterial<M extends THREE.Material>(source: M, uniforms: GcsUn
 /**
  * Shadow materials for a GCS mesh: depth (directional and spot lights) and distance (point
  * lights), patched the same way; alpha-tested maps carried so cut-outs cast the right shadow.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
 export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms, smooth: boolean, path: GpuPath = 'sections', method: GpuMethod = 'gcs', slots: TableSlots = 4): {
   /** For directional and spot lights' shadows (`customDepthMaterial`). */
@@ -52,6 +62,9 @@ export function gcsShadowMaterials(source: THREE.Material, uniforms: GcsUniforms
   /** For point lights' shadows (`customDistanceMaterial`). */
   distance: THREE.MeshDistanceMaterial;
 } {
+  checkMaterial(source, 'source', 'gcsShadowMaterials');
+  checkObject(uniforms, 'uniforms', 'gcsShadowMaterials');
+  checkVariant(path, method, slots, 'gcsShadowMaterials');
   const depth = new THREE.MeshDepthMaterial({ depthPacking: THREE.RGBADepthPacking });
   const distance = new THREE.MeshDistanceMaterial();
   const s = source as THREE.Material & { map?: THREE.Texture | null; alphaMap?: THREE.Texture | null };

@@ -7,6 +7,7 @@ import type { FidelityOptions } from './fidelity.js';
 import { boundsHeight, meshBorder } from './mesh.js';
 import { referenceDqs } from './reference-dqs.js';
 import { maxOf, percentile } from './statistics.js';
+import { checkList, checkMethods, checkNumberFields, checkObject, checkOptionsObject, checkRigInput } from '../arguments.js';
 
 /** What the classic model makes of a rig at one setting (the paper's Fig. 5 comparison). */
 export interface ClassicFigures {
@@ -32,8 +33,12 @@ export interface ClassicFigures {
   points: Map<number, number>;
 }
 
-/** Builds the classic model at one setting and measures it (disposes it). */
+/**
+ * Builds the classic model at one setting and measures it (disposes it).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function classicFigures(rig: Rig, contours: number, rays: number): ClassicFigures {
+  checkMethods(rig, 'rig', 'classicFigures', ['buildClassic']);
   const d = rig.buildClassic({ contours, rays });
   try {
     const parts = d.parts;
@@ -53,8 +58,10 @@ export function classicFigures(rig: Rig, contours: number, rays: number): Classi
  * The classic model at the vertex budget of GCS (which keeps every input vertex): the square
  * setting (contours = rays = s) whose output vertex count is closest to the rig's, by bisection
  * over s in [3, 256] (output size grows with s).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function classicAtBudget(rig: Rig): ClassicFigures {
+  checkMethods(rig, 'rig', 'classicAtBudget', ['buildClassic']);
   let lo = 3, hi = 256;
   const size = (s: number) => {
     const d = rig.buildClassic({ contours: s, rays: s });
@@ -109,9 +116,14 @@ export interface ClassicOffSurface {
  * each), in % of `options.height` (default: the rig's bind-pose height): what resampling loses
  * (detail, bulge at the deformer's current setting) and anything that stands off the skin (flaps,
  * cuts, carried parts that do not follow it). Leaves the deformer in the last frame's pose.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function classicOffSurface(input: RigInput, deformer: ClassicDeformer, frames: readonly Float32Array[],
                                   options: FidelityOptions = {}): ClassicOffSurface {
+  checkRigInput(input, 'input', 'classicOffSurface');
+  checkObject(deformer, 'deformer', 'classicOffSurface');
+  checkList(frames, 'frames', 'classicOffSurface');
+  checkOptionsObject(options, 'options', 'classicOffSurface');
   const height = options.height ?? boundsHeight(input.positions);
   const nOut = deformer.vertexCount;
   const parts = deformer.parts;
@@ -161,8 +173,10 @@ export function classicOffSurface(input: RigInput, deformer: ClassicDeformer, fr
  * A rig of rigid parts made from a skinned one (like Mixamo's X Bot): every vertex bound with
  * weight 1 to its dominant joint (the first of equal largest weights). The classic model's
  * decisions must hold on such a rig too: its skin tears at every joint instead of blending.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function rigidRebind(input: RigInput): RigInput {
+  checkRigInput(input, 'input', 'rigidRebind');
   const n = Math.floor(input.positions.length / 3), k = input.influences ?? 4;
   const joints = new Uint32Array(4 * n), weights = new Float32Array(4 * n);
   for (let v = 0; v < n; v++) {
@@ -203,8 +217,11 @@ export interface BandQuality {
  * nor a carried triangle of `input` (every corner a copied input vertex, and the three of them one
  * of the input's triangles): it joins a ring to carried skin, touches a band's own vertices, or
  * runs along a loop.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function classicBandQuality(deformer: ClassicDeformer, input: Pick<RigInput, 'indices'>): BandQuality {
+  checkNumberFields(deformer, 'deformer', 'classicBandQuality', ['indices', 'positions']);
+  checkNumberFields(input, 'input', 'classicBandQuality', ['indices']);
   const I = deformer.indices, X = deformer.positions, ring = deformer.contourOfVertex, source = deformer.sourceOfVertex;
   const key = (a: number, b: number, c: number) => [a, b, c].sort((x, y) => x - y).join();
   const carried = new Set<string>();

@@ -2,6 +2,7 @@
 // CREASE_DEGREES from the rest pose.
 import { weldByPosition } from './mesh.js';
 import { len3 } from './vectors.js';
+import { checkFinite, checkNumberFields, checkNumbers } from '../arguments.js';
 
 /** The crease threshold of docs/method.md §9: a dihedral angle change of more than 20°. */
 export const CREASE_DEGREES = 20;
@@ -11,6 +12,7 @@ export const CREASE_DEGREES = 20;
  * one rest position are welded (so UV seams are not borders). `a`/`b` are the two triangles.
  * Edges of three or more triangles (non-manifold) and border edges are left out. `weld`: the
  * weldByPosition of `rest`, when the caller has it.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number>,
   weld: ArrayLike<number> = weldByPosition(rest)): {
@@ -19,6 +21,9 @@ export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number
   /** Per edge, its second triangle. */
   b: Uint32Array;
 } {
+  checkNumbers(rest, 'rest', 'interiorEdges');
+  checkNumbers(indices, 'indices', 'interiorEdges');
+  checkNumbers(weld, 'weld', 'interiorEdges');
   const n = Math.floor(rest.length / 3);
   // Edge key → first triangle, or -1 once a third triangle uses it; second triangle beside it.
   const first = new Map<number, number>();
@@ -41,8 +46,13 @@ export function interiorEdges(rest: ArrayLike<number>, indices: ArrayLike<number
   return { a, b };
 }
 
-/** cos of the angle between the two face normals of each edge; NaN where a face is degenerate. */
+/**
+ * cos of the angle between the two face normals of each edge; NaN where a face is degenerate.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function dihedralCosines(faceNormals: ArrayLike<number>, edges: { a: Uint32Array; b: Uint32Array }): Float64Array {
+  checkNumbers(faceNormals, 'faceNormals', 'dihedralCosines');
+  checkNumberFields(edges, 'edges', 'dihedralCosines', ['a', 'b']);
   const out = new Float64Array(edges.a.length);
   for (let i = 0; i < out.length; i++) out[i] = normalCos(faceNormals, edges.a[i], edges.b[i]);
   return out;
@@ -52,9 +62,13 @@ export function dihedralCosines(faceNormals: ArrayLike<number>, edges: { a: Uint
  * Interior edges whose dihedral angle differs from its rest value by more than CREASE_DEGREES.
  * Edges degenerate at rest are skipped; a face that collapses in the pose (or a non-finite one)
  * counts as a crease.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32Array; b: Uint32Array },
   restCos: Float64Array, degrees = CREASE_DEGREES, bands = creaseBands(restCos, degrees)): number {
+  checkNumbers(faceNormals, 'faceNormals', 'countCreases');
+  checkNumberFields(edges, 'edges', 'countCreases', ['a', 'b']);
+  checkNumberFields(bands, 'bands', 'countCreases', ['lo', 'hi']);
   let count = 0;
   for (let i = 0; i < restCos.length; i++) {
     if (Number.isNaN(restCos[i])) continue;
@@ -68,6 +82,7 @@ export function countCreases(faceNormals: ArrayLike<number>, edges: { a: Uint32A
  * Per edge, the cosines its posed dihedral may take without a crease: the angle within `degrees`
  * of its rest angle a0 is the cosine within [cos(a0 + limit), cos(a0 − limit)] (cos falls on
  * [0, π]), so a frame compares cosines instead of taking an acos per edge.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): {
   /** Per edge, the lowest cosine without a crease. */
@@ -75,6 +90,8 @@ export function creaseBands(restCos: Float64Array, degrees = CREASE_DEGREES): {
   /** Per edge, the highest cosine without a crease. */
   hi: Float64Array;
 } {
+  checkNumbers(restCos, 'restCos', 'creaseBands');
+  checkFinite(degrees, 'degrees', 'creaseBands');
   const limit = degrees * Math.PI / 180;
   const lo = new Float64Array(restCos.length), hi = new Float64Array(restCos.length);
   for (let i = 0; i < restCos.length; i++) {

@@ -8,6 +8,7 @@ import { boundsHeight, coincidentPairs, countNonFinite, seamGap } from './mesh.j
 import { referenceDqs, splitSkinMatrix } from './reference-dqs.js';
 import { maxOf, percentile } from './statistics.js';
 import { dist2, faceNormal, len3 } from './vectors.js';
+import { checkOptionsObject, checkRigInput } from '../arguments.js';
 
 /** Fidelity of one method over a set of frames (docs/method.md §9). Distances in % of `height`. */
 export interface Fidelity {
@@ -69,8 +70,11 @@ export class FidelityProbe {
    * @param input The rig, as given to `createRig`.
    * @param frames Skin matrices per frame (J × 16 each).
    * @param options The character's height in output units.
+   * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
    */
   constructor(readonly input: RigInput, readonly frames: readonly Float32Array[], options: FidelityOptions = {}) {
+    checkRigInput(input, 'input', 'FidelityProbe');
+    checkOptionsObject(options, 'options', 'FidelityProbe');
     const n = Math.floor(input.positions.length / 3);
     this.vertexCount = n;
     this.height = options.height ?? boundsHeight(input.positions);

@@ -12,6 +12,7 @@
  * where the feet point (the skin of the foot lies ahead of the ankle).
  */
 import type { RigInput } from '../index.js';
+import { checkList, checkRigInput } from '../arguments.js';
 
 /** A point or vector: x, y, z. */
 export type Vec3 = [number, number, number];
@@ -89,8 +90,11 @@ interface Skeleton {
  * @param input The rig (joint centres come from its inverse bind matrices and skin).
  * @param names Joint names, used only in the labels.
  * @returns The hinges found, the body frame, and notes on what was not found or guessed.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function findHinges(input: RigInput, names?: readonly (string | undefined)[]): HingeSearch {
+  checkRigInput(input, 'input', 'findHinges');
+  if (names !== undefined) checkList(names, 'names', 'findHinges');
   const notes: string[] = [];
   const skeleton = skeletonOf(input);
   const limbs = limbPairs(skeleton, mirroredPairs(skeleton));
@@ -317,8 +321,12 @@ function mirrorError(a: Limb, b: Limb, centres: Vec3[]): number {
   return length > 0 ? worst / length : Infinity;
 }
 
-/** Bind-pose centre of every joint (mesh space): the translation of its inverse bind matrix's inverse. */
+/**
+ * Bind-pose centre of every joint (mesh space): the translation of its inverse bind matrix's inverse.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function jointCentres(input: RigInput): Vec3[] {
+  checkRigInput(input, 'input', 'jointCentres');
   const J = input.parents.length;
   const M = input.inverseBindMatrices;
   const out: Vec3[] = [];
@@ -332,8 +340,12 @@ export function jointCentres(input: RigInput): Vec3[] {
   return out;
 }
 
-/** The joint of largest weight of each vertex. */
+/**
+ * The joint of largest weight of each vertex.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function dominantJoints(input: RigInput): Int32Array {
+  checkRigInput(input, 'input', 'dominantJoints');
   const K = input.influences ?? 4;
   const n = Math.floor(input.positions.length / 3);
   const out = new Int32Array(n).fill(-1);

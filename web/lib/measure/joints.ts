@@ -12,7 +12,7 @@
  * Any deformer can be measured: a method is a name and a build function (JointMethod).
  */
 import type { ClassicDeformer, Deformer, Rig, RigInput } from '../index.js';
-import { GcsError } from '../errors.js';
+import { asGiven, GcsError } from '../errors.js';
 import { identitySkin } from '../index.js';
 import { countCreases, dihedralCosines, interiorEdges } from './creases.js';
 import { boundsHeight, weldByPosition } from './mesh.js';
@@ -20,6 +20,7 @@ import { METHOD_LABELS, buildMethod, errorInfo, type BuildSettings, type MethodN
 import { maxOf, percentile } from './statistics.js';
 import { findHinges, jointCentres, type BodyFrame, type Hinge, type Vec3 } from './hinges.js';
 import { intersectingPairs } from './self-intersection.js';
+import { checkFinite, checkList, checkNumberFields, checkNumbers, checkObject, checkOptionsObject, checkRigInput } from '../arguments.js';
 
 /** The bends measured unless told otherwise, degrees. */
 export const JOINT_ANGLES: readonly number[] = [45, 90, 135];
@@ -79,8 +80,14 @@ export const CENTRES_METHOD = (settings: BuildSettings = {}): JointMethod => ({
 /**
  * Skin matrices (J × 16) of the bind pose with `hinge.joint` and everything below it turned by
  * `degrees` about the hinge axis through the joint centre.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function bendSkin(parents: ArrayLike<number>, hinge: Hinge, degrees: number, out?: Float32Array): Float32Array {
+  checkNumbers(parents, 'parents', 'bendSkin');
+  checkNumberFields(hinge, 'hinge', 'bendSkin', ['centre', 'axis']);
+  checkFinite(degrees, 'degrees', 'bendSkin');
+  if (out !== undefined && !(out instanceof Float32Array && out.length >= 16 * parents.length))
+    throw new GcsError('INVALID_ARGUMENT', `bendSkin: out must be a Float32Array of 16 × ${parents.length} numbers; got ${asGiven(out)}`);
   const J = parents.length;
   const skin = out ?? new Float32Array(16 * J);
   skin.set(identitySkin(J));
@@ -261,8 +268,12 @@ export class JointProbe {
    * @param hinge The joint to bend and its axis (from `findHinges`).
    * @param angles Bend angles in degrees (default JOINT_ANGLES).
    * @throws GcsError `INVALID_ARGUMENT` when an angle is not a finite number.
+   * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
    */
   constructor(readonly input: RigInput, readonly hinge: Hinge, angles: readonly number[] = JOINT_ANGLES) {
+    checkRigInput(input, 'input', 'JointProbe');
+    checkObject(hinge, 'hinge', 'JointProbe');
+    checkList(angles, 'angles', 'JointProbe');
     const J = input.parents.length;
     if (!(hinge.joint >= 0 && hinge.joint < J && hinge.parent >= 0 && hinge.parent < J))
       throw new GcsError('INVALID_ARGUMENT', `the hinge's joint ${hinge.joint} and parent ${hinge.parent} must be joints of the rig (0 … ${J - 1})`);
@@ -418,8 +429,15 @@ export interface JointsOptions {
   hinges?: readonly Hinge[];
 }
 
-/** Finds the knees and elbows of `input` (the rig's input) and measures every method at each. */
+/**
+ * Finds the knees and elbows of `input` (the rig's input) and measures every method at each.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function measureJoints(rig: Rig, input: RigInput, options: JointsOptions = {}): JointsMeasure {
+  checkObject(rig, 'rig', 'measureJoints');
+  checkRigInput(input, 'input', 'measureJoints');
+  checkOptionsObject(options, 'options', 'measureJoints');
+  for (const key of ['hinges', 'angles', 'methods'] as const) if (options[key] !== undefined) checkList(options[key], `options.${key}`, 'measureJoints');
   const search = options.hinges ? { hinges: [...options.hinges], frame: null, notes: [] } : findHinges(input, options.names);
   const angles = [...(options.angles ?? JOINT_ANGLES)];
   const methods = options.methods ?? jointMethods();
@@ -477,8 +495,12 @@ function minOf(a: Float64Array): number {
  * A compact table of a JointsMeasure (header first; fits 120 columns with two spaces between
  * columns): per joint and method the volume change at every angle, and at `degrees` (default the
  * largest angle) bulge p95 / max, collapse p5 / min, creases and new self-intersecting pairs.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
-export function jointTableRows(m: JointsMeasure, degrees = Math.max(...m.angles)): string[][] {
+export function jointTableRows(m: JointsMeasure, degrees?: number): string[][] {
+  checkObject(m, 'm', 'jointTableRows');
+  checkList(m.angles, 'm.angles', 'jointTableRows');
+  if (degrees === undefined) degrees = Math.max(...m.angles);
   const at = m.angles.indexOf(degrees);
   const f2 = (x: number) => (Number.isFinite(x) ? x.toFixed(2) : String(x));
   const f1 = (x: number) => (Number.isFinite(x) ? (Math.abs(x) < 0.05 ? 0 : x).toFixed(1) : String(x));

@@ -1,9 +1,14 @@
 // Small measures of a deformer's output mesh: non-finite values, vertices welded at rest and the gap
 // a seam opens, the mesh's border, the rest pose in the output order and its error, the bounds.
 import { identitySkin, type Deformer } from '../index.js';
+import { checkMethods, checkNumbers } from '../arguments.js';
 
-/** Number of NaN or infinite values in the given arrays. */
+/**
+ * Number of NaN or infinite values in the given arrays.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function countNonFinite(...arrays: ArrayLike<number>[]): number {
+  for (let k = 0; k < arrays.length; k++) checkNumbers(arrays[k], `array ${k}`, 'countNonFinite');
   let bad = 0;
   for (const a of arrays) for (let i = 0; i < a.length; i++) if (!Number.isFinite(a[i])) bad++;
   return bad;
@@ -12,16 +17,22 @@ export function countNonFinite(...arrays: ArrayLike<number>[]): number {
 /**
  * Groups of output vertices that coincide at rest (glTF splits vertices along UV and normal
  * seams): pairs [first of group, other member], flattened. `rest` is xyz per output vertex.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function coincidentPairs(rest: ArrayLike<number>): Uint32Array {
+  checkNumbers(rest, 'rest', 'coincidentPairs');
   const weld = weldByPosition(rest);
   const pairs: number[] = [];
   for (let v = 0; v < weld.length; v++) if (weld[v] !== v) pairs.push(weld[v], v);
   return Uint32Array.from(pairs);
 }
 
-/** For each vertex, the first vertex at exactly its rest position (itself when none comes before). */
+/**
+ * For each vertex, the first vertex at exactly its rest position (itself when none comes before).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function weldByPosition(rest: ArrayLike<number>): Uint32Array {
+  checkNumbers(rest, 'rest', 'weldByPosition');
   const n = Math.floor(rest.length / 3);
   const f = new Float32Array(3);
   const u = new Uint32Array(f.buffer);
@@ -37,8 +48,13 @@ export function weldByPosition(rest: ArrayLike<number>): Uint32Array {
   return weld;
 }
 
-/** Largest distance between vertices that coincide at rest (0 = no seam opens). NaN counts as infinite. */
+/**
+ * Largest distance between vertices that coincide at rest (0 = no seam opens). NaN counts as infinite.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): number {
+  checkNumbers(positions, 'positions', 'seamGap');
+  checkNumbers(pairs, 'pairs', 'seamGap');
   let gap = 0;
   for (let i = 0; i < pairs.length; i += 2) {
     const a = 3 * pairs[i], b = 3 * pairs[i + 1];
@@ -54,6 +70,7 @@ export function seamGap(positions: ArrayLike<number>, pairs: Uint32Array): numbe
  * (coincidentPairs): `open` edges used by one triangle, `overused` edges by more than two (a fold
  * or an overlap glued on). A closed manifold mesh has both 0; a closed input deformed into an
  * output with a gap or a torn seam has open > 0.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<number>): {
   /** Edges used by one triangle. */
@@ -61,6 +78,8 @@ export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<numb
   /** Edges used by more than two triangles. */
   overused: number;
 } {
+  checkNumbers(positions, 'positions', 'meshBorder');
+  checkNumbers(indices, 'indices', 'meshBorder');
   const vertexCount = Math.floor(positions.length / 3);
   const pairs = coincidentPairs(positions);
   const weld = new Uint32Array(vertexCount);
@@ -85,8 +104,11 @@ export function meshBorder(positions: ArrayLike<number>, indices: ArrayLike<numb
 /**
  * The rest positions of a deformer's output vertices: the rig's bind-pose positions of their
  * source vertices where the deformer has them, else the output of a bind-pose deform.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function restOfOutput(deformer: Deformer, rigPositions: ArrayLike<number>): Float32Array {
+  checkMethods(deformer, 'deformer', 'restOfOutput', ['deform']);
+  checkNumbers(rigPositions, 'rigPositions', 'restOfOutput');
   const source = deformer.sourceVertex;
   const nRig = Math.floor(rigPositions.length / 3);
   deformer.deform(identitySkin(deformer.jointCount));
@@ -104,8 +126,11 @@ export function restOfOutput(deformer: Deformer, rigPositions: ArrayLike<number>
  * Rest error: the largest distance, over output vertices that come from a rig vertex, between the
  * bind-pose deform and that vertex's original position. null when no output vertex has a source
  * (a resampled model: see the classic detail loss instead).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function restError(deformer: Deformer, rigPositions: ArrayLike<number>): number | null {
+  checkMethods(deformer, 'deformer', 'restError', ['deform']);
+  checkNumbers(rigPositions, 'rigPositions', 'restError');
   const source = deformer.sourceVertex;
   if (!source) return null;
   const nRig = Math.floor(rigPositions.length / 3);
@@ -123,8 +148,12 @@ export function restError(deformer: Deformer, rigPositions: ArrayLike<number>): 
   return any ? err : null;
 }
 
-/** Largest extent of the bounding box of xyz positions. */
+/**
+ * Largest extent of the bounding box of xyz positions.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
+ */
 export function boundsHeight(positions: ArrayLike<number>): number {
+  checkNumbers(positions, 'positions', 'boundsHeight');
   const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   for (let i = 0; i + 2 < positions.length; i += 3)
     for (let c = 0; c < 3; c++) { lo[c] = Math.min(lo[c], positions[i + c]); hi[c] = Math.max(hi[c], positions[i + c]); }

@@ -1,5 +1,5 @@
 // The methods the report, metrics and tests compare, built by name, and a build failure as data.
-import { GcsError } from '../errors.js';
+import { asGiven, GcsError } from '../errors.js';
 import type { Deformer, Rig } from '../index.js';
 
 /**
@@ -47,5 +47,8 @@ export function errorInfo(e: unknown): {
   message: string;
 } {
   if (e instanceof GcsError) return { code: e.code, message: e.message };
-  return { code: 'ERROR', message: e instanceof Error ? e.message : String(e) };
+  if (e instanceof Error) return { code: 'ERROR', message: e.message };
+  let message: string;
+  try { message = String(e); } catch { message = asGiven(e); } // an object whose toString or toPrimitive throws
+  return { code: 'ERROR', message };
 }

@@ -1,6 +1,7 @@
 // A reference dual-quaternion skinning in double precision, computed here in JavaScript
 // (independently of the core): what FidelityProbe measures every method against.
 import type { RigInput } from '../index.js';
+import { checkCount, checkNumbers, checkRigInput } from '../arguments.js';
 
 /**
  * A skin matrix split as S = [R·K | t] in double precision: R a rotation (Gram–Schmidt on the
@@ -22,8 +23,11 @@ export interface SplitMatrix {
  * @param s Skin matrices, 16 column-major numbers each.
  * @param offset Where the matrix starts in `s`.
  * @returns Its rotation R, scale K and dual quaternion.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a count that is not a whole number, a callback that is not a function, options that are not a plain object); `OUT_OF_RANGE` for a count out of its bounds.
  */
 export function splitSkinMatrix(s: ArrayLike<number>, offset = 0): SplitMatrix {
+  checkNumbers(s, 's', 'splitSkinMatrix');
+  checkCount(offset, 'offset', 'splitSkinMatrix', 2 ** 32);
   const col = (c: number) => [s[offset + 4 * c], s[offset + 4 * c + 1], s[offset + 4 * c + 2]];
   const cols = [col(0), col(1), col(2)];
   const len = cols.map((v) => Math.hypot(v[0], v[1], v[2]));
@@ -94,8 +98,12 @@ function quatFromRotation(r: Float64Array): number[] {
  * Scale-aware dual-quaternion skinning of a rig's bind-pose positions (docs/method.md §7): per vertex,
  * the normalised blend of its joints' dual quaternions (in the first influence's hemisphere) moves
  * K·x, K the blend of the joints' scale parts. Writes vertexCount × 3 positions into `out`.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function referenceDqs(input: RigInput, skin: ArrayLike<number>, out: Float64Array | Float32Array): void {
+  checkRigInput(input, 'input', 'referenceDqs');
+  checkNumbers(skin, 'skin', 'referenceDqs');
+  checkNumbers(out, 'out', 'referenceDqs');
   const J = input.parents.length;
   const split: SplitMatrix[] = [];
   for (let j = 0; j < J; j++) split.push(splitSkinMatrix(skin, 16 * j));

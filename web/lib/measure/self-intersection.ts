@@ -1,3 +1,4 @@
+import { checkNumbers } from '../arguments.js';
 /**
  * Pairs of triangles of a mesh that pass through each other: the skin of a bent joint folding into
  * itself. Triangles are binned in a uniform grid by their bounding boxes, and only pairs that share
@@ -10,8 +11,12 @@
  * The crossing pairs, as keys a · T + b (a < b, T = the triangle count), sorted. `weld[v]`: one id
  * for every vertex at one rest position (measure's weldByPosition), so that triangles on either
  * side of a UV seam count as neighbours.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (numbers that are not an array or a typed array, a record that is not an object, a missing method, a number that is not finite).
  */
 export function intersectingPairs(positions: ArrayLike<number>, indices: ArrayLike<number>, weld: ArrayLike<number>): Float64Array {
+  checkNumbers(positions, 'positions', 'intersectingPairs');
+  checkNumbers(indices, 'indices', 'intersectingPairs');
+  checkNumbers(weld, 'weld', 'intersectingPairs');
   const T = Math.floor(indices.length / 3);
   const box = new Float64Array(6 * T);
   const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];

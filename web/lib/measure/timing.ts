@@ -1,6 +1,24 @@
 // Timing a per-frame step: median and p95 milliseconds over enough samples, alone or interleaved
 // with other steps (so that they share the machine's state).
 import { median, percentile } from './statistics.js';
+import { checkCount, checkFunction, checkList, checkOptionsObject } from '../arguments.js';
+import { asGiven, GcsError } from '../errors.js';
+
+/** The most frames a timing cycles over, and the most samples or warm-up calls it is asked for. */
+const MAX_FRAME_COUNT = 2 ** 30;
+
+/** TimingOptions as given: a plain object, whole counts, durations that are numbers ≥ 0 (Infinity: no limit). */
+function checkTimingOptions(options: unknown, fn: string): void {
+  checkOptionsObject(options, 'options', fn);
+  const o = options as TimingOptions;
+  if (o.minSamples !== undefined) checkCount(o.minSamples, 'options.minSamples', fn, MAX_FRAME_COUNT);
+  if (o.warmup !== undefined) checkCount(o.warmup, 'options.warmup', fn, MAX_FRAME_COUNT);
+  for (const key of ['minMs', 'maxMs'] as const) {
+    const v = o[key];
+    if (v !== undefined && !(typeof v === 'number' && v >= 0))
+      throw new GcsError('INVALID_ARGUMENT', `${fn}: options.${key} must be a number of milliseconds ≥ 0; got ${asGiven(v)}`);
+  }
+}
 
 /** How long and how often `timeFrames` and `timeInterleaved` time. */
 export interface TimingOptions {
@@ -33,8 +51,12 @@ export interface Timing {
 /**
  * Times `step(frameIndex)` once per frame, cycling over `frameCount` frames: the inputs are
  * precomputed by the caller so only the step itself is timed. Returns median and p95 in ms.
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a count that is not a whole number, a callback that is not a function, options that are not a plain object); `OUT_OF_RANGE` for a count out of its bounds.
  */
 export function timeFrames(frameCount: number, step: (frame: number) => void, options: TimingOptions = {}): Timing {
+  checkCount(frameCount, 'frameCount', 'timeFrames', MAX_FRAME_COUNT, 1);
+  checkFunction(step, 'step', 'timeFrames');
+  checkTimingOptions(options, 'timeFrames');
   const minSamples = options.minSamples ?? 200;
   const minMs = options.minMs ?? 150;
   const maxMs = options.maxMs ?? 3000;
@@ -58,8 +80,13 @@ export function timeFrames(frameCount: number, step: (frame: number) => void, op
  * the machine does lands on all of them alike: their ratios hold on a shared, noisy host where
  * timings taken one after the other do not. Each step cycles over `frameCount` frames, every step
  * on the same frames in a round. Returns one Timing per step (ms per call).
+ * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a count that is not a whole number, a callback that is not a function, options that are not a plain object); `OUT_OF_RANGE` for a count out of its bounds.
  */
 export function timeInterleaved(frameCount: number, steps: ((frame: number) => void)[], options: TimingOptions = {}): Timing[] {
+  checkCount(frameCount, 'frameCount', 'timeInterleaved', MAX_FRAME_COUNT, 1);
+  checkList(steps, 'steps', 'timeInterleaved');
+  for (let k = 0; k < steps.length; k++) checkFunction(steps[k], `steps[${k}]`, 'timeInterleaved');
+  checkTimingOptions(options, 'timeInterleaved');
   const minSamples = options.minSamples ?? 200;
   const minMs = options.minMs ?? 150;
   const maxMs = options.maxMs ?? 3000;
