@@ -10,8 +10,8 @@
  * computes it once.
  */
 import * as THREE from 'three';
-import { nodePassShaders } from './glsl.js';
-import { GPU_NODE_TEXTURES } from './layout.js';
+import { dqsPassShaders, nodePassShaders } from './glsl.js';
+import { GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** The widest row of the node textures: WebGL2's guaranteed 2048. */
@@ -45,7 +45,10 @@ export class NodePass {
    * @param sections The GPU sections whose joint poses and section table the pass reads.
    */
   constructor(readonly sections: GpuSections) {
-    const deformer = sections.deformer, S = deformer.sectionCount, N = sections.instanceCount;
+    // DQS: one "node" per joint (the joint pass: its quaternion and [K | t]); GCS: per section.
+    const dqs = sections.method === 'dqs';
+    const deformer = sections.deformer, N = sections.instanceCount;
+    const S = dqs ? sections.uniforms.gcsStride.value as number / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
     const nodes = N * S;
     const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     // One texel per node in each of four float targets: the node pass computes a node once and writes it whole.
@@ -55,9 +58,9 @@ export class NodePass {
     });
     const u = sections.uniforms;
     this.material = new THREE.ShaderMaterial({
-      ...nodePassShaders(sections.tableSlots),
+      ...(dqs ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
-        gcsJoints: u.gcsJoints!, gcsTable: u.gcsTable!,
+        gcsJoints: u.gcsJoints!, ...(dqs ? {} : { gcsTable: u.gcsTable! }),
         gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: width },
       },
