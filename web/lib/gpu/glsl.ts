@@ -491,7 +491,7 @@ attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
 attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
 #endif
-${ROTATION}${NORMAL_TEXEL}${TURN_JOINT}
+${ROTATION}${TURN_JOINT}
 // Joint i (counted over all instances) as the joint pass wrote it: q, K (columns) and t.
 void gcsDqsJoint( const in int i, out vec4 q, out mat3 K, out vec3 t ) {
 	int w = textureSize( gcsNodes0, 0 ).x, y = i / w;
@@ -500,6 +500,22 @@ void gcsDqsJoint( const in int i, out vec4 q, out mat3 K, out vec3 t ) {
 	vec4 r0 = texelFetch( gcsNodes1, at, 0 ), r1 = texelFetch( gcsNodes2, at, 0 ), r2 = texelFetch( gcsNodes3, at, 0 );
 	K = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 	t = vec3( r0.w, r1.w, r2.w );
+}
+// The normal matrix of M = R·K (R the blend's rotation) as gcsNormalTexel decides it, built
+// directly: R where K is a positive uniform scale (1e-4; the CPU's s·R, normalised), else
+// R·cof(K/kbig)/big with normals renormalised; 0 where K has collapsed (the rest direction kept).
+void gcsDqsNormal( const in mat3 R, const in mat3 k, out mat3 N, out bool renorm ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	vec3 e = max( max( abs( k[ 0 ] - vec3( s, 0.0, 0.0 ) ), abs( k[ 1 ] - vec3( 0.0, s, 0.0 ) ) ), abs( k[ 2 ] - vec3( 0.0, 0.0, s ) ) );
+	renorm = ! ( s > 0.0 && max( max( e.x, e.y ), e.z ) <= ${f(UNIFORM_SCALE_TOLERANCE)} * s );
+	if ( ! renorm ) { N = R; return; }
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	mat3 a = k * ( kbig > ${f(COLLAPSED)} ? 1.0 / kbig : 0.0 );
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	N = R * ( c * ( big > ${f(COLLAPSED)} ? 1.0 / big : 0.0 ) );
 }
 `;
 
@@ -533,11 +549,9 @@ const DQS_BASE = /* glsl */ `
 		}
 		float inv2 = 1.0 / dot( br, br );
 		gcsT = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
-		gcsM = gcsRotation( br, 2.0 * inv2 ) * K;
-		vec4 n = gcsNormalTexel( K );
-		mat3 a = gcsM * n.x;
-		gcsN = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
-		gcsNormalise = n.w < 0.0;
+		mat3 R = gcsRotation( br, 2.0 * inv2 );
+		gcsM = R * K;
+		gcsDqsNormal( R, K, gcsN, gcsNormalise );
 	}
 `;
 
