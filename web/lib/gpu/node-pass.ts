@@ -27,7 +27,9 @@ type Renderer = THREE.WebGLRenderer;
 
 /**
  * Computes every node's transform and normal matrix once per frame into float render targets that
- * the joint-level vertex stage reads (see the module comment).
+ * the joint-level vertex stage reads (see the module comment). For GPU DQS (sections of method
+ * 'dqs') it is the joint pass: one texel per joint of every instance, its rotation quaternion and
+ * the rows of [K | t] (K = Rᵀ·S), which the DQS vertex stage blends.
  */
 export class NodePass {
   /** The float render target (GPU_NODE_TEXTURES textures, one texel per node of every instance) the pass draws into. */
