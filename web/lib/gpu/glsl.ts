@@ -141,6 +141,31 @@ mat3 gcsRotation( const in vec4 q, const in float k2 ) {
 }
 `;
 
+/** The normal texel of a blended scale part K: the node pass and per-vertex DQS both compute one. */
+const NORMAL_TEXEL = /* glsl */ `
+// The CPU's normalMatrix as one texel (x, y, 0, flag), from which the vertex stage takes
+// N = cof(M·x)·y, M = R·K (cof(R) = R): R·cof(K/s) = R when K is a positive uniform scale s·I (up to
+// 1e-4): (1/s, 1, 0, 0); else R·cof(K/kbig)/big, its entries ≤ 1 and normals renormalised:
+// (1/kbig, 1/big, 0, −1). A collapsed K (rank ≤ 1) gives N = 0: the normal keeps its rest
+// direction (the CPU keeps it rotated; no direction survives such a scale).
+vec4 gcsNormalTexel( const in mat3 k ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	bool uniformScale = s > 0.0;
+	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
+		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
+	if ( uniformScale ) return vec4( 1.0 / s, 1.0, 0.0, 0.0 );
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
+	mat3 a = k / kbig;
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	if ( ! ( big > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
+	return vec4( 1.0 / kbig, 1.0 / big, 0.0, - 1.0 );
+}
+`;
+
 /** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
 const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
@@ -169,28 +194,7 @@ void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out ve
 	t = vec3( r0.w, r1.w, r2.w );
 }
 ${ROTATION}
-// The CPU's normalMatrix as one texel (x, y, 0, flag), from which the vertex stage takes
-// N = cof(M·x)·y, M = R·K (cof(R) = R): R·cof(K/s) = R when K is a positive uniform scale s·I (up to
-// 1e-4): (1/s, 1, 0, 0); else R·cof(K/kbig)/big, its entries ≤ 1 and normals renormalised:
-// (1/kbig, 1/big, 0, −1). A collapsed K (rank ≤ 1) gives N = 0: the normal keeps its rest
-// direction (the CPU keeps it rotated; no direction survives such a scale).
-vec4 gcsNormalTexel( const in mat3 k ) {
-	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
-	bool uniformScale = s > 0.0;
-	for ( int c = 0; c < 3; c ++ ) for ( int i = 0; i < 3; i ++ )
-		if ( abs( k[ c ][ i ] - ( c == i ? s : 0.0 ) ) > ${f(UNIFORM_SCALE_TOLERANCE)} * s ) uniformScale = false;
-	if ( uniformScale ) return vec4( 1.0 / s, 1.0, 0.0, 0.0 );
-	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
-	float kbig = max( max( m.x, m.y ), m.z );
-	if ( ! ( kbig > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
-	mat3 a = k / kbig;
-	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
-	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
-	float big = max( max( m.x, m.y ), m.z );
-	if ( ! ( big > ${f(COLLAPSED)} ) ) return vec4( 0.0, 0.0, 0.0, - 1.0 );
-	return vec4( 1.0 / kbig, 1.0 / big, 0.0, - 1.0 );
-}
-// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
+${NORMAL_TEXEL}// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
 // weights, weights1; a slot of weight 0 adds nothing) into x ↦ M x + T and the normal texel N
 // (gcsNormalTexel): K_j = R_jᵀ S_j blended linearly, applied first; with a centre of rotation
 // (w = 1; w = 0: none) the blend's M about it. One joint alone (joints.y < 0) is S_j itself.
@@ -274,6 +278,36 @@ void main() {
 }
 `;
 
+/**
+ * DQS's joint pass (WebGLRenderer): one fragment per joint of every instance (instance k's joint j
+ * is k·joints + j), four outputs: the joint's rotation quaternion, then the rows of its scale part
+ * K_j = R_jᵀ S_j with its translation in w — what each vertex's dual-quaternion blend needs per
+ * joint, computed once per joint and frame instead of once per vertex and influence.
+ */
+const DQS_PASS_FRAGMENT = /* glsl */ `
+uniform int gcsNodeCount;
+uniform int gcsSectionCount;
+uniform int gcsJointStride;
+uniform int gcsTargetWidth;
+layout( location = 0 ) out highp vec4 gcsRow0;
+layout( location = 1 ) out highp vec4 gcsRow1;
+layout( location = 2 ) out highp vec4 gcsRow2;
+layout( location = 3 ) out highp vec4 gcsNormal;
+${NODE_MATHS}
+void main() {
+	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
+	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
+	int instance = node / gcsSectionCount;
+	mat3 S; vec3 t; vec4 q;
+	gcsJoint( instance * gcsJointStride, node - instance * gcsSectionCount, S, t, q );
+	mat3 K = transpose( gcsRotation( q, 2.0 ) ) * S;
+	gcsRow0 = q;
+	gcsRow1 = vec4( K[ 0 ][ 0 ], K[ 1 ][ 0 ], K[ 2 ][ 0 ], t.x );
+	gcsRow2 = vec4( K[ 0 ][ 1 ], K[ 1 ][ 1 ], K[ 2 ][ 1 ], t.y );
+	gcsNormal = vec4( K[ 0 ][ 2 ], K[ 1 ][ 2 ], K[ 2 ][ 2 ], t.z );
+}
+`;
+
 /** A triangle covering the target: one fragment per texel. */
 const NODE_PASS_VERTEX = /* glsl */ `
 void main() {
@@ -311,6 +345,11 @@ export function nodePassShaders(slots: TableSlots): {
 } {
   checkSlots(slots, 'nodePassShaders');
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
+}
+
+/** DQS's joint pass shaders (GLSL 3: four outputs): one fragment per joint, its quaternion and [K | t] (internal: not an entry's export). */
+export function dqsPassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
+  return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${DQS_PASS_FRAGMENT}` };
 }
 
 /** The vertex stage's declarations: the node textures (written by the node pass) and how normals turn. */
@@ -455,17 +494,83 @@ vec3 gcsTurnLbs( const in vec3 v, const in mat3 M, const in vec4 q ) {
 }
 `;
 
-/** DQS (the CPU's dqsVertices): the node maths on the vertex's own joints and weights, no centre. */
+/**
+ * DQS (the CPU's dqsVertices) from the joint pass's textures: per influence the joint's quaternion,
+ * its dual part from (q, t), and K_j as the pass wrote them; the blend, M = R·K, T and the normal
+ * texel once per vertex. The arithmetic of gcsBlend without a centre, step for step.
+ */
+const DQS_PARS = /* glsl */ `
+#define GCS_PER_VERTEX
+${Array.from({ length: GPU_NODE_TEXTURES }, (_, t) => `uniform highp sampler2D gcsNodes${t};`).join('\n')}
+uniform int gcsBase;
+uniform int gcsStride;
+attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
+#if GCS_TABLE_SLOTS > 4
+attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
+attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
+#endif
+${ROTATION}${TURN_JOINT}
+// Joint i (counted over all instances) as the joint pass wrote it: q, K (columns) and t.
+void gcsDqsJoint( const in int i, out vec4 q, out mat3 K, out vec3 t ) {
+	int w = textureSize( gcsNodes0, 0 ).x, y = i / w;
+	ivec2 at = ivec2( i - y * w, y );
+	q = texelFetch( gcsNodes0, at, 0 );
+	vec4 r0 = texelFetch( gcsNodes1, at, 0 ), r1 = texelFetch( gcsNodes2, at, 0 ), r2 = texelFetch( gcsNodes3, at, 0 );
+	K = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
+	t = vec3( r0.w, r1.w, r2.w );
+}
+// The normal matrix of M = R·K (R the blend's rotation) as gcsNormalTexel decides it, built
+// directly: R where K is a positive uniform scale (1e-4; the CPU's s·R, normalised), else
+// R·cof(K/kbig)/big with normals renormalised; 0 where K has collapsed (the rest direction kept).
+void gcsDqsNormal( const in mat3 R, const in mat3 k, out mat3 N, out bool renorm ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	vec3 e = max( max( abs( k[ 0 ] - vec3( s, 0.0, 0.0 ) ), abs( k[ 1 ] - vec3( 0.0, s, 0.0 ) ) ), abs( k[ 2 ] - vec3( 0.0, 0.0, s ) ) );
+	renorm = ! ( s > 0.0 && max( max( e.x, e.y ), e.z ) <= ${f(UNIFORM_SCALE_TOLERANCE)} * s );
+	if ( ! renorm ) { N = R; return; }
+	vec3 m = max( max( abs( k[ 0 ] ), abs( k[ 1 ] ) ), abs( k[ 2 ] ) );
+	float kbig = max( max( m.x, m.y ), m.z );
+	mat3 a = k * ( kbig > ${f(COLLAPSED)} ? 1.0 / kbig : 0.0 );
+	mat3 c = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) );
+	m = max( max( abs( c[ 0 ] ), abs( c[ 1 ] ) ), abs( c[ 2 ] ) );
+	float big = max( max( m.x, m.y ), m.z );
+	N = R * ( c * ( big > ${f(COLLAPSED)} ? 1.0 / big : 0.0 ) );
+}
+`;
+
 const DQS_BASE = /* glsl */ `
 	mat3 gcsM, gcsN;
 	vec3 gcsT;
 	bool gcsNormalise;
 	{${SECOND_SET}
-		vec4 n;
-		gcsBlend( gcsFirstJoint(), ${INFLUENCE_ATTRIBUTES[0]}, ${WEIGHT_ATTRIBUTES[0]}, gcsJ1, gcsW1, vec4( 0.0 ), gcsM, gcsT, n );
-		mat3 a = gcsM * n.x;
-		gcsN = mat3( cross( a[ 1 ], a[ 2 ] ), cross( a[ 2 ], a[ 0 ] ), cross( a[ 0 ], a[ 1 ] ) ) * n.y;
-		gcsNormalise = n.w < 0.0;
+		int base = gcsBase;
+		#ifdef USE_INSTANCING
+		base += gl_InstanceID * gcsStride;
+		#endif
+		vec4 q, pivot, br = vec4( 0.0 ), bd = vec4( 0.0 );
+		mat3 Kj, K = mat3( 0.0 );
+		vec3 t;
+		gcsDqsJoint( base + int( ${INFLUENCE_ATTRIBUTES[0]}.x ), q, Kj, t );
+		pivot = q;
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+			#if GCS_TABLE_SLOTS > 4
+			float id = k < 4 ? ${INFLUENCE_ATTRIBUTES[0]}[ k ] : gcsJ1[ k - 4 ], w = k < 4 ? ${WEIGHT_ATTRIBUTES[0]}[ k ] : gcsW1[ k - 4 ];
+			#else
+			float id = ${INFLUENCE_ATTRIBUTES[0]}[ k ], w = ${WEIGHT_ATTRIBUTES[0]}[ k ];
+			#endif
+			if ( ! ( w > 0.0 ) ) continue;
+			if ( k > 0 ) gcsDqsJoint( base + int( id ), q, Kj, t );
+			vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+			float sw = dot( q, pivot ) < 0.0 ? - w : w;
+			br += sw * q;
+			bd += sw * d;
+			K += w * Kj;
+		}
+		float inv2 = 1.0 / dot( br, br );
+		gcsT = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
+		mat3 R = gcsRotation( br, 2.0 * inv2 );
+		gcsM = R * K;
+		gcsDqsNormal( R, K, gcsN, gcsNormalise );
 	}
 `;
 
@@ -493,7 +598,7 @@ export function patchVertexShader(source: string, smooth: boolean, path: GpuPath
   if (method !== 'gcs' && method !== 'lbs' && method !== 'dqs') throw new GcsError('INVALID_ARGUMENT', `the GPU backend runs 'gcs', 'lbs' or 'dqs'; got '${String(method)}'`);
   const joints = path === 'joints';
   const [pars, base, position, normal] = method === 'lbs' ? [`${SKIN_PARS}${LBS_TURN}`, LBS_BASE, JOINT_POSITION, LBS_NORMAL]
-    : method === 'dqs' ? [SKIN_PARS, DQS_BASE, JOINT_POSITION, DQS_NORMAL]
+    : method === 'dqs' ? [DQS_PARS, DQS_BASE, JOINT_POSITION, DQS_NORMAL]
     : joints ? [NODE_PARS, JOINT_BASE, JOINT_POSITION, JOINT_NORMAL] : [PARS, BASE, POSITION, NORMAL];
   let out = source
     .replace(HOOKS[0], `${HOOKS[0]}\n${pars}`)

@@ -11,8 +11,8 @@
  */
 import * as THREE from 'three';
 import { checkObject } from '../arguments.js';
-import { nodePassShaders } from './glsl.js';
-import { GPU_NODE_TEXTURES } from './layout.js';
+import { dqsPassShaders, nodePassShaders } from './glsl.js';
+import { GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** The widest row of the node textures: WebGL2's guaranteed 2048. */
@@ -28,7 +28,9 @@ type Renderer = THREE.WebGLRenderer;
 
 /**
  * Computes every node's transform and normal matrix once per frame into float render targets that
- * the joint-level vertex stage reads (see the module comment).
+ * the joint-level vertex stage reads (see the module comment). For GPU DQS (sections of method
+ * 'dqs') it is the joint pass: one texel per joint of every instance, its rotation quaternion and
+ * the rows of [K | t] (K = Rᵀ·S), which the DQS vertex stage blends.
  */
 export class NodePass {
   /** The float render target (GPU_NODE_TEXTURES textures, one texel per node of every instance) the pass draws into. */
@@ -49,7 +51,10 @@ export class NodePass {
   constructor(readonly sections: GpuSections) {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
-    const deformer = sections.deformer, S = deformer.sectionCount, N = sections.instanceCount;
+    // DQS: one "node" per joint (the joint pass: its quaternion and [K | t]); GCS: per section.
+    const dqs = sections.method === 'dqs';
+    const deformer = sections.deformer, N = sections.instanceCount;
+    const S = dqs ? sections.uniforms.gcsStride.value as number / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
     const nodes = N * S;
     const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     // One texel per node in each of four float targets: the node pass computes a node once and writes it whole.
@@ -59,9 +64,9 @@ export class NodePass {
     });
     const u = sections.uniforms;
     this.material = new THREE.ShaderMaterial({
-      ...nodePassShaders(sections.tableSlots),
+      ...(dqs ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
-        gcsJoints: u.gcsJoints!, gcsTable: u.gcsTable!,
+        gcsJoints: u.gcsJoints!, ...(dqs ? {} : { gcsTable: u.gcsTable! }),
         gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: width },
       },

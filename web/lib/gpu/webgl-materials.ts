@@ -100,7 +100,8 @@ export const glslKit: GpuMaterialKit = {
   build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
     const { smooth, path, method, tableSlots } = sections;
     // GCS, joint-level: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
-    const pass = method === 'gcs' && path === 'joints' ? new NodePass(sections) : null;
+    // DQS: the same pass, one fragment per joint (its quaternion and scale part, once per frame).
+    const pass = (method === 'gcs' && path === 'joints') || method === 'dqs' ? new NodePass(sections) : null;
     const uniforms = pass ? pass.uniforms : sections.uniforms;
     const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, method, tableSlots);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
