@@ -32,6 +32,11 @@ export interface MorphData {
   maxDelta: Float32Array;
 }
 
+/**
+ * A geometry's morph targets as {@link MorphData} (relative deltas in its vertex order, what
+ * `deformer.setMorphTargets` takes), or null when it has none. Throws GcsError NON_FINITE as
+ * checkMorphTargets does.
+ */
 export function morphData(geometry: THREE.BufferGeometry): MorphData | null {
   const targets = geometry.morphAttributes.position;
   if (!targets || targets.length === 0) return null;
