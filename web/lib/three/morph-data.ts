@@ -26,7 +26,9 @@ export function checkMorphTargets(geometry: THREE.BufferGeometry): void {
  * A relative, plain Float32 target is returned as is (not copied): treat the arrays as read-only.
  */
 export interface MorphData {
+  /** Per target, the position deltas (x, y, z per vertex). */
   positions: Float32Array[];
+  /** Per target, the normal deltas, or null when the geometry has no normal targets. */
   normals: Float32Array[] | null;
   /** Per target, the largest delta length: bounds grow by Σ |influence| · maxDelta. */
   maxDelta: Float32Array;
