@@ -1,11 +1,9 @@
 // Builds both packages. The library `gcs-skin`: web/lib → dist/ (TypeScript → ESM + .d.ts) with
-// the committed wasm binary. The command line `@gcs-skin/cli`: packages/cli/src and the library
-// modules it imports, compiled by tsc from the same sources (tsc emits only the files the
-// command line reaches), laid out as packages/cli/dist/*.js (its own modules) beside
-// packages/cli/dist/lib/ (the library's), with the wasm, the licence and the command line's docs.
+// the committed wasm binary. The command line `@gcs-skin/cli`: packages/cli/src → packages/cli/dist
+// (its own modules, which import the library by name), with the licence and the command line's docs.
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, mkdirSync, readdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
-import { dirname, join, relative, sep } from 'node:path';
+import { copyFileSync, mkdirSync, rmSync } from 'node:fs';
+import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { createRequire } from 'node:module';
 
@@ -25,37 +23,13 @@ execFileSync(process.execPath, [tsc, '-p', join(root, 'tsconfig.json')], { stdio
 mkdirSync(dist, { recursive: true });
 copyFileSync(join(root, 'web', 'lib', 'gcs-skin.wasm'), join(dist, 'gcs-skin.wasm'));
 
-// The command line: tsc writes build/cli/packages/cli/src/… and build/cli/web/lib/… (its rootDir
-// is the repository); they become packages/cli/dist/… and packages/cli/dist/lib/….
+// The command line: packages/cli/src → packages/cli/dist, its own modules only. It imports the
+// library by its package name (gcs-skin, gcs-skin/three, gcs-skin/gltf, …): in this repository the
+// workspace links node_modules/gcs-skin to the root (packages/cli's devDependency file:../..), so
+// tsc reads the dist/ built above; an install gets the library as @gcs-skin/cli's peer.
 const cli = join(root, 'packages', 'cli');
-const cliDist = join(cli, 'dist');
-const staging = join(root, 'build', 'cli');
-rmSync(staging, { recursive: true, force: true });
-rmSync(cliDist, { recursive: true, force: true });
+rmSync(join(cli, 'dist'), { recursive: true, force: true });
 execFileSync(process.execPath, [tsc, '-p', join(cli, 'tsconfig.json')], { stdio: 'inherit' });
-const PLACES = [[join(staging, 'packages', 'cli', 'src'), cliDist], [join(staging, 'web', 'lib'), join(cliDist, 'lib')]];
-/** Where a staged file goes in packages/cli/dist (null: outside both trees). */
-const placed = (file) => {
-  for (const [from, to] of PLACES) if (file.startsWith(from + sep)) return join(to, relative(from, file));
-  return null;
-};
-// Static `from '…'` and `import('…')` with a relative specifier, in .js and .d.ts alike.
-const RELATIVE_IMPORT = /(\bfrom\s*|\bimport\s*\(\s*)(['"])(\.{1,2}\/[^'"]+)\2/g;
-const files = readdirSync(staging, { recursive: true, withFileTypes: true }).filter((e) => e.isFile()).map((e) => join(e.parentPath ?? /** @type {any} */ (e).path, e.name));
-for (const file of files) {
-  const target = placed(file);
-  if (!target) throw new Error(`build-lib: tsc emitted ${relative(root, file)} for the command line, outside packages/cli/src and web/lib`);
-  const text = readFileSync(file, 'utf8').replace(RELATIVE_IMPORT, (all, head, quote, spec) => {
-    const to = placed(join(dirname(file), spec));
-    if (!to) throw new Error(`build-lib: ${relative(root, file)} imports ${spec}, outside packages/cli/src and web/lib`);
-    const moved = relative(dirname(target), to).split(sep).join('/');
-    return `${head}${quote}${moved.startsWith('.') ? moved : `./${moved}`}${quote}`;
-  });
-  mkdirSync(dirname(target), { recursive: true });
-  writeFileSync(target, text);
-}
-rmSync(staging, { recursive: true, force: true });
-copyFileSync(join(dist, 'gcs-skin.wasm'), join(cliDist, 'lib', 'gcs-skin.wasm'));
 // The package's own copies of the licence and the command line's docs (git ignores them).
 copyFileSync(join(root, 'LICENSE'), join(cli, 'LICENSE'));
 mkdirSync(join(cli, 'docs'), { recursive: true });

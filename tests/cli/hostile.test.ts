@@ -4,7 +4,7 @@
 // to smuggle values and terminal escapes. Each goes through the real command (`node
 // bin/gcs-skin.mjs report`, a child process) and must end in one line with its code in brackets,
 // within 5 s of CPU time and a memory bound, and never echo a byte of a file it refused. Files at the limits
-// (LIMITS) are accepted and still bounded. Runs on packages/cli/dist: `npm run build:lib` first (npm test does).
+// (LIMITS) are accepted and still bounded. Runs on packages/cli/dist and the dist/ it imports: `npm run build:lib` first (npm test does).
 import { spawnSync, type SpawnSyncOptions } from 'node:child_process';
 import { chmodSync, closeSync, existsSync, ftruncateSync, mkdirSync, mkdtempSync, openSync, rmSync, statSync, symlinkSync, writeFileSync, writeSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -19,7 +19,7 @@ import { packGlb, splitGlb, writeGlbVariant, type Json } from '../helpers/glb.js
 
 const ROOT = join(import.meta.dirname, '../..');
 const BIN = join(ROOT, 'bin/gcs-skin.mjs');
-const BUILT = join(ROOT, 'packages/cli/dist/lib/gltf/validate.js');
+const BUILT = join(ROOT, 'dist/gltf/validate.js'); // the library's build, which packages/cli/dist imports as gcs-skin/gltf
 
 /**
  * Time bound per file: CPU seconds of the whole child (node's own start included), so that a
@@ -109,7 +109,7 @@ function humanVariant(name: string, edit: (json: Json, bin: DataView) => void): 
 
 beforeAll(async () => {
   if (!existsSync(BUILT) || statSync(BUILT).mtimeMs < statSync(join(ROOT, 'web/lib/gltf/validate.ts')).mtimeMs)
-    throw new Error('packages/cli/dist is missing or older than web/lib: run `npm run build:lib` first');
+    throw new Error('dist/ (what packages/cli/dist imports) is missing or older than web/lib: run `npm run build:lib` first');
   dir = mkdtempSync(join(tmpdir(), 'gcs-hostile-'));
   folder = join(dir, 'model');
   mkdirSync(folder);

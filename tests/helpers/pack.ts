@@ -28,11 +28,18 @@ export interface Tarballs {
 export function packTarballs(dir: string, version?: string): Tarballs {
   const src = join(dir, 'src');
   for (const entry of SOURCES) cpSync(join(ROOT, entry), join(src, entry), { recursive: true });
-  symlinkSync(join(ROOT, 'node_modules'), join(src, 'node_modules'));
+  // This checkout's node_modules, entry by entry, but for gcs-skin (the workspace's link to the
+  // root): the copy's own, so that the command line's build reads the copy's dist/.
+  mkdirSync(join(src, 'node_modules'));
+  for (const entry of readdirSync(join(ROOT, 'node_modules')))
+    if (entry !== 'gcs-skin') symlinkSync(join(ROOT, 'node_modules', entry), join(src, 'node_modules', entry));
+  symlinkSync('..', join(src, 'node_modules', 'gcs-skin'));
   if (version) {
     for (const file of ['package.json', 'packages/cli/package.json']) {
       const manifest = JSON.parse(readFileSync(join(src, file), 'utf8'));
-      writeFileSync(join(src, file), JSON.stringify({ ...manifest, version }, null, 2));
+      // @gcs-skin/cli's peer gcs-skin: the same version, as a release pins it.
+      const peers = manifest.peerDependencies?.['gcs-skin'] ? { peerDependencies: { ...manifest.peerDependencies, 'gcs-skin': version } } : {};
+      writeFileSync(join(src, file), JSON.stringify({ ...manifest, version, ...peers }, null, 2));
     }
   }
   const pack = (cwd: string, ...flags: string[]) => {

@@ -21,5 +21,6 @@
 export type { Backend, GcsCharacterOptions, RebuildOptions, SkinDeformerOptions } from './three/options.js';
 export { writeSkinMatrices } from './three/skin-matrices.js';
 export { rigInputFromSkinnedMesh } from './three/rig-input.js';
+export { morphData, type MorphData } from './three/morph-data.js';
 export { SkinDeformer } from './three/skin-deformer.js';
 export { GcsCharacter } from './three/character.js';

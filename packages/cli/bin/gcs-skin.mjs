@@ -26,7 +26,7 @@ if (cmd === '-h' || cmd === '--help') {
   try {
     mod = await import(new URL(SUBCOMMANDS[cmd].module, import.meta.url).href);
   } catch (e) {
-    // A missing package (three is a peer dependency: yarn berry, or npm --legacy-peer-deps, does not
+    // A missing package (three and gcs-skin are peer dependencies: yarn berry, or npm --legacy-peer-deps, does not
     // install it) or a missing build (a git checkout before `npm run build:lib`).
     const pkg = e?.code === 'ERR_MODULE_NOT_FOUND' && /Cannot find package '([^']+)'/.exec(e.message)?.[1];
     process.stderr.write(pkg

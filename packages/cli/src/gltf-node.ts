@@ -1,5 +1,5 @@
 // Loads a glTF skinned character in node (no DOM, no image decoder). The file is first checked by
-// web/lib/gltf/validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
+// gcs-skin/gltf: web/lib/gltf/validate.ts (GLB container, JSON structure, limits, buffer ranges, node graph, skins,
 // animations): a bad file is a GltfError with a code and one sentence, before any loader sees it.
 // External buffers are read only from regular files inside the glTF's folder, up to their
 // declared byteLength (readBufferFile). Then @gltf-transform/core
@@ -14,17 +14,14 @@ import { realpath } from 'node:fs/promises';
 import { dirname, isAbsolute, relative, resolve, sep } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { restoreZeroWeights } from '../../../web/lib/gltf/accessors.js';
-import { decodeBufferPath, readValidatedGltf } from '../../../web/lib/gltf/buffers.js';
-import { sniffGltf } from '../../../web/lib/gltf/container.js';
-import { GltfError, loaderFailure, n } from '../../../web/lib/gltf/error.js';
-import type { BufferData, GltfJson } from '../../../web/lib/gltf/json.js';
-import { LIMITS } from '../../../web/lib/gltf/limits.js';
-import { shownName } from '../../../web/lib/gltf/shown-name.js';
+import {
+  decodeBufferPath, GltfError, LIMITS, loaderFailure, n, readValidatedGltf, restoreZeroWeights, shownName, sniffGltf,
+  type BufferData, type GltfJson,
+} from 'gcs-skin/gltf';
 import { FileRefused, namesStandardInput, readRegularFile, readStandardInput, systemReason } from './read-file.js';
-import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
+import { writeSkinMatrices } from 'gcs-skin/three';
 
-export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
+export { GltfError, type GltfErrorCode } from 'gcs-skin/gltf';
 
 export interface LoadedModel {
   scene: THREE.Object3D;
@@ -93,7 +90,7 @@ async function readBufferFile(baseDir: string, uri: string, maxBytes: number, fi
 
 /**
  * Reads a .glb or .gltf file (a regular file, read as read-file.ts guards it) and its external
- * buffers, and validates them (web/lib/gltf/validate.ts). `-` reads standard input, as bytes with
+ * buffers, and validates them (gcs-skin/gltf: web/lib/gltf/validate.ts). `-` reads standard input, as bytes with
  * no folder. Throws a GltfError (code and one sentence naming the file) for anything wrong.
  */
 export async function readGltfFile(file: string): Promise<GltfFile> {

@@ -7,16 +7,13 @@
 // three appears in the types. Documented in docs/node.md.
 import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
-import { GltfError } from '../../../web/lib/gltf/error.js';
-import { asGiven, GcsError } from '../../../web/lib/errors.js';
-import type { RigInput } from '../../../web/lib/index.js';
-import { morphData } from '../../../web/lib/three/morph-data.js';
-import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
-import { writeSkinMatrices } from '../../../web/lib/three/skin-matrices.js';
+import { asGiven, GcsError, type RigInput } from 'gcs-skin';
+import { GltfError } from 'gcs-skin/gltf';
+import { morphData, rigInputFromSkinnedMesh, writeSkinMatrices } from 'gcs-skin/three';
 import { characterHeight, loadGltfFile, rootOf } from './gltf-node.js';
 
-export { GltfError, type GltfErrorCode } from '../../../web/lib/gltf/error.js';
-export type { RigInput } from '../../../web/lib/index.js';
+export { GltfError, type GltfErrorCode } from 'gcs-skin/gltf';
+export type { RigInput } from 'gcs-skin';
 
 /** One animation clip of the file, as seen by one skinned mesh. */
 export interface CharacterClip {

@@ -1,9 +1,9 @@
 // `gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb`
 import { closeSync, constants, fstatSync, ftruncateSync, openSync, writeSync } from 'node:fs';
-import { printable } from '../../../web/lib/gltf/shown-name.js';
+import { printable } from 'gcs-skin/gltf';
 import { walkArguments, wholeNumber } from './args.js';
 import { systemReason } from './read-file.js';
-import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from '../../../web/lib/human/index.js';
+import { createHuman, DEFAULT_VERTICES, humanToGlb, MAX_VERTICES, MIN_VERTICES } from 'gcs-skin/human';
 
 export const usage = `usage: gcs-skin human [--vertices N] [--pose stand|tpose] [--no-seams] -o out.glb
   --vertices N   vertex count, ${MIN_VERTICES}..${MAX_VERTICES} (default ${DEFAULT_VERTICES})

@@ -9,16 +9,15 @@
 // Progress on stderr when it is a terminal. The JSON shape is documented in docs/report-json.md.
 import type * as THREE from 'three';
 import { setConsoleFunction } from 'three';
-import { asGiven, GcsError } from '../../../web/lib/errors.js';
-import { initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from '../../../web/lib/index.js';
-import { rigInputFromSkinnedMesh } from '../../../web/lib/three/rig-input.js';
-import { printable, shownName } from '../../../web/lib/gltf/shown-name.js';
+import { asGiven, GcsError, initGcsSkin, type Deformer, type GcsDeformer, type GcsSkin, type RigInput } from 'gcs-skin';
+import { printable, shownName } from 'gcs-skin/gltf';
+import { rigInputFromSkinnedMesh } from 'gcs-skin/three';
 import { walkArguments, wholeNumber } from './args.js';
 import { characterHeight, GltfError, loadGltfFile, sampleClip } from './gltf-node.js';
 import {
   FidelityProbe, METHODS, buildMethod, errorInfo, identitySkin, jointMethods, jointTableRows, measureJoints, median, timeInterleaved,
   type Fidelity, type JointsMeasure, type MethodName,
-} from '../../../web/lib/measure.js';
+} from 'gcs-skin/measure';
 
 /** Fidelity frames in all (default --frames: this many spread over the clips, at least MIN_FRAMES_PER_CLIP each, at most 60). */
 export const FRAME_BUDGET = 64;

@@ -18,6 +18,7 @@ export type ExternalReader = (uri: string, index: number, maxBytes: number) => P
 
 /** A validated glTF: its JSON and, per buffer, its bytes (undefined: an extension's buffer with no data). */
 export interface ValidatedGltf {
+  /** The glTF JSON, validated against the reader's limits. */
   json: GltfJson;
   /** Buffer i's bytes, at most its byteLength. */
   buffers: (Uint8Array | undefined)[];

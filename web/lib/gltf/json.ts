@@ -6,6 +6,7 @@ export type GltfJson = Record<string, any>;
 
 /** How a buffer's data is had: its length, and where it came from for messages. */
 export interface BufferData {
+  /** Bytes the data has (a file's size, a data: URI's decoded length, the BIN chunk's length). */
   byteLength: number;
   /** The data itself, when the values some checks read (key times, sparse indices) can be read. */
   bytes?: Uint8Array;

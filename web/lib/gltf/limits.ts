@@ -29,6 +29,7 @@ export const LIMITS = {
    * and sparse accessors, decompression: real files stay well under 4×).
    */
   expandedFloor: 32 * 2 ** 20,
+  /** The multiple of the file's buffer bytes the loaders may allocate beyond `expandedFloor`. */
   expansion: 16,
   /**
    * Vertices the nodes instance (a mesh used by several nodes counts once per node): at most this
@@ -36,5 +37,6 @@ export const LIMITS = {
    * a prop repeated many times).
    */
   instancing: 4,
+  /** Vertices instanced in all that are always allowed, whatever `instancing` says. */
   instancedFloor: 1_048_576,
 } as const;

@@ -26,12 +26,19 @@ export function checkMorphTargets(geometry: THREE.BufferGeometry): void {
  * A relative, plain Float32 target is returned as is (not copied): treat the arrays as read-only.
  */
 export interface MorphData {
+  /** Per target, the position deltas (x, y, z per vertex). */
   positions: Float32Array[];
+  /** Per target, the normal deltas, or null when the geometry has no normal targets. */
   normals: Float32Array[] | null;
   /** Per target, the largest delta length: bounds grow by Σ |influence| · maxDelta. */
   maxDelta: Float32Array;
 }
 
+/**
+ * A geometry's morph targets as {@link MorphData} (relative deltas in its vertex order, what
+ * `deformer.setMorphTargets` takes), or null when it has none. Throws GcsError NON_FINITE as
+ * checkMorphTargets does.
+ */
 export function morphData(geometry: THREE.BufferGeometry): MorphData | null {
   const targets = geometry.morphAttributes.position;
   if (!targets || targets.length === 0) return null;
