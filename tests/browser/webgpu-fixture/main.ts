@@ -597,7 +597,7 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
   pose(0.7);
   await draw(renderer, scene, camera);
   runs.push(pass.runs);
-  const { vertexShader } = await renderer.debug.getShaderAsync(scene, camera, c.mesh);
+  const vertexShader = (await renderer.debug.getShaderAsync(scene, camera, c.mesh)).vertexShader ?? '';
   // The GLSL pass from the same GpuSections (joint poses of the last update()), on a WebGLRenderer.
   const gl = glRenderer();
   const glsl = new NodePass(c.sections);
