@@ -918,6 +918,30 @@ struct Snapshot {
   }
 };
 
+// Joint j's bind-pose centre as the core takes it (rig.h: c_j = B_j · origin, B_j the inverse of the
+// inverse bind matrix M_j): x with M_j x = (0, 0, 0, 1), by Gauss-Jordan elimination in double.
+bool jointCentre(const float* ibm, double out[3]) {
+  double a[4][5];
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) a[r][c] = ibm[4 * c + r];
+    a[r][4] = r == 3 ? 1.0 : 0.0;
+  }
+  for (int p = 0; p < 4; ++p) {
+    int best = p;
+    for (int r = p + 1; r < 4; ++r)
+      if (std::fabs(a[r][p]) > std::fabs(a[best][p])) best = r;
+    if (a[best][p] == 0.0) return false;
+    for (int c = 0; c < 5; ++c) std::swap(a[p][c], a[best][c]);
+    for (int r = 0; r < 4; ++r) {
+      if (r == p) continue;
+      const double f = a[r][p] / a[p][p];
+      for (int c = p; c < 5; ++c) a[r][c] -= f * a[p][c];
+    }
+  }
+  for (int k = 0; k < 3; ++k) out[k] = a[k][4] / a[k][k];
+  return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+}
+
 // The joint-level GPU path (weights criterion): the static table names each section's joints (in
 // range, -1 past the last), weights ≥ 0 summing to 1, one joint exactly for a rigid core; the joint
 // poses of two instances are the rows of their S_j bit for bit and a finite unit quaternion; a
@@ -942,6 +966,13 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (uint32_t v = 0; v < in.vertexCount; ++v)
     for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], in.positions[3 * v + k]), hi[k] = std::fmax(hi[k], in.positions[3 * v + k]);
+  // A centre lies between its pair's pivot (the child joint's bind centre) and the surface average:
+  // the bounds take the joints' centres too.
+  for (uint32_t j = 0; j < J; ++j) {
+    double c[3];
+    if (!jointCentre(&in.inverseBind[16 * size_t(j)], c)) continue;
+    for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], float(c[k])), hi[k] = std::fmax(hi[k], float(c[k]));
+  }
   // Float sums of centroids: a rounding allowance relative to the extent and to the distance from the origin.
   float slack = 1e-4f * std::fmax(hi[0] - lo[0], std::fmax(hi[1] - lo[1], hi[2] - lo[2]));
   for (int k = 0; k < 3; ++k) slack += 1e-5f * std::fmax(std::fabs(lo[k]), std::fabs(hi[k]));
@@ -963,8 +994,8 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
     }
     CHECK(std::fabs(sum - 1.0) < 1e-4, "section %u weights sum to %g", s, sum);
     CHECK((n == 1) == (info[8 * size_t(s) + 4] == 2.0f), "section %u: %u joints, kind %g", s, n, double(info[8 * size_t(s) + 4]));
-    // Its centre of rotation: none for a rigid core or without centres; else a weighted average of
-    // triangle centroids, so inside the bind-pose bounds (and finite).
+    // Its centre of rotation: none for a rigid core or without centres; else a point between a joint's
+    // bind centre and a weighted average of triangle centroids, so inside the bounds of both (and finite).
     const float* c = &centres[4 * size_t(s)];
     CHECK(c[3] == 0.0f || c[3] == 1.0f, "section %u centre flag %g", s, double(c[3]));
     if (c[3] == 0.0f) {
