@@ -1,6 +1,7 @@
 // Morph targets of a geometry as relative deltas in its vertex order, what
 // deformer.setMorphTargets takes, with each target's largest delta (for the bounds).
 import type * as THREE from 'three';
+import { checkMethods, checkObject } from '../arguments.js';
 import { GcsError } from '../errors.js';
 
 type AnyAttribute = THREE.BufferAttribute | THREE.InterleavedBufferAttribute;
@@ -37,9 +38,11 @@ export interface MorphData {
 /**
  * A geometry's morph targets as {@link MorphData} (relative deltas in its vertex order, what
  * `deformer.setMorphTargets` takes), or null when it has none. Throws GcsError NON_FINITE as
- * checkMorphTargets does.
+ * checkMorphTargets does, INVALID_ARGUMENT for a geometry that is not one.
  */
 export function morphData(geometry: THREE.BufferGeometry): MorphData | null {
+  checkMethods(geometry, 'geometry', 'morphData', ['getAttribute']);
+  checkObject(geometry.morphAttributes, 'geometry.morphAttributes', 'morphData');
   const targets = geometry.morphAttributes.position;
   if (!targets || targets.length === 0) return null;
   const base = geometry.getAttribute('position');
