@@ -241,10 +241,10 @@ void gcsBlend( const in int base, const in vec4 joints, const in vec4 weights, c
 `;
 
 /**
- * The node pass's fragment shader: one fragment per node (instance k's node s is node k·sections +
- * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
+ * What both passes (node and DQS joint) declare: the counts that map a fragment to its node (or
+ * joint) and instance, and the four float targets (GPU_NODE_TEXTURES) they write.
  */
-const NODE_PASS_FRAGMENT = /* glsl */ `
+const PASS_HEAD = /* glsl */ `
 uniform int gcsNodeCount;
 uniform int gcsSectionCount;
 uniform int gcsJointStride;
@@ -253,7 +253,13 @@ layout( location = 0 ) out highp vec4 gcsRow0;
 layout( location = 1 ) out highp vec4 gcsRow1;
 layout( location = 2 ) out highp vec4 gcsRow2;
 layout( location = 3 ) out highp vec4 gcsNormal;
-uniform highp sampler2D gcsTable;
+`;
+
+/**
+ * The node pass's fragment shader: one fragment per node (instance k's node s is node k·sections +
+ * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
+ */
+const NODE_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}uniform highp sampler2D gcsTable;
 ${NODE_MATHS}
 // Section s: its joints, weights and centre of rotation from the static table (GCS_TABLE_TEXELS per
 // section: per 4 slots a texel of joints, −1 past the last, then one of weights; last, the centre).
@@ -284,16 +290,7 @@ void main() {
  * K_j = R_jᵀ S_j with its translation in w — what each vertex's dual-quaternion blend needs per
  * joint, computed once per joint and frame instead of once per vertex and influence.
  */
-const DQS_PASS_FRAGMENT = /* glsl */ `
-uniform int gcsNodeCount;
-uniform int gcsSectionCount;
-uniform int gcsJointStride;
-uniform int gcsTargetWidth;
-layout( location = 0 ) out highp vec4 gcsRow0;
-layout( location = 1 ) out highp vec4 gcsRow1;
-layout( location = 2 ) out highp vec4 gcsRow2;
-layout( location = 3 ) out highp vec4 gcsNormal;
-${NODE_MATHS}
+const DQS_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}${NODE_MATHS}
 void main() {
 	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
 	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
