@@ -13,7 +13,9 @@
 //   layout, each bent alone to 45°, 90°, 135°: volume change, bulge, collapse, creases, new
 //   self-intersecting triangle pairs, per method (largest mesh).
 // --markdown prints one fidelity table (rows: character × method) for the README, nothing else;
-// --joints-markdown the README's joint table (every knee and elbow at 135°), nothing else.
+// --joints-markdown the README's joint table (every knee and elbow at 135°), nothing else;
+// --joint-checks the joint targets as pass/fail checks for GCS with centres of rotation, or for
+// --candidate METHOD (scripts/bench/joint-checks.mjs), nothing else.
 import { existsSync, readdirSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -27,6 +29,7 @@ import {
   restOfOutput,
 } from '../dist/measure.js';
 import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
+import { centresCandidate, clipRows, jointRows } from './bench/joint-checks.mjs';
 import {
   bindCentres, findBone, rayThickness, isClosed, minWidth, outputJoints, planeSection, posedCentre,
   rotateBoneWorld, signedVolume, worldPos,
@@ -41,11 +44,13 @@ const args = argsOrExit('metrics', {
   json: { type: 'flag', default: false },
   markdown: { type: 'flag', default: false },
   jointsMarkdown: { type: 'flag', default: false },
+  jointChecks: { type: 'flag', default: false },
+  candidate: { parse: (x) => { if (x !== 'centres' && !METHODS.includes(x)) throw new Error(`--candidate must be centres or one of ${METHODS.join(', ')}; got '${x}'`); return x; }, default: 'centres' },
   noModels: { type: 'flag', default: false },
   vertices: { parse: positive, default: undefined },
   sections: { parse: positive, default: 6 },
   frames: { parse: positive, default: 60 },
-}, 'usage: npm run metrics -- [--json] [--markdown] [--joints-markdown] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
+}, 'usage: npm run metrics -- [--json] [--markdown] [--joints-markdown] [--joint-checks [--candidate centres|METHOD]] [--no-models] [--vertices N] [--sections N] [--frames N (per clip, default 60)]');
 // Progress on stderr whenever stdout carries a document (JSON or the markdown table).
 const log = args.json || args.markdown || args.jointsMarkdown ? (...a) => console.error(...a) : (...a) => console.log(...a);
 const { sections, frames: framesPerClip } = args;
@@ -293,6 +298,65 @@ function measureCharacter(name, meshes, clips) {
     name, height: heights.world, meshes: fidelity.meshes.map(({ methods, ...m }) => m), clips: clips.map((c) => c.name),
     frames: fidelity.meshes[0].frames, notes, fidelity: fidelity.methods, shape, joints,
   };
+}
+
+if (args.jointChecks) {
+  await printJointChecks();
+  process.exit(0);
+}
+
+/**
+ * The joint targets for a candidate (GCS with centres of rotation unless --candidate), check by check: the knees and elbows of our
+ * human, CesiumMan and Soldier (the Fox held out, printed apart) at 90° and 135°, then every clip
+ * of every character.
+ */
+async function printJointChecks() {
+  const candidate = args.candidate === 'centres' ? centresCandidate(sections) : (rig) => buildMethod(rig, args.candidate, { sections });
+  console.log(`candidate: ${args.candidate === 'centres' ? 'GCS with centres of rotation' : METHOD_LABELS[args.candidate]}, ${sections} sections\n`);
+  const ours = createHuman(args.vertices ? { vertices: args.vertices } : {});
+  const characters = [{ name: 'human', meshes: [ours.mesh], clips: ours.clips, counted: true }];
+  if (!args.noModels && existsSync(MODELS_DIR))
+    for (const f of readdirSync(MODELS_DIR).filter((x) => /\.glb$/i.test(x)).sort()) {
+      const model = await loadGltfFile(join(MODELS_DIR, f));
+      if (model.skinnedMeshes.length) characters.push({ name: f.replace(/\.glb$/i, ''), meshes: model.skinnedMeshes, clips: model.clips,
+        counted: /^(CesiumMan|Soldier)$/.test(f.replace(/\.glb$/i, '')) });
+    }
+  const f2 = (x) => (Number.isFinite(x) ? x.toFixed(2) : String(x));
+  const mark = (c) => `${c.name === 'volume' ? c.value.toFixed(1) : c.name === 'bulge' ? f2(c.value) : c.value} ${c.pass ? '≤' : '>'} ${c.name === 'bulge' || c.name === 'volume' ? f2(c.limit) : c.limit.toFixed(0)}${c.pass ? '' : ' ✗'}`;
+  let passed = 0, total = 0, heldPassed = 0, heldTotal = 0;
+  const rows = [['character, joint', 'bend', 'bulge p95 (≤ LBS + 0.05)', '|volume %| (≤ |DQS| + 2)', 'creases (≤ 1.1 DQS + 5)', 'new self-x (≤ 1.1 DQS + 5)',
+    'GCS / DQS / LBS bulge', 'GCS / DQS / LBS volume']];
+  for (const ch of characters) {
+    const largest = ch.meshes.reduce((a, b) => (b.geometry.getAttribute('position').count > a.geometry.getAttribute('position').count ? b : a));
+    const input = rigInputFromSkinnedMesh(largest);
+    const { rows: joints } = jointRows(gcs, input, largest.skeleton.bones.map((b) => b.name), candidate, [90, 135], buildMethod, sections);
+    for (const r of joints) {
+      const ok = r.checks.filter((c) => c.pass).length;
+      if (ch.counted) { passed += ok; total += r.checks.length; } else { heldPassed += ok; heldTotal += r.checks.length; }
+      const f = r.figures;
+      rows.push([`${ch.name}${ch.counted ? '' : ' (held out)'}, ${r.joint}`, `${r.degrees}°`, ...r.checks.map(mark),
+        `${f2(f.gcs.bulgeP95)} / ${f2(f.dqs.bulgeP95)} / ${f2(f.lbs.bulgeP95)}`,
+        `${f.gcs.volumeChange.toFixed(1)} / ${f.dqs.volumeChange.toFixed(1)} / ${f.lbs.volumeChange.toFixed(1)}`]);
+    }
+  }
+  console.log(table(rows));
+  console.log(`\njoint checks passed: ${passed} of ${total} (human, CesiumMan, Soldier); held out (Fox): ${heldPassed} of ${heldTotal}`);
+  const clipTable = [['character, clip', 'flips: candidate / LBS / DQS', 'ratio', 'creases: candidate / LBS / DQS', 'ratio', 'rigid error %', 'normal off unit', 'non-finite']];
+  let clipsPassed = 0, clipsTotal = 0;
+  for (const ch of characters) {
+    const heights = characterHeight(ch.meshes).meshUnits;
+    const meshes = ch.meshes.map((mesh) => ({ mesh, input: rigInputFromSkinnedMesh(mesh) }));
+    for (const r of clipRows(gcs, meshes, ch.clips, framesPerClip, heights, candidate, buildMethod, sampleClip, sections)) {
+      clipsTotal++;
+      if (r.pass) clipsPassed++;
+      const s = r.sum;
+      clipTable.push([`${ch.name}, ${r.clip}`, `${s.candidate.flipped} / ${s.lbs.flipped} / ${s.dqs.flipped}`, `${f2(r.flipRatio)}${r.flipRatio > 1.1 ? ' ✗' : ''}`,
+        `${s.candidate.creases} / ${s.lbs.creases} / ${s.dqs.creases}`, `${f2(r.creaseRatio)}${r.creaseRatio > 1.1 ? ' ✗' : ''}`,
+        num(r.rigidError, 6), num(r.normalOff, 6), String(r.nonFinite)]);
+    }
+  }
+  console.log(`\n${table(clipTable)}`);
+  console.log(`\nclips passed: ${clipsPassed} of ${clipsTotal} (${framesPerClip} frames per clip; flips and creases ≤ 1.1 × the more of LBS and DQS, rigid error ≤ 1e-4 %, normals unit, finite)`);
 }
 
 // ---------------------------------------------------------------- characters
