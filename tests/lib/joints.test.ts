@@ -3,7 +3,8 @@
 // scaled by k about the bone line changes its volume by k² − 1 and its bulge to k; LBS loses volume
 // where DQS keeps it), the self-intersection count (0 at rest, > 0 for LBS's collapse at 150°), and
 // the knees and elbows found from the skeleton's layout alone on our human, CesiumMan (no joint
-// names) and Soldier, each bending the right way: the shin back, the forearm forward.
+// names) and Soldier, each bending the right way: the shin back, the forearm forward; the joint
+// targets' bounds as `npm run metrics -- --joint-checks` applies them.
 import { beforeAll, describe, expect, test } from 'vitest';
 import { initGcsSkin, type Deformer, type GcsSkin, type RigInput } from '../../web/lib/index.js';
 import { rigInputFromSkinnedMesh } from '../../web/lib/three.js';
@@ -224,5 +225,20 @@ describe('every method at the joints of our human', () => {
         expect(dqs[i].bulgeP95).toBeGreaterThan(lbs[i].bulgeP95);
       }
     }
+  });
+});
+
+describe('the joint targets as checks (npm run metrics -- --joint-checks)', () => {
+  const figures = (f: Partial<JointFigures>): JointFigures => ({
+    degrees: 135, volumeChange: 0, bulgeP95: 1, bulgeMax: 1, collapseP5: 1, collapseMin: 1, creases: 0, newIntersections: 0, ...f,
+  });
+  test('each bound as the targets state it: at the bound passes, past it fails; the volume by its size, either sign', async () => {
+    const { jointChecks } = await import('../../scripts/bench/joint-checks.mjs');
+    const lbs = figures({ bulgeP95: 1.04, volumeChange: -9 }), dqs = figures({ bulgeP95: 1.4, volumeChange: -3, creases: 50, newIntersections: 100 });
+    const at = jointChecks(figures({ bulgeP95: 1.09, volumeChange: 5, creases: 60, newIntersections: 115 }), dqs, lbs);
+    expect(at.map((c: { name: string }) => c.name)).toEqual(['bulge', 'volume', 'creases', 'self-x']);
+    expect(at.map((c: { pass: boolean }) => c.pass)).toEqual([true, true, true, true]);
+    const past = jointChecks(figures({ bulgeP95: 1.1, volumeChange: -5.1, creases: 61, newIntersections: 116 }), dqs, lbs);
+    expect(past.map((c: { pass: boolean }) => c.pass)).toEqual([false, false, false, false]);
   });
 });
