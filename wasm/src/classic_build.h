@@ -58,6 +58,7 @@ class ClassicBuild {
   void transportFrames();    //    contour reference directions carried down each chain
   void countContours();      //    contours per part by bone length
   void sortWeldedEdges();    //    triangle edges by welded vertex (for boundary loops)
+  void findPieces();         //    connected pieces of skin (a rig of separate shells has several)
 
   // --- Steps 4–9: one model.
   void newModel();
@@ -68,6 +69,7 @@ class ClassicBuild {
   void traceLoops(std::vector<uint8_t>& failed);
   bool carrySeams(const std::vector<uint8_t>& failed);
   bool endTubesAtLoops();
+  float fullRingEnd(uint32_t j, float end, float other);
   void castFinalContours();  //    the contours of the parts that stay resampled
   void layContours();        // 5. rings, chains root → leaf, shared joint rings
   void fillEmptyContours();  //    misses filled, empty contours from their neighbours
@@ -95,6 +97,8 @@ class ClassicBuild {
   int32_t baseOwner(uint32_t g) const;
   bool updateCut(uint32_t j);
   void updateExtents();
+  struct PartTriangles;
+  PartTriangles& trianglesOf(uint32_t j);
   void endNormals(const ClassicPart& P, glm::vec3& nProx, glm::vec3& nDist) const;
   void contourFrame(const ClassicPart& P, float t, const glm::vec3& nProx, const glm::vec3& nDist, glm::vec3& centre,
                     glm::vec3& n, glm::vec3& u) const;
@@ -123,6 +127,7 @@ class ClassicBuild {
   // For a split trunk part j: per part x, the child of j whose subtree holds x (−1: none, or the continuing child's).
   std::vector<std::vector<int32_t>> branchOf;
   std::vector<WeldedEdge> edges;                // sorted by (lo, hi)
+  std::vector<uint32_t> piece;                  // per welded vertex: its connected piece of skin (a welded vertex id)
   std::vector<ClassicPart> analysedParts;       // the parts as step 3 leaves them
   // Per part: the triangles its contours are cast against (castPart), kept across rebuilds.
   struct PartTriangles {
