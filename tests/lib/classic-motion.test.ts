@@ -120,22 +120,37 @@ describe('classic cross-sections stay on the skin in every clip (distance to the
 });
 
 // A rig of separate rigid shells with gaps at the joints (Mixamo's X Bot; the rigid rebinds above
-// keep one connected skin, and passed). Before the rule that a contour reads influences only from
-// the pieces of skin its rays hit, and that an open tube end starts where its rays all find skin,
-// the shank's end rings stood in the gap above its slanted shell, blended with the thigh's shell
-// around their plane, and left the skin at the bent knee: p99 0.90 %, max 2.61 % (now 0.69 / 1.94).
+// keep one connected skin, and passed). Before the rules of pieces (a contour reads influences
+// only from the pieces of skin its rays hit; tubes share a joint ring only where skin joins them)
+// and of open ends (a tube end that meets nothing starts where its rays all find skin), the
+// shank's end rings stood in the gap above its slanted shell, blended with the thigh's shell
+// around their plane, and left the skin at the bent knee. Measured then (p99 / max %): 0.90 / 2.61,
+// 0.97 / 3.42 and 1.03 / 3.42 for the first three shapes below; 17 of 288 shapes of a wider sweep
+// failed, none fails now.
+const SHELL_SHAPES = [
+  // thigh's gap above the knee, shank's start below it (negative: above), dome, slant, knee bend°
+  [0.01, -0.03, 0.2, 0.4, 130],
+  [0.03, -0.005, 0.4, 1.2, 150],
+  [0.015, -0.015, 0.4, 0.8, 150],  // the shells' ends touch at one point
+  [0.02, -0.01, 0.2, 0.4, 150],
+] as const;
 describe('classic cross-sections on a rig of separate rigid shells (a stand-in for X Bot)', () => {
-  test('a stride with the knee bent to 130° (12 frames): p99 ≤ 1 %, max ≤ 2.5 % of the height', () => {
-    const figure = rigidShellFigure();
-    const rig = gcs.createRig(figure.input);
-    const d = rig.buildClassic();
-    const r = classicOffSurface(figure.input, d, strideFrames(figure, FRAMES_PER_CLIP), {});
-    console.log(`classic rigid shells: p99 ${r.p99.toFixed(3)} %, max ${r.max.toFixed(3)} %; ${r.parts.filter((p) => p.resampled).map((p) => `joint ${p.joint} resampled ${p.p99.toFixed(2)} / ${p.max.toFixed(2)}`).join(', ')}`);
-    expect(d.parts.find((p) => p.joint === 4)?.resampled, 'the shank is resampled').toBe(true);
-    expect(r.p99).toBeLessThanOrEqual(1);
-    expect(r.max).toBeLessThanOrEqual(2.5);
-    d.dispose();
-    rig.dispose();
+  test(`a stride, ${SHELL_SHAPES.length} shapes of knee (${FRAMES_PER_CLIP} frames): p99 ≤ 1 %, max ≤ 2.5 % of the height`, () => {
+    const rows: string[] = [];
+    for (const [thighGap, shankStart, dome, slant, knee] of SHELL_SHAPES) {
+      const figure = rigidShellFigure(thighGap, shankStart, dome, slant);
+      const rig = gcs.createRig(figure.input);
+      const d = rig.buildClassic();
+      const r = classicOffSurface(figure.input, d, strideFrames(figure, FRAMES_PER_CLIP, knee), {});
+      const label = `shells ${thighGap} / ${shankStart} / ${dome} / ${slant}, knee ${knee}°`;
+      rows.push(`${label}: p99 ${r.p99.toFixed(3)} %, max ${r.max.toFixed(3)} %; ${r.parts.filter((p) => p.resampled).map((p) => `joint ${p.joint} ${p.p99.toFixed(2)} / ${p.max.toFixed(2)}`).join(', ')}`);
+      expect(d.parts.find((p) => p.joint === 4)?.resampled, `${label}: the shank is resampled`).toBe(true);
+      expect(r.p99, label).toBeLessThanOrEqual(1);
+      expect(r.max, label).toBeLessThanOrEqual(2.5);
+      d.dispose();
+      rig.dispose();
+    }
+    console.log(`classic rigid shells:\n  ${rows.join('\n  ')}`);
   });
 });
 

@@ -27,7 +27,8 @@ constexpr float kMinTrunkSpan = 0.25f;     // … and keeps at least ¼ of its b
 constexpr float kMinTubeSpan = 0.1f;       // a tube between its end loops spans ≥ ⅒ of its bone
 constexpr float kBandWidth = 0.02f;        // a tube ends ¹⁄₅₀ bone inside its loop
 constexpr uint32_t kProbeContours = 5;     // contours cast to decide whether a part resamples
-constexpr float kEndStep = 0.01f;          // an open tube end moves in by ¹⁄₁₀₀ bone until its rays all hit
+constexpr float kEndStep = 0.01f;          // an open tube end moves in by ¹⁄₁₀₀ bone until its rays all hit,
+constexpr int kEndHalvings = 7;            // then to within ¹⁄₁₂₈ of that step
 
 // A tube's span along its bone: 0 / 1 at a shared joint, just inside its border loop where it
 // meets carried skin, its own vertices' extent at an open end.
@@ -300,15 +301,45 @@ void ClassicBuild::sortWeldedEdges() {
       for (uint32_t j = i; j > first[g] && edges[j - 1].hi > edges[j].hi; --j) std::swap(edges[j - 1], edges[j]);
 }
 
-// Pieces: welded vertices joined by triangles. One on most characters; one per part on a rig of
-// separate rigid shells (Mixamo's X Bot: a shell per bone, gaps at the joints), where a contour
-// near a joint has the neighbouring shell around its plane but its rays hit only its own.
+// Pieces: triangles joined through shared (welded) edges. One on most characters; one per part on
+// a rig of separate rigid shells (Mixamo's X Bot: a shell per bone, gaps at the joints), where a
+// contour near a joint has the neighbouring shell around its plane but its rays hit only its
+// own. (Edges, not vertices: two shells whose ends touch at one point are still two pieces.)
 void ClassicBuild::findPieces() {
-  root.resize(G);
-  for (uint32_t g = 0; g < G; ++g) root[g] = g;
-  for (uint32_t t = 0; t < T; ++t) unite(group[rig.indices[3 * t]], group[rig.indices[3 * t + 1]]), unite(group[rig.indices[3 * t]], group[rig.indices[3 * t + 2]]);
-  piece.resize(G);
-  for (uint32_t g = 0; g < G; ++g) piece[g] = find(g);
+  std::vector<uint32_t> triRoot(T);
+  for (uint32_t t = 0; t < T; ++t) triRoot[t] = t;
+  auto findTri = [&](uint32_t x) {
+    while (triRoot[x] != x) x = triRoot[x] = triRoot[triRoot[x]];
+    return x;
+  };
+  for (size_t e0 = 0; e0 < edges.size();) {
+    size_t e1 = e0 + 1;
+    for (; e1 < edges.size() && edges[e1].lo == edges[e0].lo && edges[e1].hi == edges[e0].hi; ++e1) {
+      uint32_t a = findTri(edges[e0].tri), b = findTri(edges[e1].tri);
+      if (a != b) triRoot[std::max(a, b)] = std::min(a, b);
+    }
+    e0 = e1;
+  }
+  triPiece.resize(T);
+  for (uint32_t t = 0; t < T; ++t) triPiece[t] = findTri(t);
+  // A welded vertex's piece: its first triangle's. A part's pieces: those of the triangles it
+  // holds most corners of (ties: the first corner's part).
+  piece.assign(G, UINT32_MAX);
+  std::vector<std::pair<uint32_t, uint32_t>> partPiece;
+  for (uint32_t t = 0; t < T; ++t) {
+    const uint32_t p = triPiece[t];
+    const uint32_t* v = &rig.indices[size_t(t) * 3];
+    for (int e = 0; e < 3; ++e)
+      if (piece[group[v[e]]] == UINT32_MAX) piece[group[v[e]]] = p;
+    const uint32_t a = partOf[v[0]], b = partOf[v[1]], c = partOf[v[2]];
+    partPiece.push_back({b == c && b != a ? b : a, p});
+  }
+  std::sort(partPiece.begin(), partPiece.end());
+  partPiece.erase(std::unique(partPiece.begin(), partPiece.end()), partPiece.end());
+  piecesFirst.assign(J + 1, 0);
+  pieceList.clear();
+  for (const auto& pp : partPiece) ++piecesFirst[pp.first + 1], pieceList.push_back(pp.second);
+  for (uint32_t j = 0; j < J; ++j) piecesFirst[j + 1] += piecesFirst[j];
 }
 
 // ---------------------------------------------------------------- helpers over the shared state
@@ -466,12 +497,22 @@ void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, 
   own.casts.push_back(std::move(cast));
 }
 
-// P's distal joint contour is shared with its child.
+// P's distal joint contour is shared with its child: both resampled, and skin joins them (two
+// separate shells have only a gap at their joint, where a shared ring would stand in the air).
 bool ClassicBuild::shares(const ClassicPart& P) const {
   const ClassicModel& m = *model;
   if (!P.resampled || P.child < 0 || P.split == 2) return false;
   const ClassicPart& C = m.parts[P.child];
-  return C.resampled && C.split != 1;
+  return C.resampled && C.split != 1 && joinedBySkin(P.joint, uint32_t(P.child));
+}
+
+// Parts a and b have skin in one piece.
+bool ClassicBuild::joinedBySkin(uint32_t a, uint32_t b) const {
+  for (uint32_t i = piecesFirst[a], e = piecesFirst[b]; i < piecesFirst[a + 1]; ++i) {
+    while (e < piecesFirst[b + 1] && pieceList[e] < pieceList[i]) ++e;
+    if (e < piecesFirst[b + 1] && pieceList[e] == pieceList[i]) return true;
+  }
+  return false;
 }
 
 void ClassicBuild::carry(uint32_t j, uint8_t reason) {
@@ -797,31 +838,45 @@ bool ClassicBuild::endTubesAtLoops() {
 }
 
 // An open end of part j's tube (its skin meets nothing there: a shell's own end, a sleeve's
-// border) at `end`, moved towards `other` to the first contour whose rays all find skin, in steps
-// of ¹⁄₁₀₀ bone over at most half the span (none: the one with the most hits). Beyond it, misses
-// would be filled from their neighbours' radii and the ring would stand in the air past a rounded
-// or slanted end of the skin (Mixamo's X Bot: a closed shell per bone, its knee end slanted).
+// border) at `end`, moved towards `other` to where a contour's rays all find skin: in steps of
+// ¹⁄₁₀₀ bone over at most half the span, then halving the last step (a plane through a cut
+// border finds nothing, one a hair inside finds it all); none: the contour with the most hits.
+// Beyond it, misses would be filled from their neighbours' radii and the ring would stand in the
+// air past a rounded or slanted end of the skin (Mixamo's X Bot: a closed shell per bone, its
+// knee end slanted).
 float ClassicBuild::fullRingEnd(uint32_t j, float end, float other) {
   const ClassicPart& P = model->parts[j];
   PartTriangles& own = trianglesOf(j);
-  glm::vec3 nProx, nDist, O, n, u;
+  glm::vec3 nProx, nDist;
   endNormals(P, nProx, nDist);
-  const float step = other > end ? kEndStep : -kEndStep;
-  const int steps = int(std::floor(0.5f * std::fabs(other - end) / kEndStep));
-  float best = end;
-  uint32_t bestHits = 0;
   std::vector<float> radius(k);
   std::vector<uint32_t> triangle(k);
-  for (int i = 0; i <= steps; ++i) {
-    const float t = end + step * float(i);
+  auto hitsAt = [&](float t) {
+    glm::vec3 O, n, u;
     contourFrame(P, t, nProx, nDist, O, n, u);
     own.slabs.candidates(O, n, cut);
     std::fill(radius.begin(), radius.end(), -1.0f);
     castContour(own.corners.data(), cut.data(), uint32_t(cut.size()), O, n, u, glm::cross(n, u), k, model->cosTable.data(),
                 model->sinTable.data(), radius.data(), triangle.data());
-    const uint32_t hits = rejectOutliers(radius.data(), k, scratch);
+    return rejectOutliers(radius.data(), k, scratch);
+  };
+  const float step = other > end ? kEndStep : -kEndStep;
+  const int steps = int(std::floor(0.5f * std::fabs(other - end) / kEndStep));
+  float best = end;
+  uint32_t bestHits = 0;
+  for (int i = 0; i <= steps; ++i) {
+    const float t = end + step * float(i);
+    const uint32_t hits = hitsAt(t);
+    if (hits == k) {
+      if (i == 0) return t;
+      float outside = t - step, inside = t;  // the ring turns full between them
+      for (int halving = 0; halving < kEndHalvings; ++halving) {
+        const float mid = 0.5f * (outside + inside);
+        (hitsAt(mid) == k ? inside : outside) = mid;
+      }
+      return inside;
+    }
     if (hits > bestHits) best = t, bestHits = hits;
-    if (hits == k) break;
   }
   return best;
 }
@@ -946,7 +1001,7 @@ void ClassicBuild::contourInfluences() {
   for (ClassicContour& c : m.contours) {
     hitPieces.clear();
     for (uint32_t r = 0; r < k; ++r)
-      if (ringTriangle[c.first + r] < T) hitPieces.push_back(piece[group[rig.indices[size_t(ringTriangle[c.first + r]) * 3]]]);
+      if (ringTriangle[c.first + r] < T) hitPieces.push_back(triPiece[ringTriangle[c.first + r]]);
     std::sort(hitPieces.begin(), hitPieces.end());
     hitPieces.erase(std::unique(hitPieces.begin(), hitPieces.end()), hitPieces.end());
     const ClassicPart& P = m.parts[c.part];

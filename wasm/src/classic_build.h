@@ -105,6 +105,7 @@ class ClassicBuild {
   void castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist, std::vector<float>& out,
                 std::vector<uint32_t>& outTriangles, uint32_t& hitCount, uint32_t& inRangeHits, uint32_t& inRangeRays);
   bool shares(const ClassicPart& P) const;
+  bool joinedBySkin(uint32_t a, uint32_t b) const;
   void carry(uint32_t j, uint8_t reason);
   uint32_t find(uint32_t x);
   void unite(uint32_t a, uint32_t b);
@@ -127,7 +128,8 @@ class ClassicBuild {
   // For a split trunk part j: per part x, the child of j whose subtree holds x (−1: none, or the continuing child's).
   std::vector<std::vector<int32_t>> branchOf;
   std::vector<WeldedEdge> edges;                // sorted by (lo, hi)
-  std::vector<uint32_t> piece;                  // per welded vertex: its connected piece of skin (a welded vertex id)
+  std::vector<uint32_t> triPiece, piece;        // per triangle and welded vertex: its connected piece of skin
+  std::vector<uint32_t> piecesFirst, pieceList;  // each part's pieces, sorted
   std::vector<ClassicPart> analysedParts;       // the parts as step 3 leaves them
   // Per part: the triangles its contours are cast against (castPart), kept across rebuilds.
   struct PartTriangles {
