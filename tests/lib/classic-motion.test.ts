@@ -4,7 +4,8 @@
 // off-surface p99 ≤ 1 %, max ≤ 2.5 % of the height). The build's outputs are pinned by a digest
 // (tests/lib/classic-golden.json): taken before the build was split into steps and made faster
 // (the same triangles, reports and deformed vertices, bit for bit), and taken again, on purpose,
-// when the zip bands got rows of their own vertices (GCS_WRITE_CLASSIC_GOLDEN=1 writes it).
+// when the zip bands got rows of their own vertices, and for Soldier's body mesh when open tube
+// ends began to start where their rays all find skin (GCS_WRITE_CLASSIC_GOLDEN=1 writes it).
 import { beforeAll, describe, expect, test } from 'vitest';
 import { createHash } from 'node:crypto';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
