@@ -1,4 +1,4 @@
-// npm run classic [-- --markdown] [--no-models]
+// npm run classic [-- --markdown] [--no-models] [--model PATH …]
 // The classic cross-section model on the default human and on every character in ../shared/models
 // (skipped with a reason when absent), per skinned mesh: which parts it resamples, the points on
 // the thigh and shank at the paper's leg densities (25 contours × 20 rays on the longest bone:
@@ -7,10 +7,11 @@
 // meet carried skin). Then, per mesh, how far the classic output lies from the skin it replaces
 // as dual-quaternion skinning poses it (6 frames per clip, bulge at its default 0.3): p99 and max
 // over all output vertices and frames, in % of the character's height, and the parts with the
-// largest figures. Measurement code: web/lib/measure.ts (classicFigures, classicAtBudget,
+// largest figures. --model PATH (repeatable) adds a .glb from anywhere, e.g. a character whose
+// licence keeps it out of ../shared/models. Measurement code: web/lib/measure.ts (classicFigures, classicAtBudget,
 // classicOffSurface).
 import { existsSync, readdirSync } from 'node:fs';
-import { dirname, join, resolve } from 'node:path';
+import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { initGcsSkin } from '../dist/index.js';
 import { rigInputFromSkinnedMesh } from '../dist/three.js';
@@ -20,8 +21,12 @@ import { classicAtBudget, classicBandQuality, classicFigures, classicOffSurface,
 import { argsOrExit, markdownTable, num, table } from './bench/common.mjs';
 import { findBone } from './bench/fidelity.mjs';
 
-const args = argsOrExit('classic', { markdown: { type: 'flag', default: false }, noModels: { type: 'flag', default: false } },
-  'usage: npm run classic -- [--markdown] [--no-models]');
+const extraModels = [];
+const args = argsOrExit('classic', {
+  markdown: { type: 'flag', default: false },
+  noModels: { type: 'flag', default: false },
+  model: { type: 'string', default: extraModels, parse: (v) => (extraModels.push(v), extraModels) },
+}, 'usage: npm run classic -- [--markdown] [--no-models] [--model PATH …]');
 const MODELS_DIR = resolve(dirname(fileURLToPath(import.meta.url)), '../../shared/models');
 const gcs = await initGcsSkin();
 
@@ -34,6 +39,14 @@ else
     const model = await loadGltfFile(join(MODELS_DIR, f));
     characters.push({ name: f, meshes: model.skinnedMeshes, clips: model.clips });
   }
+for (const path of args.model) {
+  if (!existsSync(path)) {
+    console.error(`classic: ${path} not found`);
+    process.exit(2);
+  }
+  const model = await loadGltfFile(path);
+  characters.push({ name: basename(path), meshes: model.skinnedMeshes, clips: model.clips });
+}
 
 const rows = [['character / mesh', 'input vertices (GCS)', 'resampled + trunk / carried parts', 'thigh / shank points',
   'loss at 25 × 20: RMS / max %', 'output vertices', 'at the GCS budget: setting', 'loss RMS / max %', 'border in / out']];

@@ -27,6 +27,8 @@ constexpr float kMinTrunkSpan = 0.25f;     // … and keeps at least ¼ of its b
 constexpr float kMinTubeSpan = 0.1f;       // a tube between its end loops spans ≥ ⅒ of its bone
 constexpr float kBandWidth = 0.02f;        // a tube ends ¹⁄₅₀ bone inside its loop
 constexpr uint32_t kProbeContours = 5;     // contours cast to decide whether a part resamples
+constexpr float kEndStep = 0.01f;          // an open tube end moves in by ¹⁄₁₀₀ bone until its rays all hit,
+constexpr int kEndHalvings = 7;            // then to within ¹⁄₁₂₈ of that step
 
 // A tube's span along its bone: 0 / 1 at a shared joint, just inside its border loop where it
 // meets carried skin, its own vertices' extent at an open end.
@@ -48,6 +50,7 @@ ClassicBuild::ClassicBuild(const Rig& rig, uint32_t contours, uint32_t rays, flo
   transportFrames();
   countContours();
   sortWeldedEdges();
+  findPieces();
   analysedParts = model->parts;
   partTriangles.resize(J);
 }
@@ -298,6 +301,47 @@ void ClassicBuild::sortWeldedEdges() {
       for (uint32_t j = i; j > first[g] && edges[j - 1].hi > edges[j].hi; --j) std::swap(edges[j - 1], edges[j]);
 }
 
+// Pieces: triangles joined through shared (welded) edges. One on most characters; one per part on
+// a rig of separate rigid shells (Mixamo's X Bot: a shell per bone, gaps at the joints), where a
+// contour near a joint has the neighbouring shell around its plane but its rays hit only its
+// own. (Edges, not vertices: two shells whose ends touch at one point are still two pieces.)
+void ClassicBuild::findPieces() {
+  std::vector<uint32_t> triRoot(T);
+  for (uint32_t t = 0; t < T; ++t) triRoot[t] = t;
+  auto findTri = [&](uint32_t x) {
+    while (triRoot[x] != x) x = triRoot[x] = triRoot[triRoot[x]];
+    return x;
+  };
+  for (size_t e0 = 0; e0 < edges.size();) {
+    size_t e1 = e0 + 1;
+    for (; e1 < edges.size() && edges[e1].lo == edges[e0].lo && edges[e1].hi == edges[e0].hi; ++e1) {
+      uint32_t a = findTri(edges[e0].tri), b = findTri(edges[e1].tri);
+      if (a != b) triRoot[std::max(a, b)] = std::min(a, b);
+    }
+    e0 = e1;
+  }
+  triPiece.resize(T);
+  for (uint32_t t = 0; t < T; ++t) triPiece[t] = findTri(t);
+  // A welded vertex's piece: its first triangle's. A part's pieces: those of the triangles it
+  // holds most corners of (ties: the first corner's part).
+  piece.assign(G, UINT32_MAX);
+  std::vector<std::pair<uint32_t, uint32_t>> partPiece;
+  for (uint32_t t = 0; t < T; ++t) {
+    const uint32_t p = triPiece[t];
+    const uint32_t* v = &rig.indices[size_t(t) * 3];
+    for (int e = 0; e < 3; ++e)
+      if (piece[group[v[e]]] == UINT32_MAX) piece[group[v[e]]] = p;
+    const uint32_t a = partOf[v[0]], b = partOf[v[1]], c = partOf[v[2]];
+    partPiece.push_back({b == c && b != a ? b : a, p});
+  }
+  std::sort(partPiece.begin(), partPiece.end());
+  partPiece.erase(std::unique(partPiece.begin(), partPiece.end()), partPiece.end());
+  piecesFirst.assign(J + 1, 0);
+  pieceList.clear();
+  for (const auto& pp : partPiece) ++piecesFirst[pp.first + 1], pieceList.push_back(pp.second);
+  for (uint32_t j = 0; j < J; ++j) piecesFirst[j + 1] += piecesFirst[j];
+}
+
 // ---------------------------------------------------------------- helpers over the shared state
 
 float ClassicBuild::tOn(const ClassicPart& P, uint32_t v) const {
@@ -389,18 +433,12 @@ void ClassicBuild::contourFrame(const ClassicPart& P, float t, const glm::vec3& 
   u = orthonormal(minRotate(P.axis, n, P.u), n);
 }
 
-// Casts `count` contours of part j evenly over [tLo, tHi] into out (count × k radii): its own
-// triangles; a trunk part's also its continuing child's and its carried branch children's (its
-// tube runs through their skin). Counts the hits left after outliers, and those between joints.
-void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist,
-                            std::vector<float>& out, std::vector<uint32_t>& outTriangles, uint32_t& hitCount,
-                            uint32_t& inRangeHits, uint32_t& inRangeRays) {
+// The triangles part j's contours are cast against: its own; a trunk part's also its continuing
+// child's and its carried branch children's (its tube runs through their skin). Gathered once per
+// set of parts (a trunk part's set changes as its branch children are carried), kept across rebuilds.
+ClassicBuild::PartTriangles& ClassicBuild::trianglesOf(uint32_t j) {
   ClassicModel& m = *model;
   const ClassicPart& P = m.parts[j];
-  out.assign(size_t(count) * k, -1.0f);  // no hit yet
-  outTriangles.assign(size_t(count) * k, 0);
-  // The triangles it casts against, gathered once per set of parts (a trunk part's set changes as
-  // its branch children are carried) and kept across rebuilds.
   gathered.clear();
   for (uint32_t x = 0; x < J; ++x)
     if (x == j || (P.split && (int32_t(x) == P.child || (m.parts[x].isPart && member(j, x))))) gathered.push_back(x);
@@ -418,6 +456,19 @@ void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, 
       }
     own.slabs.build(own.corners.data(), uint32_t(own.triangle.size()), rig.jointCentres[P.joint], P.axis);
   }
+  return own;
+}
+
+// Casts `count` contours of part j evenly over [tLo, tHi] into out (count × k radii), against
+// trianglesOf(j). Counts the hits left after outliers, and those between joints.
+void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist,
+                            std::vector<float>& out, std::vector<uint32_t>& outTriangles, uint32_t& hitCount,
+                            uint32_t& inRangeHits, uint32_t& inRangeRays) {
+  ClassicModel& m = *model;
+  const ClassicPart& P = m.parts[j];
+  out.assign(size_t(count) * k, -1.0f);  // no hit yet
+  outTriangles.assign(size_t(count) * k, 0);
+  PartTriangles& own = trianglesOf(j);
   // The same contours were cast before (by an earlier round, or the build before the on-skin
   // test carried a part elsewhere): the same result.
   for (const PartTriangles::Cast& c : own.casts)
@@ -446,12 +497,22 @@ void ClassicBuild::castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, 
   own.casts.push_back(std::move(cast));
 }
 
-// P's distal joint contour is shared with its child.
+// P's distal joint contour is shared with its child: both resampled, and skin joins them (two
+// separate shells have only a gap at their joint, where a shared ring would stand in the air).
 bool ClassicBuild::shares(const ClassicPart& P) const {
   const ClassicModel& m = *model;
   if (!P.resampled || P.child < 0 || P.split == 2) return false;
   const ClassicPart& C = m.parts[P.child];
-  return C.resampled && C.split != 1;
+  return C.resampled && C.split != 1 && joinedBySkin(P.joint, uint32_t(P.child));
+}
+
+// Parts a and b have skin in one piece.
+bool ClassicBuild::joinedBySkin(uint32_t a, uint32_t b) const {
+  for (uint32_t i = piecesFirst[a], e = piecesFirst[b]; i < piecesFirst[a + 1]; ++i) {
+    while (e < piecesFirst[b + 1] && pieceList[e] < pieceList[i]) ++e;
+    if (e < piecesFirst[b + 1] && pieceList[e] == pieceList[i]) return true;
+  }
+  return false;
 }
 
 void ClassicBuild::carry(uint32_t j, uint8_t reason) {
@@ -766,12 +827,58 @@ bool ClassicBuild::endTubesAtLoops() {
     if (!P.resampled) continue;
     float lo, hi;
     spanOf(P, lo, hi);
+    if (!P.proxShared && P.proxLoop < 0) lo = fullRingEnd(j, lo, hi);
+    if (!P.distShared && P.distLoop < 0) hi = fullRingEnd(j, hi, lo);
     // (the ray test is not run again on the final span: the loops only trim the ends of a
     // tube whose rays already hit, and the contours are cast below)
     if (!(hi - lo >= kMinTubeSpan)) carry(j, GCS_CLASSIC_SEAM), any = true;
     else P.tLo = lo, P.tHi = hi;
   }
   return any;
+}
+
+// An open end of part j's tube (its skin meets nothing there: a shell's own end, a sleeve's
+// border) at `end`, moved towards `other` to where a contour's rays all find skin: in steps of
+// ¹⁄₁₀₀ bone over at most half the span, then halving the last step (a plane through a cut
+// border finds nothing, one a hair inside finds it all); none: the contour with the most hits.
+// Beyond it, misses would be filled from their neighbours' radii and the ring would stand in the
+// air past a rounded or slanted end of the skin (Mixamo's X Bot: a closed shell per bone, its
+// knee end slanted).
+float ClassicBuild::fullRingEnd(uint32_t j, float end, float other) {
+  const ClassicPart& P = model->parts[j];
+  PartTriangles& own = trianglesOf(j);
+  glm::vec3 nProx, nDist;
+  endNormals(P, nProx, nDist);
+  std::vector<float> radius(k);
+  std::vector<uint32_t> triangle(k);
+  auto hitsAt = [&](float t) {
+    glm::vec3 O, n, u;
+    contourFrame(P, t, nProx, nDist, O, n, u);
+    own.slabs.candidates(O, n, cut);
+    std::fill(radius.begin(), radius.end(), -1.0f);
+    castContour(own.corners.data(), cut.data(), uint32_t(cut.size()), O, n, u, glm::cross(n, u), k, model->cosTable.data(),
+                model->sinTable.data(), radius.data(), triangle.data());
+    return rejectOutliers(radius.data(), k, scratch);
+  };
+  const float step = other > end ? kEndStep : -kEndStep;
+  const int steps = int(std::floor(0.5f * std::fabs(other - end) / kEndStep));
+  float best = end;
+  uint32_t bestHits = 0;
+  for (int i = 0; i <= steps; ++i) {
+    const float t = end + step * float(i);
+    const uint32_t hits = hitsAt(t);
+    if (hits == k) {
+      if (i == 0) return t;
+      float outside = t - step, inside = t;  // the ring turns full between them
+      for (int halving = 0; halving < kEndHalvings; ++halving) {
+        const float mid = 0.5f * (outside + inside);
+        (hitsAt(mid) == k ? inside : outside) = mid;
+      }
+      return inside;
+    }
+    if (hits > bestHits) best = t, bestHits = hits;
+  }
+  return best;
 }
 
 // The contours of the parts that stay resampled, cast once at their final span.
@@ -890,7 +997,13 @@ void ClassicBuild::contourInfluences() {
   std::vector<std::pair<float, uint32_t>> along;  // (position along the bone, rig vertex)
   std::vector<std::pair<uint32_t, uint32_t>> nearby;  // (part, rig vertex)
   int32_t alongPart = -1, alongProximal = -1;
+  std::vector<uint32_t> hitPieces;  // the pieces of skin the contour's rays hit (none: any)
   for (ClassicContour& c : m.contours) {
+    hitPieces.clear();
+    for (uint32_t r = 0; r < k; ++r)
+      if (ringTriangle[c.first + r] < T) hitPieces.push_back(triPiece[ringTriangle[c.first + r]]);
+    std::sort(hitPieces.begin(), hitPieces.end());
+    hitPieces.erase(std::unique(hitPieces.begin(), hitPieces.end()), hitPieces.end());
     const ClassicPart& P = m.parts[c.part];
     auto near = [&](uint32_t x) {
       if (x == uint32_t(c.part) || int32_t(x) == P.child || int32_t(x) == P.parent || (c.proximal >= 0 && int32_t(x) == c.proximal))
@@ -931,6 +1044,8 @@ void ClassicBuild::contourInfluences() {
       std::sort(nearby.begin(), nearby.end());
       for (const auto& pv : nearby) {
         const uint32_t v = pv.second;
+        // (skin the rays never reached: another shell around the plane, moving with its own bone)
+        if (!hitPieces.empty() && !std::binary_search(hitPieces.begin(), hitPieces.end(), piece[group[v]])) continue;
         glm::vec3 x = rig.positions[v] - c.centre;
         float h = glm::dot(x, c.normal);
         if (std::fabs(h) > window || glm::length(x - h * c.normal) > reach) continue;

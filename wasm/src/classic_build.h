@@ -58,6 +58,7 @@ class ClassicBuild {
   void transportFrames();    //    contour reference directions carried down each chain
   void countContours();      //    contours per part by bone length
   void sortWeldedEdges();    //    triangle edges by welded vertex (for boundary loops)
+  void findPieces();         //    connected pieces of skin (a rig of separate shells has several)
 
   // --- Steps 4–9: one model.
   void newModel();
@@ -68,6 +69,7 @@ class ClassicBuild {
   void traceLoops(std::vector<uint8_t>& failed);
   bool carrySeams(const std::vector<uint8_t>& failed);
   bool endTubesAtLoops();
+  float fullRingEnd(uint32_t j, float end, float other);
   void castFinalContours();  //    the contours of the parts that stay resampled
   void layContours();        // 5. rings, chains root → leaf, shared joint rings
   void fillEmptyContours();  //    misses filled, empty contours from their neighbours
@@ -95,12 +97,15 @@ class ClassicBuild {
   int32_t baseOwner(uint32_t g) const;
   bool updateCut(uint32_t j);
   void updateExtents();
+  struct PartTriangles;
+  PartTriangles& trianglesOf(uint32_t j);
   void endNormals(const ClassicPart& P, glm::vec3& nProx, glm::vec3& nDist) const;
   void contourFrame(const ClassicPart& P, float t, const glm::vec3& nProx, const glm::vec3& nDist, glm::vec3& centre,
                     glm::vec3& n, glm::vec3& u) const;
   void castPart(uint32_t j, uint32_t count, const glm::vec3& nProx, const glm::vec3& nDist, std::vector<float>& out,
                 std::vector<uint32_t>& outTriangles, uint32_t& hitCount, uint32_t& inRangeHits, uint32_t& inRangeRays);
   bool shares(const ClassicPart& P) const;
+  bool joinedBySkin(uint32_t a, uint32_t b) const;
   void carry(uint32_t j, uint8_t reason);
   uint32_t find(uint32_t x);
   void unite(uint32_t a, uint32_t b);
@@ -123,6 +128,8 @@ class ClassicBuild {
   // For a split trunk part j: per part x, the child of j whose subtree holds x (−1: none, or the continuing child's).
   std::vector<std::vector<int32_t>> branchOf;
   std::vector<WeldedEdge> edges;                // sorted by (lo, hi)
+  std::vector<uint32_t> triPiece, piece;        // per triangle and welded vertex: its connected piece of skin
+  std::vector<uint32_t> piecesFirst, pieceList;  // each part's pieces, sorted
   std::vector<ClassicPart> analysedParts;       // the parts as step 3 leaves them
   // Per part: the triangles its contours are cast against (castPart), kept across rebuilds.
   struct PartTriangles {
