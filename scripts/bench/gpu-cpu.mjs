@@ -78,7 +78,8 @@ function characterTimes(gcs, c, timing) {
   try {
     if (character.backend !== 'gpu') throw new Error(`${c.name}: the GPU backend did not build (${character.skins.map((s) => s.backendNote).join('; ')})`);
     // update() is updateWorld(scope) then the loop below: the same steps, split at three's.
-    const scope = character.scope, poses = character.poses, skinUpdate = character.skinUpdate, skins = character.skins;
+    const inner = /** @type {any} */ (character); // its private parts: the bench splits update() where the class does not
+    const scope = inner.scope, poses = inner.poses, skinUpdate = inner.skinUpdate, skins = character.skins;
     if (!scope || !poses || !skinUpdate) throw new Error('GcsCharacter.update() changed: the bench no longer splits it (scripts/bench/gpu-cpu.mjs)');
     const [three, ours, whole] = timePosedFrames(c.root, c.clip, [
       () => { scope.parent?.updateWorldMatrix(true, false); scope.updateMatrixWorld(true); },
