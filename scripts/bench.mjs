@@ -14,6 +14,7 @@ import { crowdBench } from './bench/crowd.mjs';
 import { loadRealRigs, realRigBench, realRigRows, RATIO_GOAL } from './bench/real-rigs.mjs';
 import { firstPicture, sliderRebuild } from './bench/builds.mjs';
 import { saveFigures } from './bench/figures.mjs';
+import { gpuCpuBench, gpuCpuRows, loadGpuCpuCharacters } from './bench/gpu-cpu.mjs';
 
 const sizesArg = (s) => (s === 'none' ? [] : s.split(',').map((x) => {
   const n = Number(x.replace(/k$/i, '000').replace(/m$/i, '000000'));
@@ -28,6 +29,7 @@ const args = argsOrExit('bench', {
   sections: { parse: (s) => Number(s), default: 6 },
   crowdOnly: { type: 'flag', default: false },
   noCrowd: { type: 'flag', default: false },
+  gpuCpuOnly: { type: 'flag', default: false },
   save: { type: 'flag', default: false },
 }, `usage: npm run bench -- [--sizes 10k,100k,1m|none] [--quick] [--json] [--markdown] [--sections N]
   --sizes     vertex counts of the scaling table (default 10k,100k,1m; --quick: 10k)
@@ -36,6 +38,7 @@ const args = argsOrExit('bench', {
   --markdown  tables as markdown (for docs/benchmarks.md)
   --crowd-only only the crowd bench (CPU vs GPU backend, 1/10/100 characters)
   --no-crowd  everything but the crowd bench
+  --gpu-cpu-only only the GPU backend's CPU time per character-frame (GcsCharacter, crowd of 100; human, CesiumMan, Soldier)
   --save      write the figures the README quotes to docs/figures.json (tests/readme-figures.test.ts checks them)`);
 const quick = args.quick;
 const sizes = args.sizes ?? (quick ? [10000] : [10000, 100000, 1000000]);
@@ -56,7 +59,7 @@ const PAPER = { vertices: 17023, walk: { ms: 24.817, adjusted: 0.4 }, run: { ms:
 const budget = (base) => ({ minSamples: quick ? 60 : 300, minMs: quick ? base / 4 : base, maxMs: quick ? base : 4 * base });
 
 const gcs = await initGcsSkin();
-const results = { machine: machine(), sections, table1: null, comparisons: null, adapter: null, rebuild: null, firstPicture: null, realRigs: null, sizes: [], crowd: null, targets: [] };
+const results = { machine: machine(), sections, gpuCpu: null, table1: null, comparisons: null, adapter: null, rebuild: null, firstPicture: null, realRigs: null, sizes: [], crowd: null, targets: [] };
 
 /** The crowd table: per character and frame, CPU ms and bytes uploaded, CPU vs GPU backend. */
 function printCrowd(crowd) {
@@ -78,19 +81,37 @@ function printCrowd(crowd) {
 const crowdTargetRows = (crowd) => crowd.targets.map((t) => [t.name, t.value === null ? 'n/a' : t.unit === 'bytes' ? `${(t.value / 1024).toFixed(1)} KB` : `${ms(t.value)} ms`,
   t.goal, t.met === null ? `n/a ${t.note}` : t.met ? 'met' : `MISSED (${t.note || 'measured above'})`]);
 
-if (args.crowdOnly) {
-  log('bench: building the default human…');
-  const h = createHuman();
-  results.crowd = await crowdBench(gcs, h, { quick, log });
-  results.targets.push(...results.crowd.targets);
+/** The GPU backend's CPU time per character-frame (scripts/bench/gpu-cpu.mjs), printed. */
+function printGpuCpu(r) {
+  console.log(`\nGPU backend, CPU per character-frame in node (ms, medians): ours = GcsCharacter.update() without three's world matrices ` +
+    `(skin matrices, joint poses into the texture's wasm memory, bounds); three world = the world-matrix update update() runs; ` +
+    `crowd = baked poses + GcsCrowd.update() for ${100} instances per skin, / ${100}; uploads = the per-frame texture`);
+  console.log(fmtTable(gpuCpuRows(r, ms)));
+  for (const s of r.skipped) console.log(`  ${s}`);
+}
+
+/** One part of the bench alone (--crowd-only, --gpu-cpu-only): its result under `key`, printed by `print`, its targets, then exit. */
+function reportPartAndExit(key, part, print) {
+  results[key] = part;
+  results.targets.push(...part.targets);
   if (args.json) {
     console.log(JSON.stringify(results, null, 2));
     process.exit(0);
   }
-  printCrowd(results.crowd);
+  print(part);
   console.log('\nTargets:');
-  console.log(fmtTable([['target', 'value', 'goal', 'result'], ...crowdTargetRows(results.crowd)]));
+  console.log(fmtTable([['target', 'value', 'goal', 'result'], ...crowdTargetRows(part)]));
   process.exit(0);
+}
+
+if (args.gpuCpuOnly) {
+  const g = await loadGpuCpuCharacters(createHuman(), log);
+  reportPartAndExit('gpuCpu', gpuCpuBench(gcs, g.characters, g.skipped, { quick, log }), printGpuCpu);
+}
+
+if (args.crowdOnly) {
+  log('bench: building the default human…');
+  reportPartAndExit('crowd', await crowdBench(gcs, createHuman(), { quick, log }), printCrowd);
 }
 
 /** Frames of a clip at 60 fps (at least 30), as skin-matrix arrays. */
@@ -398,6 +419,12 @@ results.realRigs = { rows: realRigBench(gcs, human, realRigs.characters, { quick
 // ---------------------------------------------------------------- crowds: CPU vs GPU backend
 results.crowd = args.noCrowd ? { rows: [], targets: [], browser: { skipped: 'not run (--no-crowd)' } } : await crowdBench(gcs, createHuman(), { quick, log });
 
+// ---------------------------------------------------------------- the GPU backend's CPU per character-frame
+{
+  const g = await loadGpuCpuCharacters(human, log);
+  results.gpuCpu = gpuCpuBench(gcs, g.characters, g.skipped, { quick, log });
+}
+
 // ---------------------------------------------------------------- targets
 const g = results.table1.methods.gcs ?? {};
 const gcsMs = g.walk ? Math.max(g.walk.medianMs, g.run.medianMs) : null;
@@ -447,7 +474,7 @@ target('classic resampling (17 k)', results.rebuild.classicBestMs, '≤ 30 ms',
   results.rebuild.classicError ? `n/a: ${results.rebuild.classicError.code}: ${results.rebuild.classicError.message}`
     : `best of ${quick ? 2 : 9}; median ${ms(results.rebuild.classicMs)}`);
 
-results.targets.push(...results.crowd.targets);
+results.targets.push(...results.crowd.targets, ...results.gpuCpu.targets);
 if (args.save) saveFigures(results, new URL('../docs/figures.json', import.meta.url));
 
 // ---------------------------------------------------------------- output
@@ -510,12 +537,14 @@ console.log(fmtTable(realRigRows(results.realRigs.rows, ms)));
 for (const s of results.realRigs.skipped) console.log(`  ${s}`);
 
 if (!args.noCrowd) printCrowd(results.crowd);
+printGpuCpu(results.gpuCpu);
 
 console.log('\nTargets:');
 const rows4 = [['target', 'value', 'goal', 'result']];
-for (const t of results.targets.filter((x) => !results.crowd.targets.includes(x))) {
+const partTargets = [...results.crowd.targets, ...results.gpuCpu.targets];
+for (const t of results.targets.filter((x) => !partTargets.includes(x))) {
   const v = t.value === null ? 'n/a' : t.unit === 'ratio' ? `${t.value.toFixed(2)}×` : `${ms(t.value)} ms`;
   rows4.push([t.name, v, t.goal, t.met === null ? `n/a ${t.note}` : t.met ? (t.note ? `met (${t.note})` : 'met') : t.retired ? t.note : t.note ? `MISSED (${t.note})` : 'MISSED']);
 }
-rows4.push(...crowdTargetRows(results.crowd));
+rows4.push(...crowdTargetRows(results.crowd), ...crowdTargetRows(results.gpuCpu));
 console.log(fmtTable(rows4));

@@ -1,11 +1,15 @@
-// Wasm memory at its limits (issue "Reliability"): pointers above 2 GiB reach JavaScript as
-// unsigned offsets, and running out of memory is a GcsError OUT_OF_MEMORY with every object still
-// usable — never an abort of the module.
+// Wasm memory at its limits: pointers above 2 GiB reach JavaScript as unsigned offsets, and
+// running out of memory is a GcsError OUT_OF_MEMORY with every object still usable — never an
+// abort of the module. And in use: the demo's sliders rebuild a model at every move; 200 rebuilds
+// must not grow the heap in use or wasm memory by more than 5 % after the first 40.
 import { describe, expect, test } from 'vitest';
 import * as THREE from 'three';
 import { GcsError, initGcsSkin, type GcsSkin } from '../../web/lib/index.js';
+import { SkinDeformer } from '../../web/lib/three.js';
+import { createHuman } from '../../web/lib/human/index.js';
 import { makeTube, rotationAbout, tubeSkin } from '../helpers/cylinder.js';
 import { gridRig } from '../helpers/grid.js';
+import { loadGlb, sharedModels } from '../helpers/models.js';
 
 const CHUNK = 256 * 1024 * 1024;
 
@@ -92,4 +96,77 @@ describe('wasm memory at its limits', () => {
     ok.dispose();
     rig.dispose();
   }, 180000);
+});
+
+/** The section slider dragged up and back over its stops (web/demo/section-stops.ts): 20 moves a sweep. */
+const SLIDER = [3, 4, 5, 6, 8, 10, 12, 16, 24, 32, 48, 32, 24, 16, 12, 10, 8, 6, 5, 4];
+/** The classic model's contour slider, 20 moves a sweep. */
+const CONTOURS = [8, 10, 12, 14, 16, 18, 20, 22, 24, 25, 26, 28, 26, 24, 22, 20, 18, 16, 12, 10];
+const REBUILDS = 200, SETTLED = 40;
+
+interface Growth { heap: number[]; memory: number[]; heapGrowth: number; memoryGrowth: number }
+
+/**
+ * `rebuild(i)` REBUILDS times, each followed by a frame (update); after each, the heap in use
+ * (gcs_heap_in_use) and wasm memory's size. Growth: the largest of the last sweep over the
+ * largest of the sweep ending at rebuild SETTLED (same settings at the same place in a sweep).
+ */
+function rebuildGrowth(gcs: GcsSkin, skins: SkinDeformer[], rebuild: (skin: SkinDeformer, i: number) => void): Growth {
+  const heap: number[] = [], memory: number[] = [];
+  for (let i = 0; i < REBUILDS; i++) {
+    for (const skin of skins) { rebuild(skin, i); skin.update(); }
+    heap.push(gcs.core.gcs_heap_in_use());
+    memory.push(gcs.memory.buffer.byteLength);
+  }
+  const sweep = SLIDER.length;
+  const peak = (a: number[], end: number) => Math.max(...a.slice(end - sweep, end));
+  return { heap, memory, heapGrowth: peak(heap, REBUILDS) / peak(heap, SETTLED) - 1, memoryGrowth: memory[REBUILDS - 1] / memory[SETTLED - 1] - 1 };
+}
+
+const pct = (x: number) => `${(100 * x).toFixed(2)} %`;
+const mb = (x: number) => `${(x / 2 ** 20).toFixed(1)} MB`;
+
+/** The three kinds of slider rebuild of `sources` (as the demo: a SkinDeformer per skinned mesh), each on a fresh core. */
+async function sliderRebuilds(name: string, sources: THREE.SkinnedMesh[]): Promise<void> {
+  const kinds: { kind: string; options: object; rebuild: (skin: SkinDeformer, i: number) => void }[] = [
+    { kind: 'GCS section slider (CPU backend)', options: { method: 'gcs' }, rebuild: (s, i) => s.rebuild('gcs', { gcs: { sections: SLIDER[i % SLIDER.length] } }) },
+    { kind: 'GCS section slider (GPU backend)', options: { method: 'gcs', backend: 'gpu' }, rebuild: (s, i) => s.rebuild('gcs', { gcs: { sections: SLIDER[i % SLIDER.length] } }) },
+    { kind: 'classic contour slider', options: { method: 'classic' }, rebuild: (s, i) => s.rebuild('classic', { classic: { contours: CONTOURS[i % CONTOURS.length] } }) },
+  ];
+  for (const k of kinds) {
+    const gcs = await initGcsSkin();
+    const skins = sources.map((source) => new SkinDeformer(gcs, source, k.options));
+    const g = rebuildGrowth(gcs, skins, k.rebuild);
+    console.log(`${name}, ${REBUILDS} × ${k.kind}: heap in use ${mb(g.heap[SETTLED - 1])} after ${SETTLED}, ${mb(g.heap[REBUILDS - 1])} after ${REBUILDS} ` +
+      `(peak growth ${pct(g.heapGrowth)}); wasm memory ${mb(g.memory[SETTLED - 1])} → ${mb(g.memory[REBUILDS - 1])} (${pct(g.memoryGrowth)})`);
+    expect(g.heap.every((b) => b > 0)).toBe(true); // the figure is read (not a platform without allocator statistics)
+    expect(g.heapGrowth, `${name}, ${k.kind}: heap in use`).toBeLessThanOrEqual(0.05);
+    expect(g.memoryGrowth, `${name}, ${k.kind}: wasm memory`).toBeLessThanOrEqual(0.05);
+    for (const s of skins) s.dispose();
+    // Everything the skins held is given back.
+    expect(gcs.core.gcs_heap_in_use()).toBe(0);
+  }
+}
+
+describe('slider rebuilds do not leak', () => {
+  test('the heap in use counts what is held: an allocation adds its bytes, freeing it gives them back', async () => {
+    const gcs = await initGcsSkin();
+    const before = gcs.core.gcs_heap_in_use();
+    const p = gcs.core.gcs_alloc(1 << 20);
+    expect(gcs.core.gcs_heap_in_use() - before).toBeGreaterThanOrEqual(1 << 20);
+    gcs.core.gcs_free(p);
+    expect(gcs.core.gcs_heap_in_use()).toBe(before);
+  });
+
+  test('our human: 200 section-slider rebuilds (CPU and GPU backends) and 200 classic rebuilds', async () => {
+    const human = createHuman();
+    await sliderRebuilds('our human', [human.mesh]);
+  }, 240000);
+
+  const shared = sharedModels();
+  const real = shared.files.find((f) => f.endsWith('CesiumMan.glb'));
+  test.skipIf(!real)(`a real rig (CesiumMan): the same${real ? '' : ` (${shared.reason ?? 'skipped: no CesiumMan.glb in the shared models'})`}`, async () => {
+    const model = await loadGlb(real!);
+    await sliderRebuilds('CesiumMan', model.skinnedMeshes);
+  }, 240000);
 });

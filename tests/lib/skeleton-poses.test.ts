@@ -9,6 +9,7 @@ import { GcsCharacter, SkinDeformer } from '../../web/lib/three.js';
 import { SkeletonPoses } from '../../web/lib/three/skeleton-poses.js';
 import { writeSkinMatrices } from '../../web/lib/three/skin-matrices.js';
 import { makeTube } from '../helpers/cylinder.js';
+import { loadGlb, sharedModels } from '../helpers/models.js';
 
 let gcs: GcsSkin;
 beforeAll(async () => {
@@ -84,5 +85,47 @@ describe('each skeleton posed once a frame', () => {
     }
     character.dispose();
     for (const s of separate) s.dispose();
+  });
+
+  // SkeletonPoses keeps boneInverse_j · bindMatrix and multiplies two affine matrices per joint a
+  // frame (skinTails); it must give what writeSkinMatrices' three products give.
+  test('the kept bind factors give writeSkinMatrices\' matrices; a bone that is not affine takes the full product', () => {
+    const a = tubeMesh(undefined, 0.3);
+    a.bones[1].scale.set(1.2, 0.8, 1.1);
+    const poses = new SkeletonPoses();
+    const alone = (m: THREE.SkinnedMesh) => { const s = new Float32Array(48); writeSkinMatrices(m, s); return s; };
+    a.bones[2].rotation.x = 0.3;
+    a.root.updateMatrixWorld(true);
+    poses.nextFrame();
+    expect(Array.from(poses.skinOf(a.mesh))).toEqual(Array.from(alone(a.mesh)));
+    // A projective world matrix on one bone (not a pose three.js makes, but a matrix it accepts).
+    a.bones[2].matrixWorld.elements[3] = 0.25;
+    poses.nextFrame();
+    const skin = poses.skinOf(a.mesh);
+    expect(skin[32 + 3]).not.toBe(0);
+    expect(Array.from(skin)).toEqual(Array.from(alone(a.mesh)));
+  });
+
+  const shared = sharedModels();
+  test.skipIf(!shared.files.length)(`real rigs over their clips: the same matrices as writeSkinMatrices ${shared.reason ?? ''}`, async () => {
+    for (const file of shared.files) {
+      const model = await loadGlb(file);
+      if (!model.clips.length) continue;
+      const mixer = new THREE.AnimationMixer(model.scene);
+      mixer.clipAction(model.clips[0]).play();
+      const poses = new SkeletonPoses();
+      let worst = 0;
+      for (let f = 0; f < 20; f++) {
+        mixer.setTime((model.clips[0].duration * f) / 20);
+        model.scene.updateMatrixWorld(true);
+        poses.nextFrame();
+        for (const m of model.skinnedMeshes) {
+          const mine = poses.skinOf(m), theirs = new Float32Array(mine.length);
+          writeSkinMatrices(m, theirs);
+          for (let k = 0; k < mine.length; k++) worst = Math.max(worst, Math.abs(mine[k] - theirs[k]) / Math.max(1, Math.abs(theirs[k])));
+        }
+      }
+      expect(worst, file).toBeLessThanOrEqual(1e-6);
+    }
   });
 });

@@ -83,6 +83,12 @@ void* gcs_alloc(uint32_t bytes);
 void gcs_free(void* pointer);
 /* Copies `bytes` bytes (memcpy). For benchmarks: the memory bound a deformer is measured against. */
 void gcs_copy_bytes(void* destination, const void* source, uint32_t bytes);
+/*
+ * Bytes of the heap in use now (malloc's allocated bytes: mallinfo's uordblks), for leak checks:
+ * after an object is made and destroyed it returns to where it was. Wasm memory itself only grows
+ * (memory.buffer.byteLength); this says how much of it the library holds.
+ */
+uint32_t gcs_heap_in_use(void);
 
 /* ---------------------------------------------------------------- rig (raw input) */
 

@@ -1,6 +1,8 @@
 #include "memory.h"
+#include <malloc.h>
 #include <cstdlib>
 #include "error.h"
+#include "../include/gcs_skin.h"
 
 namespace gcs {
 
@@ -44,3 +46,13 @@ uint64_t classicPeakBytes(uint64_t v, uint64_t i, uint64_t parts, uint64_t conto
 }
 
 }  // namespace gcs
+
+extern "C" uint32_t gcs_heap_in_use(void) {
+#if defined(__EMSCRIPTEN__)
+  return uint32_t(mallinfo().uordblks);  // dlmalloc's count of allocated bytes
+#elif defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+  return uint32_t(mallinfo2().uordblks);  // native builds (tests, fuzzers)
+#else
+  return 0;  // no allocator statistics on this platform
+#endif
+}

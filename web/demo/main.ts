@@ -95,6 +95,9 @@ Object.assign(window, {
     /** The criterion of the GCS model on screen. */
     criterion: () => state.builtCriterion,
     gcsBuilds: () => state.gcsBuilds,
+    /** For leak checks: wasm memory's size, the core's heap in use (bytes), the geometries and textures the renderer holds. */
+    memory: () => ({ wasmBytes: state.gcs.memory.buffer.byteLength, heapInUse: state.gcs.core.gcs_heap_in_use(),
+      geometries: state.renderer.info.memory.geometries, textures: state.renderer.info.memory.textures }),
     classicError: () => state.current?.classicError ?? null,
     rigidParts: () => state.current?.rigidParts.map((p) => `${p.name}: ${p.reason}`) ?? [],
     readouts: collectReadouts,

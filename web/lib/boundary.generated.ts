@@ -16,6 +16,8 @@ export interface CoreFunctions {
   gcs_free(pointer: number): void;
   /** void gcs_copy_bytes(void* destination, const void* source, uint32_t bytes) */
   gcs_copy_bytes(destination: number, source: number, bytes: number): void;
+  /** uint32_t gcs_heap_in_use(void) */
+  gcs_heap_in_use(): number;
   /** GcsRig* gcs_rig_create(const float* positions, const float* normals, uint32_t vertexCount, const uint32_t* indices, uint32_t indexCount, const uint32_t* joints, const float* weights, uint32_t influences, const int32_t* parents, const float* inverseBind, uint32_t jointCount) */
   gcs_rig_create(positions: number, normals: number, vertexCount: number, indices: number, indexCount: number, joints: number, weights: number, influences: number, parents: number, inverseBind: number, jointCount: number): number;
   /** void gcs_rig_destroy(GcsRig* rig) */
@@ -114,6 +116,7 @@ export const ARGUMENT_COUNTS = {
   gcs_alloc: 1,
   gcs_free: 1,
   gcs_copy_bytes: 3,
+  gcs_heap_in_use: 0,
   gcs_rig_create: 11,
   gcs_rig_destroy: 1,
   gcs_rig_vertex_count: 1,
@@ -165,6 +168,7 @@ export const UNSIGNED_RESULTS = [
   'gcs_version',
   'gcs_last_error_message',
   'gcs_alloc',
+  'gcs_heap_in_use',
   'gcs_rig_create',
   'gcs_rig_vertex_count',
   'gcs_rig_joint_count',

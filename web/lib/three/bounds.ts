@@ -68,7 +68,7 @@ export function boneBounds(input: RigInput, jointCount: number): BoneBounds {
 
 /**
  * The per-frame bounds of the deformed mesh from the skin matrices `skin` (J × 16), written into
- * `box` and `sphere`; `tmp` and `point` are scratch (no allocation).
+ * `box` and `sphere` (no allocation).
  *
  * Each joint j's posed position p_j = S_j b_j and a ball of radius s_j·(k·r_j + grow) (s_j the
  * largest axis scale of S_j; grow = Σ|w_t|·maxDelta_t over the morph influences w_t). LBS moves
@@ -85,22 +85,29 @@ export function boneBounds(input: RigInput, jointCount: number): BoneBounds {
  */
 export function boundsFromBones(
   skin: Float32Array, pivots: Float32Array, balls: BoneBalls, factor: number, grow: number,
-  box: THREE.Box3, sphere: THREE.Sphere, tmp: THREE.Matrix4, point: THREE.Vector3,
+  box: THREE.Box3, sphere: THREE.Sphere,
 ): void {
-  const p = point;
   const { joints, radii } = balls;
   let x0 = Infinity, y0 = Infinity, z0 = Infinity, x1 = -Infinity, y1 = -Infinity, z1 = -Infinity;
+  // Vector3.applyMatrix4 and Matrix4.getMaxScaleOnAxis written out on the array (the same
+  // arithmetic, in the same order): no copy of each matrix into a Matrix4 first.
   for (let i = 0; i < joints.length; i++) {
-    const j = joints[i];
-    tmp.fromArray(skin, 16 * j);
-    p.set(pivots[3 * j], pivots[3 * j + 1], pivots[3 * j + 2]).applyMatrix4(tmp);
-    const r = (radii[j] * factor + grow) * tmp.getMaxScaleOnAxis();
-    if (p.x - r < x0) x0 = p.x - r;
-    if (p.y - r < y0) y0 = p.y - r;
-    if (p.z - r < z0) z0 = p.z - r;
-    if (p.x + r > x1) x1 = p.x + r;
-    if (p.y + r > y1) y1 = p.y + r;
-    if (p.z + r > z1) z1 = p.z + r;
+    const j = joints[i], e = 16 * j;
+    const bx = pivots[3 * j], by = pivots[3 * j + 1], bz = pivots[3 * j + 2];
+    const w = 1 / (skin[e + 3] * bx + skin[e + 7] * by + skin[e + 11] * bz + skin[e + 15]);
+    const px = (skin[e] * bx + skin[e + 4] * by + skin[e + 8] * bz + skin[e + 12]) * w;
+    const py = (skin[e + 1] * bx + skin[e + 5] * by + skin[e + 9] * bz + skin[e + 13]) * w;
+    const pz = (skin[e + 2] * bx + skin[e + 6] * by + skin[e + 10] * bz + skin[e + 14]) * w;
+    const sx = skin[e] * skin[e] + skin[e + 1] * skin[e + 1] + skin[e + 2] * skin[e + 2];
+    const sy = skin[e + 4] * skin[e + 4] + skin[e + 5] * skin[e + 5] + skin[e + 6] * skin[e + 6];
+    const sz = skin[e + 8] * skin[e + 8] + skin[e + 9] * skin[e + 9] + skin[e + 10] * skin[e + 10];
+    const r = (radii[j] * factor + grow) * Math.sqrt(Math.max(sx, sy, sz));
+    if (px - r < x0) x0 = px - r;
+    if (py - r < y0) y0 = py - r;
+    if (pz - r < z0) z0 = pz - r;
+    if (px + r > x1) x1 = px + r;
+    if (py + r > y1) y1 = py + r;
+    if (pz + r > z1) z1 = pz + r;
   }
   setBounds(box, sphere, x0, y0, z0, x1, y1, z1);
 }

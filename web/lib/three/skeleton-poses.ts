@@ -4,13 +4,15 @@
 // object of its own even where they share a glTF skin, so skins match by their bones and inverse
 // bind matrices, not by Skeleton object.
 import * as THREE from 'three';
-import { writeSkinMatrices } from './skin-matrices.js';
+import { skinTails, writeSkinMatrices, writeSkinMatricesWithTails } from './skin-matrices.js';
 
 interface Posed {
   bones: readonly THREE.Bone[];
   boneInverses: readonly THREE.Matrix4[];
   bindMatrix: THREE.Matrix4;
   skin: Float32Array;
+  /** boneInverse_j · bindMatrix per joint (skinTails), or null: the full product every frame. */
+  tails: Float64Array | null;
   frame: number;
 }
 
@@ -35,7 +37,8 @@ export class SkeletonPoses {
   /**
    * `source`'s skin matrices this frame (J × 16 floats, writeSkinMatrices'): written at the first
    * call for its bones and bind matrix, then the same array. Allocates only the first time a
-   * source, or a skeleton, is seen.
+   * source, or a skeleton, is seen; the bones' inverse bind matrices are read then (the skins' GCS
+   * models were built from them), their products with the bind matrix kept (skinTails).
    */
   skinOf(source: THREE.SkinnedMesh): Float32Array {
     let p = this.bySource.get(source);
@@ -44,13 +47,14 @@ export class SkeletonPoses {
       if (!p) {
         const { bones, boneInverses } = source.skeleton;
         p = { bones: [...bones], boneInverses: boneInverses.map((m) => m.clone()), bindMatrix: source.bindMatrix.clone(),
-          skin: new Float32Array(bones.length * 16), frame: -1 };
+          skin: new Float32Array(bones.length * 16), tails: skinTails(source), frame: -1 };
         this.posed.push(p);
       }
       this.bySource.set(source, p);
     }
     if (p.frame !== this.frame) {
-      writeSkinMatrices(source, p.skin, 0, this.tmp);
+      if (p.tails) writeSkinMatricesWithTails(source, p.tails, p.skin, this.tmp);
+      else writeSkinMatrices(source, p.skin, 0, this.tmp);
       p.frame = this.frame;
     }
     return p.skin;

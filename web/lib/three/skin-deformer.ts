@@ -58,7 +58,6 @@ export class SkinDeformer {
   private options: SkinDeformerOptions;
   private readonly skin: Float32Array;
   private readonly tmp = new THREE.Matrix4();
-  private readonly point = new THREE.Vector3();
   /** What update() refreshes: the lowest common ancestor of the source and its bones. */
   private readonly scope: THREE.Object3D;
   private readonly inPlace: boolean;
@@ -316,7 +315,7 @@ export class SkinDeformer {
       if (this.velocity === 'wanted') this.startVelocity();
       deformer.deform(skin); // positions, normals and tangents; the last positions become the previous
     }
-    boundsFromBones(skin, this.pivots, this.balls, this.ballFactor, grow, this.box, this.sphere, this.tmp, this.point);
+    boundsFromBones(skin, this.pivots, this.balls, this.ballFactor, grow, this.box, this.sphere);
     this.exactFresh = false;
     if (this.inPlace && !this.childOfSource) {
       mesh.position.copy(source.position);
