@@ -18,10 +18,13 @@ import {
   abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mrt, screenCoordinate, select, step, texture, textureSize, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
-import { COLLAPSED, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots } from './layout.js';
+import {
+  COLLAPSED, DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, RIGID_JOINT_TOLERANCE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+} from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import type { GpuSections } from './sections.js';
 
+type Bool = Node<'bool'>;
 type Float = Node<'float'>;
 type Int = Node<'int'>;
 type Vec4 = Node<'vec4'>;
@@ -71,7 +74,7 @@ export const gcsRotation = Fn(([q, k2]: [Vec4, Float]) => {
  * (1/kbig, 1/big, 0, −1), R·cof(K/kbig)/big with entries ≤ 1, normals renormalised; a collapsed
  * K gives (0, 0, 0, −1): N = 0, the normal keeps its rest direction.
  */
-const gcsNormalTexel = Fn(([k]: [Mat3]) => {
+export const gcsNormalTexel = Fn(([k]: [Mat3]) => {
   const s = column(k, 0).x.add(column(k, 1).y).add(column(k, 2).z).div(3).toVar();
   const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
   const out = vec4(0, 0, 0, -1).toVar();
@@ -134,6 +137,43 @@ function nodeBlendFunction(slots: TableSlots) {
   }).setLayout({ name: `gcsNodeBlend${slots}`, type: 'mat4', inputs });
 }
 const gcsNodeBlend = { 4: nodeBlendFunction(4), 8: nodeBlendFunction(8) } as const;
+
+/**
+ * s where k is a positive uniform scale s·I within RIGID_JOINT_TOLERANCE × s (the CPU's test for a
+ * uniform frame, per joint; s exactly the diagonal where its entries are equal), else 0: the
+ * GLSL's gcsRigidScale.
+ */
+const gcsRigidScale = Fn(([k]: [Mat3]) => {
+  const diagonal = vec3(column(k, 0).x, column(k, 1).y, column(k, 2).z).toVar();
+  const s = diagonal.x.add(diagonal.y).add(diagonal.z).div(3).toVar();
+  const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
+  const out = float(0).toVar();
+  If(s.greaterThan(0).and(deviation.lessThanEqual(s.mul(RIGID_JOINT_TOLERANCE))), () => {
+    out.assign(select(diagonal.x.equal(diagonal.y).and(diagonal.y.equal(diagonal.z)), diagonal.x, s));
+  });
+  return out;
+}).setLayout({ name: 'gcsRigidScale', type: 'float', inputs: [{ name: 'k', type: 'mat3' }] });
+
+/**
+ * DQS's joint pass: one of a joint's two texels (DQS_TEXELS_PER_JOINT) in the four targets, from
+ * its pose (columns 0–2 the rows of [S | t], column 3 its quaternion q): the first (q, its dual
+ * part ½ (0, t)·q, (u, 0, 0, 0), 0), u = gcsRigidScale(K); the second (the rows of K = Rᵀ S, 0).
+ * The GLSL's DQS_PASS_FRAGMENT.
+ */
+const gcsDqsJointTexels = Fn(([pose, second]: [Mat4, Bool]) => {
+  const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
+  const t = vec3(r0.w, r1.w, r2.w);
+  const k = gcsRotation(q, float(2)).transpose().mul(mat3(r0.xyz, r1.xyz, r2.xyz).transpose()).toVar();
+  const out = mat4(vec4(0), vec4(0), vec4(0), vec4(0)).toVar();
+  If(second, () => {
+    const rows = k.transpose();
+    out.assign(mat4(vec4(column(rows, 0), 0), vec4(column(rows, 1), 0), vec4(column(rows, 2), 0), vec4(0)));
+  }).Else(() => {
+    const dual = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
+    out.assign(mat4(q, dual, vec4(gcsRigidScale(k), 0, 0, 0), vec4(0)));
+  });
+  return out;
+}).setLayout({ name: 'gcsDqsJointTexels', type: 'mat4', inputs: [{ name: 'pose', type: 'mat4' }, { name: 'second', type: 'bool' }] });
 
 // ------------------------------------------------------------ accessors (texel reads, per skin)
 
@@ -213,7 +253,10 @@ export class TslNodePass {
   private glsl: NodePass | null = null;
 
   constructor(readonly sections: GpuSections) {
-    const S = sections.deformer.sectionCount, nodes = sections.instanceCount * S;
+    // DQS: the joint pass, two texels per joint (its quaternion, dual part and uniform scale; K); GCS: one per section.
+    const dqs = sections.method === 'dqs', stride = sections.uniforms.gcsStride.value;
+    const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
+    const nodes = sections.instanceCount * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
     const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     this.target = new THREE.RenderTarget(width, height, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
@@ -221,13 +264,19 @@ export class TslNodePass {
     });
     this.target.textures.forEach((t, i) => { t.name = OUTPUTS[i]; });
     // One fragment per texel: its node from the fragment's position (texels past the last repeat the last node).
-    const joints = texture(sections.texture), table = texture(sections.table as DataTexture), stride = sections.uniforms.gcsStride.value;
+    const joints = texture(sections.texture);
+    const table = dqs ? null : texture(sections.table as DataTexture);
     const texels = Fn(() => {
       const at = ivec2(screenCoordinate);
-      const node = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
-      const instance = node.div(S).toVar();
-      const inputs: JointInputs = { joints, table, slots: sections.tableSlots, first: instance.mul(stride) };
-      return nodeTexels(inputs, node.sub(instance.mul(S)));
+      const texel = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
+      if (dqs) {
+        const node = texel.div(DQS_TEXELS_PER_JOINT).toVar(), instance = node.div(S).toVar();
+        const pose = jointPose({ joints, slots: sections.tableSlots, first: instance.mul(stride) }, node.sub(instance.mul(S)));
+        return gcsDqsJointTexels(pose, texel.notEqual(node.mul(DQS_TEXELS_PER_JOINT)));
+      }
+      const instance = texel.div(S).toVar();
+      const inputs: JointInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride) };
+      return nodeTexels(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
     this.material = new THREE.NodeMaterial();
     this.material.name = 'gcsNodePass';
