@@ -286,7 +286,7 @@ void main() {
 
 /**
  * DQS's joint pass (WebGLRenderer): two fragments per joint of every instance (instance k's joint j
- * is joint k·joints + j, its texels 2·(k·joints + j) and the next; DQS_TEXELS_PER_JOINT): first the
+ * has texels (2j, k) and (2j + 1, k): one row per instance, DQS_TEXELS_PER_JOINT): first the
  * joint's rotation quaternion q, its dual part ½ (0, t)·q and its uniform scale u (0 where K is not
  * one), then the rows of its scale part K = Rᵀ S — what each vertex's dual-quaternion blend needs
  * per joint, computed once per joint and frame instead of once per vertex and influence.
@@ -301,14 +301,12 @@ float gcsRigidScale( const in mat3 k ) {
 	return k[ 0 ][ 0 ] == k[ 1 ][ 1 ] && k[ 1 ][ 1 ] == k[ 2 ][ 2 ] ? k[ 0 ][ 0 ] : s;
 }
 void main() {
-	int texel = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
-	gcsNormal = vec4( 0.0 );
-	if ( texel >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = vec4( 0.0 ); return; }
-	int node = texel / ${DQS_TEXELS_PER_JOINT}, instance = node / gcsSectionCount;
+	int x = int( gl_FragCoord.x ), joint = x / ${DQS_TEXELS_PER_JOINT};
 	mat3 S; vec3 t; vec4 q;
-	gcsJoint( instance * gcsJointStride, node - instance * gcsSectionCount, S, t, q );
+	gcsJoint( int( gl_FragCoord.y ) * gcsJointStride, joint, S, t, q );
 	mat3 K = transpose( gcsRotation( q, 2.0 ) ) * S;
-	if ( texel == node * ${DQS_TEXELS_PER_JOINT} ) {
+	gcsNormal = vec4( 0.0 );
+	if ( x == joint * ${DQS_TEXELS_PER_JOINT} ) {
 		gcsRow0 = q;
 		gcsRow1 = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
 		gcsRow2 = vec4( gcsRigidScale( K ), 0.0, 0.0, 0.0 );
@@ -359,7 +357,7 @@ export function nodePassShaders(slots: TableSlots): {
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
 }
 
-/** DQS's joint pass shaders (GLSL 3: four outputs): one fragment per joint, its quaternion and [K | t] (internal: not an entry's export). */
+/** DQS's joint pass shaders (GLSL 3: four outputs): two fragments per joint, its quaternion, dual part and uniform scale, then its scale part K (internal: not an entry's export). */
 export function dqsPassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${DQS_PASS_FRAGMENT}` };
 }
@@ -514,10 +512,7 @@ vec3 gcsTurnLbs( const in vec3 v, const in mat3 M, const in vec4 q ) {
  * arithmetic of gcsBlend without a centre, step for step.
  */
 const DQS_PARS = /* glsl */ `
-#define GCS_PER_VERTEX
 ${Array.from({ length: GPU_NODE_TEXTURES }, (_, t) => `uniform highp sampler2D gcsNodes${t};`).join('\n')}
-uniform int gcsBase;
-uniform int gcsStride;
 attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
 #if GCS_TABLE_SLOTS > 4
@@ -525,14 +520,17 @@ attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
 #endif
 ${ROTATION}${TURN_JOINT}
-// Texel t of the joint pass's targets.
-ivec2 gcsDqsAt( const in int t ) {
-	int w = textureSize( gcsNodes0, 0 ).x, y = t / w;
-	return ivec2( t - y * w, y );
+// Joint j's first texel in the joint pass's targets (one row per instance: no division per joint).
+ivec2 gcsDqsAt( const in float j ) {
+	#ifdef USE_INSTANCING
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, gl_InstanceID );
+	#else
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, 0 );
+	#endif
 }
-// Joint i's scale part K (columns), from its second texel.
-mat3 gcsDqsScale( const in int i ) {
-	ivec2 at = gcsDqsAt( i * ${DQS_TEXELS_PER_JOINT} + 1 );
+// Joint j's scale part K (columns), from its second texel.
+mat3 gcsDqsScale( const in float j ) {
+	ivec2 at = gcsDqsAt( j ) + ivec2( 1, 0 );
 	return transpose( mat3( texelFetch( gcsNodes0, at, 0 ).xyz, texelFetch( gcsNodes1, at, 0 ).xyz, texelFetch( gcsNodes2, at, 0 ).xyz ) );
 }
 // The normal matrix of M = R·K (R the blend's rotation) as gcsNormalTexel decides it, built
@@ -567,16 +565,12 @@ const DQS_BASE = /* glsl */ `
 	vec3 gcsT;
 	bool gcsNormalise = false;
 	{${SECOND_SET}
-		int base = gcsBase;
-		#ifdef USE_INSTANCING
-		base += gl_InstanceID * gcsStride;
-		#endif
-		vec4 pivot = texelFetch( gcsNodes0, gcsDqsAt( ( base + int( ${INFLUENCE_ATTRIBUTES[0]}.x ) ) * ${DQS_TEXELS_PER_JOINT} ), 0 );
+		vec4 pivot = texelFetch( gcsNodes0, gcsDqsAt( ${INFLUENCE_ATTRIBUTES[0]}.x ), 0 );
 		vec4 br = vec4( 0.0 ), bd = vec4( 0.0 );
 		float s = 0.0;
 		bool rigid = true; // every joint's K is a uniform scale: the blend of scales is s·I
 		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${INFLUENCE}
-			ivec2 at = gcsDqsAt( ( base + int( id ) ) * ${DQS_TEXELS_PER_JOINT} );
+			ivec2 at = gcsDqsAt( id );
 			vec4 q = texelFetch( gcsNodes0, at, 0 );
 			float sw = dot( q, pivot ) < 0.0 ? - w : w;
 			br += sw * q;
@@ -594,7 +588,7 @@ const DQS_BASE = /* glsl */ `
 		} else {
 			mat3 K = mat3( 0.0 );
 			for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${INFLUENCE}
-				K += w * gcsDqsScale( base + int( id ) );
+				K += w * gcsDqsScale( id );
 			}
 			gcsM = R * K;
 			gcsDqsNormal( R, K, gcsN, gcsNormalise );

@@ -11,7 +11,8 @@
  *
  * The node maths lives here once, as small laid-out functions (like three.js's Skinning.js):
  * `nodeTexels` is called by the pass's fragment and, for the previous frame of a velocity pass
- * only, by the vertex stage.
+ * only, by the vertex stage. For DQS the same pass is the joint pass (`gcsDqsJointTexels`: each
+ * joint's quaternion, dual part, uniform scale and scale part), as glsl.ts's.
  */
 import * as THREE from 'three/webgpu';
 import {
@@ -235,7 +236,8 @@ function noFloatTargets(renderer: unknown): boolean {
 
 /**
  * The pass: a QuadMesh over a RenderTarget of GPU_NODE_TEXTURES float textures, one texel per node
- * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide). Runs at the skin's
+ * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide); for method 'dqs' the
+ * joint pass, two texels per joint, one row per instance (DQS_TEXELS_PER_JOINT; gcsDqsJointTexels). Runs at the skin's
  * first draw after `GpuSections.update()` (shadow or colour pass): every pass of that frame reads
  * the same texels, and a frame drawn twice computes them once.
  */
@@ -257,7 +259,8 @@ export class TslNodePass {
     const dqs = sections.method === 'dqs', stride = sections.uniforms.gcsStride.value;
     const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
     const nodes = sections.instanceCount * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
-    const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
+    // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = MAX_WIDTH, read without a division per joint.)
+    const width = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     this.target = new THREE.RenderTarget(width, height, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
       depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
@@ -270,9 +273,9 @@ export class TslNodePass {
       const at = ivec2(screenCoordinate);
       const texel = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
       if (dqs) {
-        const node = texel.div(DQS_TEXELS_PER_JOINT).toVar(), instance = node.div(S).toVar();
-        const pose = jointPose({ joints, slots: sections.tableSlots, first: instance.mul(stride) }, node.sub(instance.mul(S)));
-        return gcsDqsJointTexels(pose, texel.notEqual(node.mul(DQS_TEXELS_PER_JOINT)));
+        const joint = at.x.div(DQS_TEXELS_PER_JOINT).toVar();
+        const pose = jointPose({ joints, slots: sections.tableSlots, first: at.y.mul(stride) }, joint);
+        return gcsDqsJointTexels(pose, at.x.notEqual(joint.mul(DQS_TEXELS_PER_JOINT)));
       }
       const instance = texel.div(S).toVar();
       const inputs: JointInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride) };

@@ -19,7 +19,7 @@ import {
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
-  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, DQS_TEXELS_PER_JOINT, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, DQS_TEXELS_PER_JOINT, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
   GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE,
 } from './layout.js';
 import { column, gcsNormalTexel, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
@@ -217,7 +217,8 @@ const gcsTurnLbs = Fn(([v, m, q]: [Vec3, Mat3, Vec4]) => {
  * Each vertex blends its own joints (4, or 8 with a second set) from the joint poses, at its own
  * weights (the rig's, as the core normalises them; joint −1 where the weight is 0): LBS as the
  * CPU's (M = Σ w S_j; normals by M, then unit length), DQS through the node maths (jointBlend) with
- * no centre, normals as the joint-level path turns an unblended one.
+ * no centre, normals as the joint-level path turns an unblended one. (DQS with a joint pass reads
+ * its parts instead, dqsVertex; this is a velocity pass's previous frame.)
  */
 function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slots: 4 | 8): VertexTransform {
   const ids: Vec4[] = [], weights: Vec4[] = [];
@@ -249,40 +250,34 @@ function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slot
   return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnLbs(v, m, q) };
 }
 
-/** A texel index of the pass's targets as integer coordinates (row-major, the targets' width). */
-function passAt(nodes: TextureNode, i: Int): Node<'ivec2'> {
-  const w = int((textureSize(nodes) as unknown as Node<'ivec2'>).x);
-  const y = i.div(w);
-  return ivec2(i.sub(y.mul(w)), y);
-}
-
 /**
  * DQS from the joint pass's targets (node-pass-tsl.ts, DQS_TEXELS_PER_JOINT; the GLSL's DQS_BASE):
  * per influence the joint's quaternion, dual part and uniform scale as the pass wrote them, the
  * blend; then M = s·R and the normal by R where every joint of the vertex is a uniform scale (the
  * CPU's quaternion-only path: no scale part read), else the scale parts K_j blended, M = R·K and
- * the normal matrix of gcsNormalTexel(K). `first`: this instance's first joint.
+ * the normal matrix of gcsNormalTexel(K). `row`: this instance's row of the targets.
  */
-function dqsVertex(nodes: TextureNode[], first: Int, slots: 4 | 8): VertexTransform {
+function dqsVertex(nodes: TextureNode[], row: Int, slots: 4 | 8): VertexTransform {
   const lanes = ['x', 'y', 'z', 'w'] as const;
   const ids: Vec4[] = [], weights: Vec4[] = [];
   for (let g = 0; g < slots / 4; g++) {
     ids.push(attribute<'vec4'>(INFLUENCE_ATTRIBUTES[g], 'vec4'));
     weights.push(attribute<'vec4'>(WEIGHT_ATTRIBUTES[g], 'vec4'));
   }
-  const joint = (c: number) => first.add(int(ids[c >> 2][lanes[c & 3]].max(0)));
+  // Joint j's first texel (one row per instance: no division per joint).
+  const at = (c: number, texel = 0) => ivec2(int(ids[c >> 2][lanes[c & 3]].max(0)).mul(DQS_TEXELS_PER_JOINT).add(texel), row);
   // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early continue).
   const weight = (c: number) => weights[c >> 2][lanes[c & 3]].mul(step(0, ids[c >> 2][lanes[c & 3]]));
-  const pivot = nodes[0].load(passAt(nodes[0], joint(0).mul(DQS_TEXELS_PER_JOINT))).toVar();
+  const pivot = nodes[0].load(at(0)).toVar();
   const br = vec4(0).toVar(), bd = vec4(0).toVar(), s = float(0).toVar(), rigid = bool(true).toVar();
   for (let c = 0; c < slots; c++) {
     const w = weight(c).toVar();
-    const at = passAt(nodes[0], joint(c).mul(DQS_TEXELS_PER_JOINT)).toVar();
-    const q = nodes[0].load(at).toVar();
+    const first = at(c).toVar();
+    const q = nodes[0].load(first).toVar();
     const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
     br.addAssign(q.mul(sw));
-    bd.addAssign(nodes[1].load(at).mul(sw));
-    const u = nodes[2].load(at).x.toVar();
+    bd.addAssign(nodes[1].load(first).mul(sw));
+    const u = nodes[2].load(first).x.toVar();
     s.addAssign(w.mul(u));
     rigid.assign(rigid.and(u.greaterThan(0).or(w.greaterThan(0).not())));
   }
@@ -293,8 +288,8 @@ function dqsVertex(nodes: TextureNode[], first: Int, slots: 4 | 8): VertexTransf
   If(rigid.not(), () => {
     const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
     for (let c = 0; c < slots; c++) {
-      const at = passAt(nodes[0], joint(c).mul(DQS_TEXELS_PER_JOINT).add(1)).toVar();
-      k.addAssign(mat3(nodes[0].load(at).xyz, nodes[1].load(at).xyz, nodes[2].load(at).xyz).transpose().mul(weight(c)));
+      const second = at(c, 1).toVar();
+      k.addAssign(mat3(nodes[0].load(second).xyz, nodes[1].load(second).xyz, nodes[2].load(second).xyz).transpose().mul(weight(c)));
     }
     m.assign(r.mul(k));
     const texel = gcsNormalTexel(k).toVar();
@@ -325,7 +320,7 @@ const passTextures = (pass: TslNodePass): TextureNode[] => Array.from({ length: 
 
 /**
  * How each vertex moves: path 'sections' from the section transforms; path 'joints' from the node
- * pass's targets (`pass`, `nodeFirst` this instance's first node), or, without one (a velocity
+ * pass's targets (`pass`, `nodeFirst` this instance's first node; DQS's joint pass: its row), or, without one (a velocity
  * pass's previous frame, or a caller that built no pass), from nodes computed here from the joint
  * poses (`perFrame`, `first` this instance's first joint texel).
  */
@@ -368,8 +363,8 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
   return Fn((builder: NodeBuilder) => {
     const has = (name: string) => builder.geometry?.getAttribute(name) !== undefined;
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
-    // The pass's nodes per instance: sections, or (DQS's joint pass) joints.
-    const perInstance = sections.method === 'dqs' ? stride.value / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
+    // This instance's first node in the pass's targets (DQS's joint pass: its row).
+    const perInstance = sections.method === 'dqs' ? 1 : sections.deformer.sectionCount;
     const nodeFirst = (instanced ? int(instanceIndex).mul(perInstance) : int(0)).toVar();
     const vertex = vertexTransform(sections, perFrame, first, pass, nodeFirst);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
