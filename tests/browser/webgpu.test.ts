@@ -317,8 +317,10 @@ describe.skipIf(!!reason || !!noCesium8)('velocity on WebGPURenderer: a velocity
   // A crowd in plain mode: with velocity, three.js adds the previous instance matrices (4 vertex
   // attributes) to the crowd's 4 + 4, and the smooth mode's two section attributes would pass
   // WebGL2's 16 (docs/gpu.md).
-  for (const kind of ['joints', 'sections', 'cpu', 'crowd'] as const) {
-    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : `GPU backend, ${kind} path`;
+  // The joints path, the crowd and DQS read the previous frame's nodes (or joint parts) from the node
+  // pass's targets of the run before; the sections path from the previous frame's section texels.
+  for (const kind of ['joints', 'sections', 'cpu', 'crowd', 'dqs'] as const) {
+    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : kind === 'dqs' ? 'GPU backend, DQS' : `GPU backend, ${kind} path`;
     test(`CesiumMan walking, ${what}: velocity as three.js's skinning writes it; paused, zero`, async () => {
       const r = await call<{ backends: string[]; vsThree: number; moving: number; largest: number; pausedLargest: number; threePausedLargest: number }>(
         'velocity', `/@fs${CESIUM_8_SOURCE}`, kind, 0.5, 1 / 30, kind === 'crowd' ? { smooth: false } : {});

@@ -421,10 +421,10 @@ export interface VelocityResult {
 
 /**
  * A walking character drawn through a velocity MRT pass by our skin (`kind`: the GPU backend on a
- * path, the CPU backend, or a one-instance crowd) and by three.js's own skinning of the same clip,
+ * path, GPU DQS, the CPU backend, or a one-instance crowd) and by three.js's own skinning of the same clip,
  * two frames `dt` apart; then our skin paused (the same time drawn again).
  */
-async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'crowd', time: number, dt: number, gcsOptions: GcsOptions = {}, clipName?: string): Promise<VelocityResult> {
+async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'crowd' | 'dqs', time: number, dt: number, gcsOptions: GcsOptions = {}, clipName?: string): Promise<VelocityResult> {
   const gcs = await gcsReady;
   const renderer = await gpuRenderer();
   const ours = await load(model), three = await load(model);
@@ -444,7 +444,8 @@ async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'cr
     skinned.visible = false;
     oursScene.add(crowd.mesh);
   } else {
-    character = new GcsCharacter(gcs, ours.root, { gcs: gcsOptions, backend: kind === 'cpu' ? 'cpu' : 'gpu', gpuPath: kind === 'cpu' ? 'auto' : kind });
+    character = kind === 'dqs' ? new GcsCharacter(gcs, ours.root, { backend: 'gpu', method: 'dqs' })
+      : new GcsCharacter(gcs, ours.root, { gcs: gcsOptions, backend: kind === 'cpu' ? 'cpu' : 'gpu', gpuPath: kind === 'cpu' ? 'auto' : kind });
   }
   const pose = (t: number) => {
     threeMixer.setTime(t);

@@ -253,6 +253,14 @@ export class TslNodePass {
   private readonly views: TextureNode[];
   /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
   private glsl: NodePass | null = null;
+  /**
+   * Velocity: a copy of the targets as the run before wrote them (copied on the GPU before each
+   * run) and the views a velocity pass's previous positions read; made on first use
+   * (previousTextureNode).
+   */
+  private previous: { target: THREE.RenderTarget; views: TextureNode[]; filled: boolean } | null = null;
+  /** The renderer's frame (info.frame) of the last run: a frame drawn without a new run has no motion. */
+  private runFrame = -1;
 
   constructor(readonly sections: GpuSections) {
     // DQS: the joint pass, two texels per joint (its quaternion, dual part and uniform scale; K); GCS: one per section.
@@ -298,6 +306,25 @@ export class TslNodePass {
   }
 
   /**
+   * Velocity: a view of target i as the frame before drew it (the run before this frame's), for a
+   * velocity pass's previous positions: the nodes of the previous frame, read as this frame's are,
+   * not blended again per vertex. Until a second run, and in a frame drawn without a new run, it
+   * shows this frame's (no motion).
+   */
+  previousTextureNode(i: number): TextureNode {
+    if (!this.previous) {
+      const target = this.target.clone();
+      this.previous = { target, views: target.textures.map((t) => texture(t)), filled: false };
+    }
+    return this.previous.views[i];
+  }
+
+  /** The vertex stage's views of the previous frame's targets (previousTextureNode), as textureNode gives this frame's. */
+  previousViews(): { textureNode(i: number): TextureNode } {
+    return { textureNode: (i) => this.previousTextureNode(i) };
+  }
+
+  /**
    * Writes every node of every instance for the current joint poses, unless already written since
    * the last GpuSections.update(); returns why `renderer` cannot, or null. WebGPURenderer: this
    * pass (restoring the render target, cube face, mip level and MRT). A WebGLRenderer with
@@ -318,9 +345,17 @@ export class TslNodePass {
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
     this.show(this.target.textures);
-    const version = this.sections.version;
-    if (this.drawn === version) return null;
+    const version = this.sections.version, frame = r.info.frame;
+    const previous = this.previous;
+    if (this.drawn === version) {
+      // Drawn again in a new frame without an update: no motion (the previous frame's nodes are these).
+      if (previous && frame !== this.runFrame) { this.keepPrevious(r); this.runFrame = frame; }
+      return null;
+    }
+    // The nodes this run overwrites become the previous frame's (the first run has none: no motion).
+    if (previous && this.drawn >= 0) this.keepPrevious(r);
     this.drawn = version;
+    this.runFrame = frame;
     this.runs++;
     const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
     const outputMRT = r.getMRT(), autoClear = r.autoClear;
@@ -334,6 +369,23 @@ export class TslNodePass {
     return null;
   }
 
+  /**
+   * Velocity, before each draw that reads previousTextureNode: until the previous frame's copy has
+   * been made (its targets were made by the draw's shader build, after this frame's run), this
+   * frame's nodes are copied in (no motion rather than an unwritten texture).
+   */
+  fillPrevious(renderer: unknown): void {
+    const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
+    if (this.previous && !this.previous.filled && this.drawn >= 0 && r?.isWebGPURenderer) this.keepPrevious(r);
+  }
+
+  /** Copies the targets into the previous frame's (four small GPU copies). */
+  private keepPrevious(renderer: THREE.WebGPURenderer): void {
+    const previous = this.previous!;
+    this.target.textures.forEach((t, i) => renderer.copyTextureToTexture(t, previous.target.textures[i]));
+    previous.filled = true;
+  }
+
   /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
   private show(textures: THREE.Texture[]): void {
     for (let i = 0; i < this.views.length; i++) if (this.views[i].value !== textures[i]) this.views[i].value = textures[i];
@@ -341,6 +393,7 @@ export class TslNodePass {
 
   dispose(): void {
     this.target.dispose();
+    this.previous?.target.dispose();
     this.material.dispose();
     this.glsl?.dispose();
   }

@@ -315,8 +315,11 @@ export function previousPositionNode(): Node<'vec3'> {
   })();
 }
 
+/** What the vertex stage reads of a node pass: this frame's targets (TslNodePass) or the frame before's (its previousViews()). */
+type PassViews = Pick<TslNodePass, 'textureNode'>;
+
 /** The vertex stage's views of the pass's targets. */
-const passTextures = (pass: TslNodePass): TextureNode[] => Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i));
+const passTextures = (pass: PassViews): TextureNode[] => Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i));
 
 /**
  * How each vertex moves: path 'sections' from the section transforms; path 'joints' from the node
@@ -324,7 +327,7 @@ const passTextures = (pass: TslNodePass): TextureNode[] => Array.from({ length: 
  * pass's previous frame, or a caller that built no pass), from nodes computed here from the joint
  * poses (`perFrame`, `first` this instance's first joint texel).
  */
-function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: TslNodePass | null, nodeFirst: Int): VertexTransform {
+function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: PassViews | null, nodeFirst: Int): VertexTransform {
   if (sections.method === 'dqs' && pass) return dqsVertex(passTextures(pass), nodeFirst, sections.tableSlots);
   if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
   if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
@@ -370,8 +373,12 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
     if (needsPreviousData(builder)) {
-      OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
-      const previous = vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
+      // With a node pass, the previous frame's nodes are its targets of the run before (no per-vertex node maths).
+      if (pass) OnObjectUpdate(({ renderer }) => pass.fillPrevious(renderer));
+      const previous = pass ? vertexTransform(sections, perFrame, first, pass.previousViews(), nodeFirst) : (() => {
+        OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
+        return vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
+      })();
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
     }
     if (has('normal')) {
