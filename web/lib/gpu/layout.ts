@@ -60,10 +60,11 @@ export const BLEND_THIRD_ATTRIBUTE = 'gcsBlendThird';
 export const PREVIOUS_POSITION_ATTRIBUTE = 'gcsPreviousPosition';
 
 /**
- * DQS's joint pass: texels per joint in its four targets. Texel 2j: the rotation quaternion q_j,
- * the dual part d_j = ½ (0, t_j)·q_j, then (u_j, 0, 0, 0) with u_j = s_j where the joint's scale
- * part K_j = R_jᵀ S_j is a positive uniform scale s_j·I (within RIGID_JOINT_TOLERANCE), else 0.
- * Texel 2j + 1: the rows of K_j, read only by vertices with a joint whose u_j is 0.
+ * DQS's joint pass: texels per joint in its four targets, one row per instance. Texel (2j, k): the
+ * rotation quaternion q_j, the dual part d_j = ½ (0, t_j)·q_j, then (u_j, 0, 0, 0) with u_j = s_j
+ * where the joint's scale part K_j = R_jᵀ S_j is a positive uniform scale s_j·I (within
+ * RIGID_JOINT_TOLERANCE), else 0. Texel (2j + 1, k): the rows of K_j, read only by vertices with a
+ * joint whose u_j is 0. (2 · GCS_MAX_JOINTS = 2048 texels: a row fits WebGL2's guaranteed width.)
  */
 export const DQS_TEXELS_PER_JOINT = 2;
 
