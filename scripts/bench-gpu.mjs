@@ -2,8 +2,9 @@
 // Chromium: N characters drawn by three.js's SkinnedMesh and by each GPU path and method of
 // gcs-skin, interleaved in one page; prints ms per frame and the ratio to three.js.
 //
-//   npm run bench:gpu                       our human ×8 and Soldier ×16 (../shared/models), 640×360 and 64×36
-//   npm run bench:gpu -- --model human --n 8 --size 640x360 --frames 40 --methods three,gpu,crowd
+//   npm run bench:gpu                       our human ×8 and Soldier ×16 (../shared/models), 640×360 and 64×36,
+//                                           on WebGLRenderer, then on WebGPURenderer (its WebGL2 backend here)
+//   npm run bench:gpu -- --model human --n 8 --size 640x360 --frames 40 --methods three,gpu,crowd --renderer webgl
 //
 // Headless Chromium here draws with SwiftShader, a CPU rasteriser: its vertex and fragment shaders
 // run on the CPU, so the figures are a proxy for shader arithmetic, not a GPU's timings. On a
@@ -28,6 +29,9 @@ if (!arg('model') && !existsSync(soldier)) console.log(`Soldier skipped: ${soldi
 const sizes = (arg('size') ? [arg('size')] : ['640x360', '64x36']).map((s) => s.split('x').map(Number));
 const frames = Number(arg('frames', 30));
 const methods = arg('methods');
+const renderers = (arg('renderer') ?? 'webgl,webgpu').split(',');
+// WebGPURenderer: three.js's SkinnedMesh against gcs-skin/webgpu's default, DQS and LBS.
+const webgpuMethods = arg('methods') ?? 'three,gpu,dqs,lbs';
 
 const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
 if (!existsSync(chromiumPath)) {
@@ -49,12 +53,13 @@ const context = await chromium.launchPersistentContext(mkdtempSync(join(tmpdir()
 const results = [];
 try {
   for (const c of cases) {
-    for (const [w, h] of sizes) {
+    for (const [w, h] of sizes) for (const renderer of renderers) {
       const page = await context.newPage();
       const errors = [];
       page.on('pageerror', (e) => errors.push(String(e)));
       const model = c.model === 'human' ? 'human' : `/@fs${c.model}`;
-      const q = new URLSearchParams({ bench: 'gpu', model, n: String(c.n), w: String(w), h: String(h), frames: String(frames), ...(methods ? { methods } : {}) });
+      const which = renderer === 'webgpu' ? { renderer: 'webgpu', forceWebGL: '1', methods: webgpuMethods } : methods ? { methods } : {};
+      const q = new URLSearchParams({ bench: 'gpu', model, n: String(c.n), w: String(w), h: String(h), frames: String(frames), ...which });
       await page.goto(`http://127.0.0.1:${port}/?${q}`);
       // The page leaves its result on window.__benchGpu (web/demo/bench-gpu.ts).
       await page.waitForFunction(() => /** @type {any} */ (window).__benchGpu !== undefined, null, { timeout: 120000 });

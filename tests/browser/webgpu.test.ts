@@ -175,6 +175,34 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
     });
   }
 
+  // DQS's joint pass (node-pass-tsl.ts): two texels per joint (quaternion, dual part, uniform scale;
+  // the scale part K), TSL against GLSL from the same joint poses; the vertex stage blends them,
+  // the quaternion-only way where every joint of the vertex is a uniform scale, else with the
+  // scale parts (the hips scaled non-uniformly: every joint below them).
+  interface DqsPassResult { backends: string[]; joints: number; rows: number; largest: number; scale: number; rigid: number; runs: number[]; vertexJointMaths: boolean; vsCpu: Diff; vsRest: Diff; coverage: number }
+  for (const [name, model, missing, times, clip, boneScale] of [
+    ['the human', 'human-morph', false, [0.3, 0.7], 'walk', undefined],
+    ['the human, hips scaled (1.3, 0.7, 1.1)', 'human-morph', false, [0.3, 0.7], 'walk', [1.3, 0.7, 1.1]],
+    ['Soldier.glb', `/@fs${soldier}`, noSoldier, [0.2, 0.55], 'Run', undefined],
+  ] as const) {
+    test.skipIf(missing)(`DQS joint pass, ${name}: once per frame, TSL texels = GLSL texels, GPU = CPU`, async () => {
+      const r = await call<DqsPassResult>('dqsPass', model, times, clip, boneScale);
+      console.log(`DQS joint pass ${name}: ${r.joints} joints (${r.rigid} a uniform scale) in ${r.rows} row(s); TSL vs GLSL texels within ${r.largest.toExponential(2)} (translations' dual parts up to ${r.scale.toFixed(3)}); runs ${r.runs.join(', ')}; ` +
+        `vertex shader joint maths ${r.vertexJointMaths}; GPU vs CPU ${pct(r.vsCpu)}; vs the rest pose ${pct(r.vsRest)}`);
+      expect(r.backends).toEqual(r.backends.map(() => 'gpu'));
+      expect(r.runs).toEqual([1, 2, 2, 3]); // the rest pose, a frame, the same frame drawn again, the next frame
+      expect(r.vertexJointMaths).toBe(false);
+      expect(r.scale).toBeGreaterThan(0);
+      expect(r.largest).toBeLessThanOrEqual(1e-5 * Math.max(1, r.scale));
+      if (boneScale) expect(r.rigid).toBeLessThan(r.joints / 2); // most joints take the scale blend
+      else expect(r.rigid).toBe(r.joints); // a clip without scale: every joint the quaternion-only way
+      expect(r.coverage).toBeGreaterThan(0.02);
+      expect(r.vsCpu.image).toBeLessThanOrEqual(PIXEL_SHARE);
+      expect(r.vsRest.covered).toBeGreaterThan(0.05);
+      expect(fixture.errors).toEqual([]);
+    });
+  }
+
   interface Fallback { before: string; after: string; note: string; warnings: string[]; vsCpu: Diff; firstVsCpu: Diff; firstCoverage: number; error: string }
   const fallback = (which: string) => call<Fallback>('fallback', `/@fs${cesium}`, which);
   /** Ran on the CPU from the first draw on: a note, one warning, and the right picture from the second frame. */
@@ -289,8 +317,10 @@ describe.skipIf(!!reason || !!noCesium8)('velocity on WebGPURenderer: a velocity
   // A crowd in plain mode: with velocity, three.js adds the previous instance matrices (4 vertex
   // attributes) to the crowd's 4 + 4, and the smooth mode's two section attributes would pass
   // WebGL2's 16 (docs/gpu.md).
-  for (const kind of ['joints', 'sections', 'cpu', 'crowd'] as const) {
-    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : `GPU backend, ${kind} path`;
+  // The joints path, the crowd and DQS read the previous frame's nodes (or joint parts) from the node
+  // pass's targets of the run before; the sections path from the previous frame's section texels.
+  for (const kind of ['joints', 'sections', 'cpu', 'crowd', 'dqs'] as const) {
+    const what = kind === 'crowd' ? 'a crowd of one (plain)' : kind === 'cpu' ? 'CPU backend (previous positions kept by the core)' : kind === 'dqs' ? 'GPU backend, DQS' : `GPU backend, ${kind} path`;
     test(`CesiumMan walking, ${what}: velocity as three.js's skinning writes it; paused, zero`, async () => {
       const r = await call<{ backends: string[]; vsThree: number; moving: number; largest: number; pausedLargest: number; threePausedLargest: number }>(
         'velocity', `/@fs${CESIUM_8_SOURCE}`, kind, 0.5, 1 / 30, kind === 'crowd' ? { smooth: false } : {});

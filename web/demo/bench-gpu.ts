@@ -6,6 +6,8 @@
 // rasteriser such as SwiftShader, the shaders themselves). `npm run bench:gpu` drives it headless.
 //
 //   ?bench=gpu&model=human|<glTF URL>&n=8&w=640&h=360&frames=40&clip=Run&methods=three,gpu,crowd,...
+//   &renderer=webgpu   three/webgpu's WebGPURenderer instead (three.js's SkinnedMesh on it against
+//                      gcs-skin/webgpu); &forceWebGL=1 its WebGL2 backend (headless Chromium has no WebGPU)
 //
 // Results: the page's table, and window.__benchGpu (a promise of the rows) for scripts.
 import * as THREE from 'three';
@@ -15,6 +17,7 @@ import { initGcsSkin, type DeformerKind, type GcsSkin } from '../lib/index.js';
 import { GcsCharacter, writeSkinMatrices, type GcsCharacterOptions } from '../lib/three.js';
 import { GcsCrowd } from '../lib/crowd.js';
 import { createHuman } from '../lib/human/index.js';
+import { glContext, rendererLabel, type DemoRenderer } from './renderer.js';
 
 const query = new URLSearchParams(location.search);
 
@@ -44,12 +47,15 @@ function layout(roots: THREE.Object3D[], spacing: number): void {
   roots.forEach((r, i) => r.position.set(((i % cols) - (cols - 1) / 2) * spacing, 0, -Math.floor(i / cols) * spacing));
 }
 
+/** gcs-skin/three's classes, or gcs-skin/webgpu's under WebGPURenderer (set by run() before any method is made). */
+const entry: { Character: typeof GcsCharacter; Crowd: typeof GcsCrowd } = { Character: GcsCharacter, Crowd: GcsCrowd };
+
 function characters(options: GcsCharacterOptions): (gcs: GcsSkin, sources: THREE.Object3D[]) => Drawn {
   return (gcs, sources) => {
     const scene = stageScene();
     const list = sources.map((root) => {
       scene.add(root);
-      return new GcsCharacter(gcs, root, options);
+      return new entry.Character(gcs, root, options);
     });
     return {
       scene,
@@ -70,7 +76,7 @@ function crowd(gcs: GcsSkin, sources: THREE.Object3D[]): Drawn {
     return out;
   };
   const perSource = sources.map(skinsOf);
-  const crowds = perSource[0].map((skin) => new GcsCrowd(gcs, skin, sources.length));
+  const crowds = perSource[0].map((skin) => new entry.Crowd(gcs, skin, sources.length));
   for (const root of sources) {
     scene.add(root);
     for (const s of skinsOf(root)) s.visible = false; // posed by the mixer, drawn by the crowd
@@ -177,14 +183,25 @@ async function run(): Promise<BenchResult> {
   const wanted = (query.get('methods') ?? METHODS.map((m) => m.name).join(',')).split(',');
   const methods = METHODS.filter((m) => wanted.includes(m.name));
 
-  const renderer = new THREE.WebGLRenderer({ antialias: false, powerPreference: 'high-performance' });
+  let renderer: DemoRenderer;
+  if (query.get('renderer') === 'webgpu') {
+    const webgpu = await import('three/webgpu');
+    const entryModule = await import('../lib/webgpu.js');
+    entry.Character = entryModule.GcsCharacter;
+    entry.Crowd = entryModule.GcsCrowd;
+    renderer = new webgpu.WebGPURenderer({ antialias: false, powerPreference: 'high-performance', forceWebGL: query.get('forceWebGL') === '1' });
+    await renderer.init();
+  } else {
+    renderer = new THREE.WebGLRenderer({ antialias: false, powerPreference: 'high-performance' });
+  }
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
   document.body.replaceChildren(renderer.domElement);
-  const gl = renderer.getContext() as WebGL2RenderingContext;
-  const timerExt = gl.getExtension('EXT_disjoint_timer_query_webgl2') as { TIME_ELAPSED_EXT: number; GPU_DISJOINT_EXT: number } | null;
-  const debug = gl.getExtension('WEBGL_debug_renderer_info');
-  const rendererName = debug ? String(gl.getParameter(debug.UNMASKED_RENDERER_WEBGL)) : String(gl.getParameter(gl.RENDERER));
+  const gl = glContext(renderer);
+  const timerExt = gl?.getExtension('EXT_disjoint_timer_query_webgl2') as { TIME_ELAPSED_EXT: number; GPU_DISJOINT_EXT: number } | null;
+  const debug = gl?.getExtension('WEBGL_debug_renderer_info');
+  const rendererName = `${rendererLabel(renderer)}: ${gl ? (debug ? String(gl.getParameter(debug.UNMASKED_RENDERER_WEBGL)) : String(gl.getParameter(gl.RENDERER))) : 'WebGPU'}`;
+  const waitForGpu = gpuWait(renderer, gl);
 
   const gcs = await initGcsSkin();
   const { make, clips } = await loadModel(model);
@@ -206,27 +223,26 @@ async function run(): Promise<BenchResult> {
   camera.position.copy(centre).add(new THREE.Vector3(0, 0.35, 1).normalize().multiplyScalar(extent * 1.05));
   camera.lookAt(centre);
 
-  const pixel = new Uint8Array(4);
   const pose = (r: (typeof runs)[number], f: number) => r.mixers.forEach((m, i) => m.setTime(f / 30 + i * 0.137));
-  const frame = (r: (typeof runs)[number]): { ms: number; update: number } => {
+  const frame = async (r: (typeof runs)[number]): Promise<{ ms: number; update: number }> => {
     const t0 = performance.now();
     r.drawn.update();
     const t1 = performance.now();
     renderer.render(r.drawn.scene, camera);
-    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    await waitForGpu();
     return { ms: performance.now() - t0, update: t1 - t0 };
   };
   // Warm-up: compile every program, first uploads.
-  for (const r of runs) for (let f = 0; f < 3; f++) { pose(r, f); r.sources.forEach((s) => s.updateMatrixWorld(true)); frame(r); }
+  for (const r of runs) for (let f = 0; f < 3; f++) { pose(r, f); r.sources.forEach((s) => s.updateMatrixWorld(true)); await frame(r); }
   for (let f = 0; f < frames; f++) {
     // Interleaved, the order rotated each frame.
     for (let k = 0; k < runs.length; k++) {
       const r = runs[(k + f) % runs.length];
       pose(r, f);
       let query: WebGLQuery | null = null;
-      if (timerExt) { query = gl.createQuery(); gl.beginQuery(timerExt.TIME_ELAPSED_EXT, query!); }
-      const t = frame(r);
-      if (timerExt && query) {
+      if (gl && timerExt) { query = gl.createQuery(); gl.beginQuery(timerExt.TIME_ELAPSED_EXT, query!); }
+      const t = await frame(r);
+      if (gl && timerExt && query) {
         gl.endQuery(timerExt.TIME_ELAPSED_EXT);
         await new Promise((res) => setTimeout(res, 0));
         for (let tries = 0; tries < 100 && !gl.getQueryParameter(query, gl.QUERY_RESULT_AVAILABLE); tries++) await new Promise((res) => setTimeout(res, 1));
@@ -246,6 +262,25 @@ async function run(): Promise<BenchResult> {
   for (const r of runs) r.drawn.dispose();
   renderer.dispose();
   return { model, n, width, height, frames, timer: !!timerExt, renderer: rendererName, rows };
+}
+
+/**
+ * What waits until the GPU has drawn the frame: on WebGL2 a one-pixel readPixels from the canvas
+ * (a read-back waits for every draw into it; the renderer's read binding restored), on WebGPU the
+ * queue's submitted work.
+ */
+function gpuWait(renderer: DemoRenderer, gl: WebGL2RenderingContext | null): () => Promise<void> {
+  if (!gl) {
+    const device = (renderer as unknown as { backend: { device: { queue: { onSubmittedWorkDone(): Promise<void> } } } }).backend.device;
+    return () => device.queue.onSubmittedWorkDone();
+  }
+  const pixel = new Uint8Array(4);
+  return async () => {
+    const bound = gl.getParameter(gl.READ_FRAMEBUFFER_BINDING) as WebGLFramebuffer | null;
+    if (bound) gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    if (bound) gl.bindFramebuffer(gl.READ_FRAMEBUFFER, bound);
+  };
 }
 
 /** Runs the bench and shows its table on the page. */

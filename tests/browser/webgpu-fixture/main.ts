@@ -421,10 +421,10 @@ export interface VelocityResult {
 
 /**
  * A walking character drawn through a velocity MRT pass by our skin (`kind`: the GPU backend on a
- * path, the CPU backend, or a one-instance crowd) and by three.js's own skinning of the same clip,
+ * path, GPU DQS, the CPU backend, or a one-instance crowd) and by three.js's own skinning of the same clip,
  * two frames `dt` apart; then our skin paused (the same time drawn again).
  */
-async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'crowd', time: number, dt: number, gcsOptions: GcsOptions = {}, clipName?: string): Promise<VelocityResult> {
+async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'crowd' | 'dqs', time: number, dt: number, gcsOptions: GcsOptions = {}, clipName?: string): Promise<VelocityResult> {
   const gcs = await gcsReady;
   const renderer = await gpuRenderer();
   const ours = await load(model), three = await load(model);
@@ -444,7 +444,8 @@ async function velocity(model: string, kind: 'joints' | 'sections' | 'cpu' | 'cr
     skinned.visible = false;
     oursScene.add(crowd.mesh);
   } else {
-    character = new GcsCharacter(gcs, ours.root, { gcs: gcsOptions, backend: kind === 'cpu' ? 'cpu' : 'gpu', gpuPath: kind === 'cpu' ? 'auto' : kind });
+    character = kind === 'dqs' ? new GcsCharacter(gcs, ours.root, { backend: 'gpu', method: 'dqs' })
+      : new GcsCharacter(gcs, ours.root, { gcs: gcsOptions, backend: kind === 'cpu' ? 'cpu' : 'gpu', gpuPath: kind === 'cpu' ? 'auto' : kind });
   }
   const pose = (t: number) => {
     threeMixer.setTime(t);
@@ -629,8 +630,96 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
   };
 }
 
-declare global {
-  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences; velocity: typeof velocity; normalMapped: typeof normalMapped; nodePass: typeof nodePass } }
+export interface DqsPassResult {
+  backends: string[];
+  /** joints the pass holds (two texels each) and the rows of its targets */
+  joints: number; rows: number;
+  /** the largest |TSL − GLSL| over every texel of the four targets, and the largest |translation| for scale */
+  largest: number; scale: number;
+  /** joints whose scale part the pass found a uniform scale (u > 0: their vertices take the quaternion-only path) */
+  rigid: number;
+  /** the joint pass's runs after the rest pose, the first frame, that frame drawn again, the next frame */
+  runs: number[];
+  /** the vertex shader: whether it still computes the joint parts (the per-vertex node maths, or the pass's own functions) */
+  vertexJointMaths: boolean;
+  /** GPU (TSL, joint pass) vs CPU backend pictures, and GPU vs the unanimated picture */
+  vsCpu: { image: number; covered: number }; vsRest: { image: number; covered: number }; coverage: number;
 }
-window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences, velocity, normalMapped, nodePass };
+
+/**
+ * DQS on WebGPURenderer: the TSL joint pass's four targets read back against the GLSL joint pass
+ * (node-pass.ts, on a WebGLRenderer) from the same joint poses, texel by texel; how often it runs;
+ * the picture against the CPU backend's. `boneScale`: the first bone's scale multiplied by it (a
+ * non-uniform scale puts a scale part that is not s·I in the joints below it: the vertex stage's
+ * scale blend instead of the quaternion-only path).
+ */
+async function dqsPass(model: string, times: [number, number], clipName?: string, boneScale?: [number, number, number]): Promise<DqsPassResult> {
+  const gcs = await gcsReady;
+  const renderer = await gpuRenderer();
+  const loaded = await load(model);
+  const { scene, camera } = stage(loaded.root);
+  const character = new GcsCharacter(gcs, loaded.root, { backend: 'gpu', method: 'dqs' });
+  character.update();
+  const rest = await draw(renderer, scene, camera);
+  let bone: THREE.Object3D | undefined;
+  loaded.root.traverse((o) => { if (!bone && (o as THREE.Bone).isBone) bone = o; });
+  const baseScale = bone!.scale.clone();
+  const mixer = play(loaded, clipName);
+  const pose = (t: number) => {
+    bone!.scale.copy(baseScale);
+    mixer.setTime(t);
+    if (boneScale) bone!.scale.multiply(new THREE.Vector3(...boneScale));
+    character.update();
+  };
+  const skin = character.skins[0];
+  const material = (Array.isArray(skin.mesh.material) ? skin.mesh.material[0] : skin.mesh.material) as THREE.Material;
+  const pass = material.userData.gcsNodePass as TslNodePass;
+  const runs = [pass.runs];
+  pose(times[0]);
+  const gpu = await draw(renderer, scene, camera);
+  runs.push(pass.runs);
+  await draw(renderer, scene, camera);
+  runs.push(pass.runs);
+  pose(times[1]);
+  await draw(renderer, scene, camera);
+  runs.push(pass.runs);
+  const vertexShader = (await renderer.debug.getShaderAsync(scene, camera, skin.mesh)).vertexShader ?? '';
+  // The GLSL pass from the same GpuSections (joint poses of the last update()), on a WebGLRenderer.
+  const gl = glRenderer();
+  const glsl = new NodePass(pass.sections);
+  glsl.render(gl);
+  const { width, height: rows } = pass.target;
+  const joints = pass.sections.uniforms.gcsStride.value / 4;
+  let largest = 0, scale = 0, rigid = 0;
+  for (let t = 0; t < 4; t++) {
+    const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
+    const theirs = new Float32Array(4 * width * rows);
+    gl.readRenderTargetPixels(glsl.target, 0, 0, width, rows, theirs, undefined, t);
+    for (let n = 0; n < 2 * joints; n++) {
+      const x = n % width, y = Math.floor(n / width);
+      const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);
+      for (let k = 0; k < 4; k++) largest = Math.max(largest, Math.abs(ours[a + k] - theirs[b + k]));
+      if (t === 1 && n % 2 === 0) for (let k = 0; k < 3; k++) scale = Math.max(scale, Math.abs(theirs[b + k]));
+      if (t === 2 && n % 2 === 0 && theirs[b] > 0) rigid++;
+    }
+  }
+  glsl.dispose();
+  gl.dispose();
+  const backends = character.skins.map((s) => s.backend); // still 'gpu' after drawing: no fallback happened
+  // The first frame again, on the CPU backend.
+  character.rebuild(undefined, { backend: 'cpu' });
+  pose(times[0]);
+  const cpu = await draw(renderer, scene, camera);
+  character.dispose();
+  return {
+    backends, joints, rows, largest, scale, rigid, runs,
+    vertexJointMaths: /gcsNodeBlend|gcsDqsJointTexels|gcsRigidScale/.test(vertexShader),
+    vsCpu: differing(gpu, cpu), vsRest: differing(gpu, rest), coverage: coverage(gpu),
+  };
+}
+
+declare global {
+  interface Window { __webgpu: { check: typeof check; glslVsTsl: typeof glslVsTsl; crowd: typeof crowd; fallback: typeof fallback; crowdOnWrongRenderer: typeof crowdOnWrongRenderer; influences: typeof influences; velocity: typeof velocity; normalMapped: typeof normalMapped; nodePass: typeof nodePass; dqsPass: typeof dqsPass } }
+}
+window.__webgpu = { check, glslVsTsl, crowd, fallback, crowdOnWrongRenderer, influences, velocity, normalMapped, nodePass, dqsPass };
 

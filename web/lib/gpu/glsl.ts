@@ -7,7 +7,7 @@ import { checkString } from '../arguments.js';
 import { asGiven, GcsError } from '../errors.js';
 import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, GPU_TEXELS_PER_JOINT,
-  GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, type GpuMethod, type GpuPath, type TableSlots,
+  DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_SECTION, LENGTH_FIX, RIGID_JOINT_TOLERANCE, NEAR_TRACE, NEAR_TRACE3, SECTION_ATTRIBUTE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, type GpuMethod, type GpuPath, type TableSlots,
 } from './layout.js';
 
 /** GLSL's spelling of a float constant (always with a decimal point or exponent). */
@@ -285,23 +285,36 @@ void main() {
 `;
 
 /**
- * DQS's joint pass (WebGLRenderer): one fragment per joint of every instance (instance k's joint j
- * is k·joints + j), four outputs: the joint's rotation quaternion, then the rows of its scale part
- * K_j = R_jᵀ S_j with its translation in w — what each vertex's dual-quaternion blend needs per
- * joint, computed once per joint and frame instead of once per vertex and influence.
+ * DQS's joint pass (WebGLRenderer): two fragments per joint of every instance (instance k's joint j
+ * has texels (2j, k) and (2j + 1, k): one row per instance, DQS_TEXELS_PER_JOINT): first the
+ * joint's rotation quaternion q, its dual part ½ (0, t)·q and its uniform scale u (0 where K is not
+ * one), then the rows of its scale part K = Rᵀ S — what each vertex's dual-quaternion blend needs
+ * per joint, computed once per joint and frame instead of once per vertex and influence.
  */
 const DQS_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}${NODE_MATHS}
+// s where k is a positive uniform scale s·I within ${RIGID_JOINT_TOLERANCE} × s (the CPU's test for a
+// uniform frame, per joint; s exactly the diagonal where its entries are equal), else 0.
+float gcsRigidScale( const in mat3 k ) {
+	float s = ( k[ 0 ][ 0 ] + k[ 1 ][ 1 ] + k[ 2 ][ 2 ] ) / 3.0;
+	vec3 e = max( max( abs( k[ 0 ] - vec3( s, 0.0, 0.0 ) ), abs( k[ 1 ] - vec3( 0.0, s, 0.0 ) ) ), abs( k[ 2 ] - vec3( 0.0, 0.0, s ) ) );
+	if ( ! ( s > 0.0 && max( max( e.x, e.y ), e.z ) <= ${f(RIGID_JOINT_TOLERANCE)} * s ) ) return 0.0;
+	return k[ 0 ][ 0 ] == k[ 1 ][ 1 ] && k[ 1 ][ 1 ] == k[ 2 ][ 2 ] ? k[ 0 ][ 0 ] : s;
+}
 void main() {
-	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
-	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
-	int instance = node / gcsSectionCount;
+	int x = int( gl_FragCoord.x ), joint = x / ${DQS_TEXELS_PER_JOINT};
 	mat3 S; vec3 t; vec4 q;
-	gcsJoint( instance * gcsJointStride, node - instance * gcsSectionCount, S, t, q );
+	gcsJoint( int( gl_FragCoord.y ) * gcsJointStride, joint, S, t, q );
 	mat3 K = transpose( gcsRotation( q, 2.0 ) ) * S;
-	gcsRow0 = q;
-	gcsRow1 = vec4( K[ 0 ][ 0 ], K[ 1 ][ 0 ], K[ 2 ][ 0 ], t.x );
-	gcsRow2 = vec4( K[ 0 ][ 1 ], K[ 1 ][ 1 ], K[ 2 ][ 1 ], t.y );
-	gcsNormal = vec4( K[ 0 ][ 2 ], K[ 1 ][ 2 ], K[ 2 ][ 2 ], t.z );
+	gcsNormal = vec4( 0.0 );
+	if ( x == joint * ${DQS_TEXELS_PER_JOINT} ) {
+		gcsRow0 = q;
+		gcsRow1 = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+		gcsRow2 = vec4( gcsRigidScale( K ), 0.0, 0.0, 0.0 );
+	} else {
+		gcsRow0 = vec4( K[ 0 ][ 0 ], K[ 1 ][ 0 ], K[ 2 ][ 0 ], 0.0 );
+		gcsRow1 = vec4( K[ 0 ][ 1 ], K[ 1 ][ 1 ], K[ 2 ][ 1 ], 0.0 );
+		gcsRow2 = vec4( K[ 0 ][ 2 ], K[ 1 ][ 2 ], K[ 2 ][ 2 ], 0.0 );
+	}
 }
 `;
 
@@ -344,7 +357,7 @@ export function nodePassShaders(slots: TableSlots): {
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
 }
 
-/** DQS's joint pass shaders (GLSL 3: four outputs): one fragment per joint, its quaternion and [K | t] (internal: not an entry's export). */
+/** DQS's joint pass shaders (GLSL 3: four outputs): two fragments per joint, its quaternion, dual part and uniform scale, then its scale part K (internal: not an entry's export). */
 export function dqsPassShaders(slots: TableSlots): { vertexShader: string; fragmentShader: string } {
   return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${DQS_PASS_FRAGMENT}` };
 }
@@ -493,14 +506,13 @@ vec3 gcsTurnLbs( const in vec3 v, const in mat3 M, const in vec4 q ) {
 
 /**
  * DQS (the CPU's dqsVertices) from the joint pass's textures: per influence the joint's quaternion,
- * its dual part from (q, t), and K_j as the pass wrote them; the blend, M = R·K, T and the normal
- * texel once per vertex. The arithmetic of gcsBlend without a centre, step for step.
+ * dual part and uniform scale as the pass wrote them; the blend, then M = s·R and the normal by R
+ * where every joint of the vertex is a uniform scale (the CPU's quaternion-only path: no scale
+ * parts read), else the scale parts K_j blended, M = R·K and the normal texel's matrix — the
+ * arithmetic of gcsBlend without a centre, step for step.
  */
 const DQS_PARS = /* glsl */ `
-#define GCS_PER_VERTEX
 ${Array.from({ length: GPU_NODE_TEXTURES }, (_, t) => `uniform highp sampler2D gcsNodes${t};`).join('\n')}
-uniform int gcsBase;
-uniform int gcsStride;
 attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
 #if GCS_TABLE_SLOTS > 4
@@ -508,14 +520,18 @@ attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
 #endif
 ${ROTATION}${TURN_JOINT}
-// Joint i (counted over all instances) as the joint pass wrote it: q, K (columns) and t.
-void gcsDqsJoint( const in int i, out vec4 q, out mat3 K, out vec3 t ) {
-	int w = textureSize( gcsNodes0, 0 ).x, y = i / w;
-	ivec2 at = ivec2( i - y * w, y );
-	q = texelFetch( gcsNodes0, at, 0 );
-	vec4 r0 = texelFetch( gcsNodes1, at, 0 ), r1 = texelFetch( gcsNodes2, at, 0 ), r2 = texelFetch( gcsNodes3, at, 0 );
-	K = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
-	t = vec3( r0.w, r1.w, r2.w );
+// Joint j's first texel in the joint pass's targets (one row per instance: no division per joint).
+ivec2 gcsDqsAt( const in float j ) {
+	#ifdef USE_INSTANCING
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, gl_InstanceID );
+	#else
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, 0 );
+	#endif
+}
+// Joint j's scale part K (columns), from its second texel.
+mat3 gcsDqsScale( const in float j ) {
+	ivec2 at = gcsDqsAt( j ) + ivec2( 1, 0 );
+	return transpose( mat3( texelFetch( gcsNodes0, at, 0 ).xyz, texelFetch( gcsNodes1, at, 0 ).xyz, texelFetch( gcsNodes2, at, 0 ).xyz ) );
 }
 // The normal matrix of M = R·K (R the blend's rotation) as gcsNormalTexel decides it, built
 // directly: R where K is a positive uniform scale (1e-4; the CPU's s·R, normalised), else
@@ -535,39 +551,48 @@ void gcsDqsNormal( const in mat3 R, const in mat3 k, out mat3 N, out bool renorm
 }
 `;
 
-const DQS_BASE = /* glsl */ `
-	mat3 gcsM, gcsN;
-	vec3 gcsT;
-	bool gcsNormalise;
-	{${SECOND_SET}
-		int base = gcsBase;
-		#ifdef USE_INSTANCING
-		base += gl_InstanceID * gcsStride;
-		#endif
-		vec4 q, pivot, br = vec4( 0.0 ), bd = vec4( 0.0 );
-		mat3 Kj, K = mat3( 0.0 );
-		vec3 t;
-		gcsDqsJoint( base + int( ${INFLUENCE_ATTRIBUTES[0]}.x ), q, Kj, t );
-		pivot = q;
-		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
+/** Influence k of the vertex: its joint id and weight (the second set past 4). */
+const INFLUENCE = /* glsl */ `
 			#if GCS_TABLE_SLOTS > 4
 			float id = k < 4 ? ${INFLUENCE_ATTRIBUTES[0]}[ k ] : gcsJ1[ k - 4 ], w = k < 4 ? ${WEIGHT_ATTRIBUTES[0]}[ k ] : gcsW1[ k - 4 ];
 			#else
 			float id = ${INFLUENCE_ATTRIBUTES[0]}[ k ], w = ${WEIGHT_ATTRIBUTES[0]}[ k ];
 			#endif
-			if ( ! ( w > 0.0 ) ) continue;
-			if ( k > 0 ) gcsDqsJoint( base + int( id ), q, Kj, t );
-			vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+			if ( ! ( w > 0.0 ) ) continue;`;
+
+const DQS_BASE = /* glsl */ `
+	mat3 gcsM, gcsN;
+	vec3 gcsT;
+	bool gcsNormalise = false;
+	{${SECOND_SET}
+		vec4 pivot = texelFetch( gcsNodes0, gcsDqsAt( ${INFLUENCE_ATTRIBUTES[0]}.x ), 0 );
+		vec4 br = vec4( 0.0 ), bd = vec4( 0.0 );
+		float s = 0.0;
+		bool rigid = true; // every joint's K is a uniform scale: the blend of scales is s·I
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${INFLUENCE}
+			ivec2 at = gcsDqsAt( id );
+			vec4 q = texelFetch( gcsNodes0, at, 0 );
 			float sw = dot( q, pivot ) < 0.0 ? - w : w;
 			br += sw * q;
-			bd += sw * d;
-			K += w * Kj;
+			bd += sw * texelFetch( gcsNodes1, at, 0 );
+			float u = texelFetch( gcsNodes2, at, 0 ).x;
+			s += w * u;
+			rigid = rigid && u > 0.0;
 		}
 		float inv2 = 1.0 / dot( br, br );
 		gcsT = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
 		mat3 R = gcsRotation( br, 2.0 * inv2 );
-		gcsM = R * K;
-		gcsDqsNormal( R, K, gcsN, gcsNormalise );
+		if ( rigid ) {
+			gcsM = s * R;
+			gcsN = R;
+		} else {
+			mat3 K = mat3( 0.0 );
+			for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${INFLUENCE}
+				K += w * gcsDqsScale( id );
+			}
+			gcsM = R * K;
+			gcsDqsNormal( R, K, gcsN, gcsNormalise );
+		}
 	}
 `;
 

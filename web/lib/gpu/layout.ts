@@ -59,6 +59,22 @@ export const BLEND_THIRD_ATTRIBUTE = 'gcsBlendThird';
  */
 export const PREVIOUS_POSITION_ATTRIBUTE = 'gcsPreviousPosition';
 
+/**
+ * DQS's joint pass: texels per joint in its four targets, one row per instance. Texel (2j, k): the
+ * rotation quaternion q_j, the dual part d_j = ½ (0, t_j)·q_j, then (u_j, 0, 0, 0) with u_j = s_j
+ * where the joint's scale part K_j = R_jᵀ S_j is a positive uniform scale s_j·I (within
+ * RIGID_JOINT_TOLERANCE), else 0. Texel (2j + 1, k): the rows of K_j, read only by vertices with a
+ * joint whose u_j is 0. (2 · GCS_MAX_JOINTS = 2048 texels: a row fits WebGL2's guaranteed width.)
+ */
+export const DQS_TEXELS_PER_JOINT = 2;
+
+/**
+ * DQS: a joint's K_j counts as s_j·I when every entry is within this × s_j of it: the CPU's test
+ * for a frame whose every K is s·I (decomposeEach), per joint. A vertex all of whose joints pass
+ * it is moved by s·R (no scale blend, the normal by R), as the CPU's quaternion-only path.
+ */
+export const RIGID_JOINT_TOLERANCE = 1e-5;
+
 /** The CPU's test for "the scale part K is a positive uniform scale": every entry within this × s of s·I. */
 export const UNIFORM_SCALE_TOLERANCE = 1e-4;
 /** Below this a largest entry counts as zero (a collapsed scale): the normal keeps its rotation. */

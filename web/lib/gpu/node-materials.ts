@@ -86,7 +86,8 @@ export const tslKit: GpuMaterialKit = {
   support: nodeMaterialSupport,
   build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
     // Joint-level path: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
-    const pass = sections.method === 'gcs' && sections.path === 'joints' ? new TslNodePass(sections) : null;
+    // DQS: the same pass, two texels per joint (its quaternion, dual part, uniform scale and scale part, once per frame).
+    const pass = (sections.method === 'gcs' && sections.path === 'joints') || sections.method === 'dqs' ? new TslNodePass(sections) : null;
     const convert = (m: THREE.Material) => {
       const material = toNodeMaterial(m);
       material.positionNode = gcsPositionNode(sections, instances !== null, pass);

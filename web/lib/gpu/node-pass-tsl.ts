@@ -11,17 +11,21 @@
  *
  * The node maths lives here once, as small laid-out functions (like three.js's Skinning.js):
  * `nodeTexels` is called by the pass's fragment and, for the previous frame of a velocity pass
- * only, by the vertex stage.
+ * only, by the vertex stage. For DQS the same pass is the joint pass (`gcsDqsJointTexels`: each
+ * joint's quaternion, dual part, uniform scale and scale part), as glsl.ts's.
  */
 import * as THREE from 'three/webgpu';
 import {
   abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mrt, screenCoordinate, select, step, texture, textureSize, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
-import { COLLAPSED, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots } from './layout.js';
+import {
+  COLLAPSED, DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, RIGID_JOINT_TOLERANCE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
+} from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import type { GpuSections } from './sections.js';
 
+type Bool = Node<'bool'>;
 type Float = Node<'float'>;
 type Int = Node<'int'>;
 type Vec4 = Node<'vec4'>;
@@ -71,7 +75,7 @@ export const gcsRotation = Fn(([q, k2]: [Vec4, Float]) => {
  * (1/kbig, 1/big, 0, −1), R·cof(K/kbig)/big with entries ≤ 1, normals renormalised; a collapsed
  * K gives (0, 0, 0, −1): N = 0, the normal keeps its rest direction.
  */
-const gcsNormalTexel = Fn(([k]: [Mat3]) => {
+export const gcsNormalTexel = Fn(([k]: [Mat3]) => {
   const s = column(k, 0).x.add(column(k, 1).y).add(column(k, 2).z).div(3).toVar();
   const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
   const out = vec4(0, 0, 0, -1).toVar();
@@ -135,6 +139,43 @@ function nodeBlendFunction(slots: TableSlots) {
 }
 const gcsNodeBlend = { 4: nodeBlendFunction(4), 8: nodeBlendFunction(8) } as const;
 
+/**
+ * s where k is a positive uniform scale s·I within RIGID_JOINT_TOLERANCE × s (the CPU's test for a
+ * uniform frame, per joint; s exactly the diagonal where its entries are equal), else 0: the
+ * GLSL's gcsRigidScale.
+ */
+const gcsRigidScale = Fn(([k]: [Mat3]) => {
+  const diagonal = vec3(column(k, 0).x, column(k, 1).y, column(k, 2).z).toVar();
+  const s = diagonal.x.add(diagonal.y).add(diagonal.z).div(3).toVar();
+  const deviation = largest(k.sub(mat3(vec3(s, 0, 0), vec3(0, s, 0), vec3(0, 0, s))));
+  const out = float(0).toVar();
+  If(s.greaterThan(0).and(deviation.lessThanEqual(s.mul(RIGID_JOINT_TOLERANCE))), () => {
+    out.assign(select(diagonal.x.equal(diagonal.y).and(diagonal.y.equal(diagonal.z)), diagonal.x, s));
+  });
+  return out;
+}).setLayout({ name: 'gcsRigidScale', type: 'float', inputs: [{ name: 'k', type: 'mat3' }] });
+
+/**
+ * DQS's joint pass: one of a joint's two texels (DQS_TEXELS_PER_JOINT) in the four targets, from
+ * its pose (columns 0–2 the rows of [S | t], column 3 its quaternion q): the first (q, its dual
+ * part ½ (0, t)·q, (u, 0, 0, 0), 0), u = gcsRigidScale(K); the second (the rows of K = Rᵀ S, 0).
+ * The GLSL's DQS_PASS_FRAGMENT.
+ */
+const gcsDqsJointTexels = Fn(([pose, second]: [Mat4, Bool]) => {
+  const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
+  const t = vec3(r0.w, r1.w, r2.w);
+  const k = gcsRotation(q, float(2)).transpose().mul(mat3(r0.xyz, r1.xyz, r2.xyz).transpose()).toVar();
+  const out = mat4(vec4(0), vec4(0), vec4(0), vec4(0)).toVar();
+  If(second, () => {
+    const rows = k.transpose();
+    out.assign(mat4(vec4(column(rows, 0), 0), vec4(column(rows, 1), 0), vec4(column(rows, 2), 0), vec4(0)));
+  }).Else(() => {
+    const dual = vec4(q.w.mul(t).add(cross(t, q.xyz)), dot(t, q.xyz).negate()).mul(0.5);
+    out.assign(mat4(q, dual, vec4(gcsRigidScale(k), 0, 0, 0), vec4(0)));
+  });
+  return out;
+}).setLayout({ name: 'gcsDqsJointTexels', type: 'mat4', inputs: [{ name: 'pose', type: 'mat4' }, { name: 'second', type: 'bool' }] });
+
 // ------------------------------------------------------------ accessors (texel reads, per skin)
 
 /** The node maths' inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
@@ -195,7 +236,8 @@ function noFloatTargets(renderer: unknown): boolean {
 
 /**
  * The pass: a QuadMesh over a RenderTarget of GPU_NODE_TEXTURES float textures, one texel per node
- * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide). Runs at the skin's
+ * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide); for method 'dqs' the
+ * joint pass, two texels per joint, one row per instance (DQS_TEXELS_PER_JOINT; gcsDqsJointTexels). Runs at the skin's
  * first draw after `GpuSections.update()` (shadow or colour pass): every pass of that frame reads
  * the same texels, and a frame drawn twice computes them once.
  */
@@ -211,23 +253,41 @@ export class TslNodePass {
   private readonly views: TextureNode[];
   /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
   private glsl: NodePass | null = null;
+  /**
+   * Velocity: a copy of the targets as the run before wrote them (copied on the GPU before each
+   * run) and the views a velocity pass's previous positions read; made on first use
+   * (previousTextureNode).
+   */
+  private previous: { target: THREE.RenderTarget; views: TextureNode[]; filled: boolean } | null = null;
+  /** The renderer's frame (info.frame) of the last run: a frame drawn without a new run has no motion. */
+  private runFrame = -1;
 
   constructor(readonly sections: GpuSections) {
-    const S = sections.deformer.sectionCount, nodes = sections.instanceCount * S;
-    const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
+    // DQS: the joint pass, two texels per joint (its quaternion, dual part and uniform scale; K); GCS: one per section.
+    const dqs = sections.method === 'dqs', stride = sections.uniforms.gcsStride.value;
+    const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
+    const nodes = sections.instanceCount * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
+    // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = MAX_WIDTH, read without a division per joint.)
+    const width = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     this.target = new THREE.RenderTarget(width, height, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
       depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
     });
     this.target.textures.forEach((t, i) => { t.name = OUTPUTS[i]; });
     // One fragment per texel: its node from the fragment's position (texels past the last repeat the last node).
-    const joints = texture(sections.texture), table = texture(sections.table as DataTexture), stride = sections.uniforms.gcsStride.value;
+    const joints = texture(sections.texture);
+    const table = dqs ? null : texture(sections.table as DataTexture);
     const texels = Fn(() => {
       const at = ivec2(screenCoordinate);
-      const node = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
-      const instance = node.div(S).toVar();
-      const inputs: JointInputs = { joints, table, slots: sections.tableSlots, first: instance.mul(stride) };
-      return nodeTexels(inputs, node.sub(instance.mul(S)));
+      const texel = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
+      if (dqs) {
+        const joint = at.x.div(DQS_TEXELS_PER_JOINT).toVar();
+        const pose = jointPose({ joints, slots: sections.tableSlots, first: at.y.mul(stride) }, joint);
+        return gcsDqsJointTexels(pose, at.x.notEqual(joint.mul(DQS_TEXELS_PER_JOINT)));
+      }
+      const instance = texel.div(S).toVar();
+      const inputs: JointInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride) };
+      return nodeTexels(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
     this.material = new THREE.NodeMaterial();
     this.material.name = 'gcsNodePass';
@@ -243,6 +303,25 @@ export class TslNodePass {
   /** The vertex stage's view of target i (0–2: rows of [M | T], 3: the normal texel); one node per target, shared by every material. */
   textureNode(i: number): TextureNode {
     return this.views[i];
+  }
+
+  /**
+   * Velocity: a view of target i as the frame before drew it (the run before this frame's), for a
+   * velocity pass's previous positions: the nodes of the previous frame, read as this frame's are,
+   * not blended again per vertex. Until a second run, and in a frame drawn without a new run, it
+   * shows this frame's (no motion).
+   */
+  previousTextureNode(i: number): TextureNode {
+    if (!this.previous) {
+      const target = this.target.clone();
+      this.previous = { target, views: target.textures.map((t) => texture(t)), filled: false };
+    }
+    return this.previous.views[i];
+  }
+
+  /** The vertex stage's views of the previous frame's targets (previousTextureNode), as textureNode gives this frame's. */
+  previousViews(): { textureNode(i: number): TextureNode } {
+    return { textureNode: (i) => this.previousTextureNode(i) };
   }
 
   /**
@@ -266,9 +345,17 @@ export class TslNodePass {
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
     this.show(this.target.textures);
-    const version = this.sections.version;
-    if (this.drawn === version) return null;
+    const version = this.sections.version, frame = r.info.frame;
+    const previous = this.previous;
+    if (this.drawn === version) {
+      // Drawn again in a new frame without an update: no motion (the previous frame's nodes are these).
+      if (previous && frame !== this.runFrame) { this.keepPrevious(r); this.runFrame = frame; }
+      return null;
+    }
+    // The nodes this run overwrites become the previous frame's (the first run has none: no motion).
+    if (previous && this.drawn >= 0) this.keepPrevious(r);
     this.drawn = version;
+    this.runFrame = frame;
     this.runs++;
     const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
     const outputMRT = r.getMRT(), autoClear = r.autoClear;
@@ -282,6 +369,23 @@ export class TslNodePass {
     return null;
   }
 
+  /**
+   * Velocity, before each draw that reads previousTextureNode: until the previous frame's copy has
+   * been made (its targets were made by the draw's shader build, after this frame's run), this
+   * frame's nodes are copied in (no motion rather than an unwritten texture).
+   */
+  fillPrevious(renderer: unknown): void {
+    const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
+    if (this.previous && !this.previous.filled && this.drawn >= 0 && r?.isWebGPURenderer) this.keepPrevious(r);
+  }
+
+  /** Copies the targets into the previous frame's (four small GPU copies). */
+  private keepPrevious(renderer: THREE.WebGPURenderer): void {
+    const previous = this.previous!;
+    this.target.textures.forEach((t, i) => renderer.copyTextureToTexture(t, previous.target.textures[i]));
+    previous.filled = true;
+  }
+
   /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
   private show(textures: THREE.Texture[]): void {
     for (let i = 0; i < this.views.length; i++) if (this.views[i].value !== textures[i]) this.views[i].value = textures[i];
@@ -289,6 +393,7 @@ export class TslNodePass {
 
   dispose(): void {
     this.target.dispose();
+    this.previous?.target.dispose();
     this.material.dispose();
     this.glsl?.dispose();
   }

@@ -12,7 +12,7 @@
 import * as THREE from 'three';
 import { checkObject } from '../arguments.js';
 import { dqsPassShaders, nodePassShaders } from './glsl.js';
-import { GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
+import { DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** The widest row of the node textures: WebGL2's guaranteed 2048. */
@@ -29,8 +29,9 @@ type Renderer = THREE.WebGLRenderer;
 /**
  * Computes every node's transform and normal matrix once per frame into float render targets that
  * the joint-level vertex stage reads (see the module comment). For GPU DQS (sections of method
- * 'dqs') it is the joint pass: one texel per joint of every instance, its rotation quaternion and
- * the rows of [K | t] (K = Rᵀ·S), which the DQS vertex stage blends.
+ * 'dqs') it is the joint pass: two texels per joint, one row per instance (DQS_TEXELS_PER_JOINT:
+ * its rotation quaternion, dual part and uniform scale, then the rows of K = Rᵀ·S), which the DQS
+ * vertex stage blends.
  */
 export class NodePass {
   /** The float render target (GPU_NODE_TEXTURES textures, one texel per node of every instance) the pass draws into. */
@@ -51,12 +52,13 @@ export class NodePass {
   constructor(readonly sections: GpuSections) {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
-    // DQS: one "node" per joint (the joint pass: its quaternion and [K | t]); GCS: per section.
+    // DQS: the joint pass, two texels per joint (q, dual part, uniform scale; K), one row per
+    // instance (2 · GCS_MAX_JOINTS = MAX_WIDTH). GCS: one texel per section, rows of MAX_WIDTH.
     const dqs = sections.method === 'dqs';
     const deformer = sections.deformer, N = sections.instanceCount;
     const S = dqs ? sections.uniforms.gcsStride.value as number / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
-    const nodes = N * S;
-    const width = Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
+    const nodes = N * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
+    const width = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
     // One texel per node in each of four float targets: the node pass computes a node once and writes it whole.
     this.target = new THREE.WebGLRenderTarget(width, height, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,

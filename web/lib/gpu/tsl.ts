@@ -19,10 +19,10 @@ import {
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
 import {
-  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
+  ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, DQS_TEXELS_PER_JOINT, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
   GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE,
 } from './layout.js';
-import { column, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
+import { column, gcsNormalTexel, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
 import { checkObject } from '../arguments.js';
 
@@ -217,7 +217,8 @@ const gcsTurnLbs = Fn(([v, m, q]: [Vec3, Mat3, Vec4]) => {
  * Each vertex blends its own joints (4, or 8 with a second set) from the joint poses, at its own
  * weights (the rig's, as the core normalises them; joint −1 where the weight is 0): LBS as the
  * CPU's (M = Σ w S_j; normals by M, then unit length), DQS through the node maths (jointBlend) with
- * no centre, normals as the joint-level path turns an unblended one.
+ * no centre, normals as the joint-level path turns an unblended one. (DQS with a joint pass reads
+ * its parts instead, dqsVertex; this is a velocity pass's previous frame.)
  */
 function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slots: 4 | 8): VertexTransform {
   const ids: Vec4[] = [], weights: Vec4[] = [];
@@ -249,6 +250,57 @@ function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slot
   return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnLbs(v, m, q) };
 }
 
+/**
+ * DQS from the joint pass's targets (node-pass-tsl.ts, DQS_TEXELS_PER_JOINT; the GLSL's DQS_BASE):
+ * per influence the joint's quaternion, dual part and uniform scale as the pass wrote them, the
+ * blend; then M = s·R and the normal by R where every joint of the vertex is a uniform scale (the
+ * CPU's quaternion-only path: no scale part read), else the scale parts K_j blended, M = R·K and
+ * the normal matrix of gcsNormalTexel(K). `row`: this instance's row of the targets.
+ */
+function dqsVertex(nodes: TextureNode[], row: Int, slots: 4 | 8): VertexTransform {
+  const lanes = ['x', 'y', 'z', 'w'] as const;
+  const ids: Vec4[] = [], weights: Vec4[] = [];
+  for (let g = 0; g < slots / 4; g++) {
+    ids.push(attribute<'vec4'>(INFLUENCE_ATTRIBUTES[g], 'vec4'));
+    weights.push(attribute<'vec4'>(WEIGHT_ATTRIBUTES[g], 'vec4'));
+  }
+  // Joint j's first texel (one row per instance: no division per joint).
+  const at = (c: number, texel = 0) => ivec2(int(ids[c >> 2][lanes[c & 3]].max(0)).mul(DQS_TEXELS_PER_JOINT).add(texel), row);
+  // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's early continue).
+  const weight = (c: number) => weights[c >> 2][lanes[c & 3]].mul(step(0, ids[c >> 2][lanes[c & 3]]));
+  const pivot = nodes[0].load(at(0)).toVar();
+  const br = vec4(0).toVar(), bd = vec4(0).toVar(), s = float(0).toVar(), rigid = bool(true).toVar();
+  for (let c = 0; c < slots; c++) {
+    const w = weight(c).toVar();
+    const first = at(c).toVar();
+    const q = nodes[0].load(first).toVar();
+    const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
+    br.addAssign(q.mul(sw));
+    bd.addAssign(nodes[1].load(first).mul(sw));
+    const u = nodes[2].load(first).x.toVar();
+    s.addAssign(w.mul(u));
+    rigid.assign(rigid.and(u.greaterThan(0).or(w.greaterThan(0).not())));
+  }
+  const inv2 = float(1).div(dot(br, br)).toVar();
+  const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
+  const r = gcsRotation(br, inv2.mul(2)).toVar();
+  const m = r.mul(s).toVar(), n = r.toVar(), renorm = bool(false).toVar();
+  If(rigid.not(), () => {
+    const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
+    for (let c = 0; c < slots; c++) {
+      const second = at(c, 1).toVar();
+      k.addAssign(mat3(nodes[0].load(second).xyz, nodes[1].load(second).xyz, nodes[2].load(second).xyz).transpose().mul(weight(c)));
+    }
+    m.assign(r.mul(k));
+    const texel = gcsNormalTexel(k).toVar();
+    const a = m.mul(texel.x).toVar();
+    const a0 = column(a, 0), a1 = column(a, 1), a2 = column(a, 2);
+    n.assign(mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1)).mul(texel.y));
+    renorm.assign(texel.w.lessThan(0));
+  });
+  return { position: (p) => m.mul(p).add(t), turn: (v) => gcsTurnJoint(v, n, bool(false), bool(false), renorm) };
+}
+
 /** Whether this build writes velocity (three.js asks for previous positions then). */
 const needsPreviousData = (builder: NodeBuilder): boolean => (builder as NodeBuilder & { needsPreviousData(): boolean }).needsPreviousData();
 
@@ -263,17 +315,24 @@ export function previousPositionNode(): Node<'vec3'> {
   })();
 }
 
+/** What the vertex stage reads of a node pass: this frame's targets (TslNodePass) or the frame before's (its previousViews()). */
+type PassViews = Pick<TslNodePass, 'textureNode'>;
+
+/** The vertex stage's views of the pass's targets. */
+const passTextures = (pass: PassViews): TextureNode[] => Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i));
+
 /**
  * How each vertex moves: path 'sections' from the section transforms; path 'joints' from the node
- * pass's targets (`pass`, `nodeFirst` this instance's first node), or, without one (a velocity
+ * pass's targets (`pass`, `nodeFirst` this instance's first node; DQS's joint pass: its row), or, without one (a velocity
  * pass's previous frame, or a caller that built no pass), from nodes computed here from the joint
  * poses (`perFrame`, `first` this instance's first joint texel).
  */
-function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: TslNodePass | null, nodeFirst: Int): VertexTransform {
+function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: PassViews | null, nodeFirst: Int): VertexTransform {
+  if (sections.method === 'dqs' && pass) return dqsVertex(passTextures(pass), nodeFirst, sections.tableSlots);
   if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
   if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
   if (pass) {
-    const inputs: NodeInputs = { nodes: Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i)), first: nodeFirst };
+    const inputs: NodeInputs = { nodes: passTextures(pass), first: nodeFirst };
     return jointVertex((s) => passNode(inputs, s), sections.smooth);
   }
   const inputs: JointInputs = { joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first };
@@ -307,14 +366,19 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
   return Fn((builder: NodeBuilder) => {
     const has = (name: string) => builder.geometry?.getAttribute(name) !== undefined;
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
-    const sectionCount = sections.deformer.sectionCount;
-    const nodeFirst = (instanced ? int(instanceIndex).mul(sectionCount) : int(0)).toVar();
+    // This instance's first node in the pass's targets (DQS's joint pass: its row).
+    const perInstance = sections.method === 'dqs' ? 1 : sections.deformer.sectionCount;
+    const nodeFirst = (instanced ? int(instanceIndex).mul(perInstance) : int(0)).toVar();
     const vertex = vertexTransform(sections, perFrame, first, pass, nodeFirst);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
     if (needsPreviousData(builder)) {
-      OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
-      const previous = vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
+      // With a node pass, the previous frame's nodes are its targets of the run before (no per-vertex node maths).
+      if (pass) OnObjectUpdate(({ renderer }) => pass.fillPrevious(renderer));
+      const previous = pass ? vertexTransform(sections, perFrame, first, pass.previousViews(), nodeFirst) : (() => {
+        OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
+        return vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
+      })();
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
     }
     if (has('normal')) {
