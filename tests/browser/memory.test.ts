@@ -122,10 +122,15 @@ async function memoryUnderDrag(demo: DemoInChromium, what: string, builds: 'gcsB
   const at = (n: number) => samples.find((s) => s.moves === n)!;
   const settled = at(SETTLED), end = at(MOVES);
   // Growth: the larger of the two samples after the last two sweeps over the larger of those at
-  // SETTLED and one sweep later (the core's heap swings by a block between samples: a peak
-  // against a peak).
+  // SETTLED and one sweep later (a peak against a peak).
   const peak = (key: keyof Sample, first: number) => Math.max(at(first)[key] as number, at(first + sweep.length)[key] as number);
-  const growth = (key: keyof Sample) => peak(key, MOVES - sweep.length) / peak(key, SETTLED) - 1;
+  // The core's heap in use: the lowest of the last three samples over the lowest of the three from
+  // SETTLED. It swings by one block that falls on samples by chance; a leak raises every sample,
+  // the lowest too.
+  const floor = (key: keyof Sample, first: number) => Math.min(...[0, 1, 2].map((k) => at(first + k * sweep.length)[key] as number));
+  const growth = (key: keyof Sample) => key === 'heapInUse'
+    ? floor(key, MOVES - 2 * sweep.length) / floor(key, SETTLED) - 1
+    : peak(key, MOVES - sweep.length) / peak(key, SETTLED) - 1;
   const figures = ['jsHeap', 'wasmBytes', 'heapInUse', 'rendererRss', 'gpuRss'] as const;
   const pct = (x: number) => `${(100 * x).toFixed(2)} %`;
   console.log(`${what}, growth from ${SETTLED} to ${MOVES} moves: ${figures.map((k) => `${k} ${settled[k] === null ? 'n/a' : pct(growth(k))}`).join(', ')}`);
