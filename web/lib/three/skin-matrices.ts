@@ -14,15 +14,16 @@ export function writeSkinMatrices(source: THREE.SkinnedMesh, out: Float32Array, 
   if (typeof offset !== 'number' || !Number.isInteger(offset) || offset < 0 || offset + 16 * bones.length > out.length)
     throw new GcsError('OUT_OF_RANGE', `writeSkinMatrices: ${bones.length} joints × 16 floats from offset ${asGiven(offset)} do not fit in ${out.length} floats`);
   if (!(tmp as { isMatrix4?: boolean })?.isMatrix4) throw new GcsError('INVALID_ARGUMENT', 'writeSkinMatrices: tmp must be a THREE.Matrix4 (scratch)');
-  const inverses = source.skeleton.boneInverses;
-  for (let j = 0; j < bones.length; j++) {
-    tmp.multiplyMatrices(bones[j].matrixWorld, inverses[j]);
-    tmp.premultiply(source.bindMatrixInverse);
-    tmp.multiply(source.bindMatrix);
-    const e = tmp.elements;
-    const o = offset + 16 * j;
-    for (let k = 0; k < 16; k++) out[o + k] = e[k];
-  }
+  for (let j = 0; j < bones.length; j++) writeSkinMatrix(source, j, out, offset + 16 * j, tmp);
+}
+
+/** Joint j's skin matrix by Matrix4's full products, into `out` at `o` (checked by the callers). */
+function writeSkinMatrix(source: THREE.SkinnedMesh, j: number, out: Float32Array, o: number, tmp: THREE.Matrix4): void {
+  tmp.multiplyMatrices(source.skeleton.bones[j].matrixWorld, source.skeleton.boneInverses[j]);
+  tmp.premultiply(source.bindMatrixInverse);
+  tmp.multiply(source.bindMatrix);
+  const e = tmp.elements;
+  for (let k = 0; k < 16; k++) out[o + k] = e[k];
 }
 
 /** Whether a column-major 4×4 matrix is affine (last row 0, 0, 0, 1). */
@@ -62,8 +63,7 @@ export function writeSkinMatricesWithTails(source: THREE.SkinnedMesh, tails: Flo
   for (let j = 0; j < bones.length; j++) {
     const w = bones[j].matrixWorld.elements, o = 16 * j;
     if (!affine(w)) {
-      tmp.multiplyMatrices(bones[j].matrixWorld, source.skeleton.boneInverses[j]).premultiply(source.bindMatrixInverse).multiply(source.bindMatrix);
-      for (let k = 0; k < 16; k++) out[o + k] = tmp.elements[k];
+      writeSkinMatrix(source, j, out, o, tmp);
       continue;
     }
     // A = L · W (3 × 4)
