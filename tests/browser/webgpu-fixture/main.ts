@@ -601,7 +601,7 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
   const vertexShader = (await renderer.debug.getShaderAsync(scene, camera, c.mesh)).vertexShader ?? '';
   // The GLSL pass from the same GpuSections (joint poses of the last update()), on a WebGLRenderer.
   const gl = glRenderer();
-  const glsl = new NodePass(c.sections);
+  const glsl = new NodePass(c.sections, true);
   glsl.render(gl);
   const { width, height: rows } = pass.target;
   let largest = 0, scale = 0;
@@ -609,7 +609,7 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
   for (let t = 0; t < 4; t++) {
     const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
     const theirs = new Float32Array(4 * width * rows);
-    gl.readRenderTargetPixels(glsl.target, 0, 0, width, rows, theirs, undefined, t);
+    gl.readRenderTargetPixels(glsl.target!, 0, 0, width, rows, theirs, undefined, t);
     for (let n = 0; n < nodes; n++) {
       const x = n % width, y = Math.floor(n / width);
       const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);
@@ -686,7 +686,7 @@ async function dqsPass(model: string, times: [number, number], clipName?: string
   const vertexShader = (await renderer.debug.getShaderAsync(scene, camera, skin.mesh)).vertexShader ?? '';
   // The GLSL pass from the same GpuSections (joint poses of the last update()), on a WebGLRenderer.
   const gl = glRenderer();
-  const glsl = new NodePass(pass.sections);
+  const glsl = new NodePass(pass.sections, true);
   glsl.render(gl);
   const { width, height: rows } = pass.target;
   const joints = pass.sections.uniforms.gcsStride.value / 4;
@@ -694,7 +694,7 @@ async function dqsPass(model: string, times: [number, number], clipName?: string
   for (let t = 0; t < 4; t++) {
     const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
     const theirs = new Float32Array(4 * width * rows);
-    gl.readRenderTargetPixels(glsl.target, 0, 0, width, rows, theirs, undefined, t);
+    gl.readRenderTargetPixels(glsl.target!, 0, 0, width, rows, theirs, undefined, t);
     for (let n = 0; n < 2 * joints; n++) {
       const x = n % width, y = Math.floor(n / width);
       const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);

@@ -249,6 +249,7 @@ uniform int gcsNodeCount;
 uniform int gcsSectionCount;
 uniform int gcsJointStride;
 uniform int gcsTargetWidth;
+uniform int gcsFirstRow;
 layout( location = 0 ) out highp vec4 gcsRow0;
 layout( location = 1 ) out highp vec4 gcsRow1;
 layout( location = 2 ) out highp vec4 gcsRow2;
@@ -272,7 +273,7 @@ void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T,
 	gcsBlend( base, gcsTexel( gcsTable, row ), gcsTexel( gcsTable, row + 1 ), joints1, weights1, gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 ), M, T, N );
 }
 void main() {
-	int node = int( gl_FragCoord.y ) * gcsTargetWidth + int( gl_FragCoord.x );
+	int node = ( int( gl_FragCoord.y ) - gcsFirstRow ) * gcsTargetWidth + int( gl_FragCoord.x );
 	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
 	int instance = node / gcsSectionCount;
 	mat3 M; vec3 T; vec4 N;
@@ -303,7 +304,7 @@ float gcsRigidScale( const in mat3 k ) {
 void main() {
 	int x = int( gl_FragCoord.x ), joint = x / ${DQS_TEXELS_PER_JOINT};
 	mat3 S; vec3 t; vec4 q;
-	gcsJoint( int( gl_FragCoord.y ) * gcsJointStride, joint, S, t, q );
+	gcsJoint( ( int( gl_FragCoord.y ) - gcsFirstRow ) * gcsJointStride, joint, S, t, q );
 	mat3 K = transpose( gcsRotation( q, 2.0 ) ) * S;
 	gcsNormal = vec4( 0.0 );
 	if ( x == joint * ${DQS_TEXELS_PER_JOINT} ) {
@@ -318,11 +319,13 @@ void main() {
 }
 `;
 
-/** A triangle covering the target: one fragment per texel. */
+/** Two triangles over the pass's texels in its page (gcsRect: their corners in clip space): one fragment per texel. */
 const NODE_PASS_VERTEX = /* glsl */ `
+uniform vec4 gcsRect;
 void main() {
-	vec2 p = vec2( float( ( gl_VertexID << 1 ) & 2 ), float( gl_VertexID & 2 ) );
-	gl_Position = vec4( p * 2.0 - 1.0, 0.0, 1.0 );
+	int i = gl_VertexID % 3 + gl_VertexID / 3; // 0 1 2, 1 2 3: the corners (0, 0), (1, 0), (0, 1), (1, 1)
+	vec2 corner = vec2( float( i & 1 ), float( i >> 1 ) );
+	gl_Position = vec4( mix( gcsRect.xy, gcsRect.zw, corner ), 0.0, 1.0 );
 }
 `;
 
@@ -519,13 +522,14 @@ attribute vec4 ${WEIGHT_ATTRIBUTES[0]};
 attribute vec4 ${INFLUENCE_ATTRIBUTES[1]};
 attribute vec4 ${WEIGHT_ATTRIBUTES[1]};
 #endif
+uniform int gcsFirstRow;
 ${ROTATION}${TURN_JOINT}
-// Joint j's first texel in the joint pass's targets (one row per instance: no division per joint).
+// Joint j's first texel in the joint pass's targets (one row per instance from gcsFirstRow: no division per joint).
 ivec2 gcsDqsAt( const in float j ) {
 	#ifdef USE_INSTANCING
-	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, gl_InstanceID );
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, gcsFirstRow + gl_InstanceID );
 	#else
-	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, 0 );
+	return ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT}, gcsFirstRow );
 	#endif
 }
 // Joint j's scale part K (columns), from its second texel.

@@ -338,10 +338,9 @@ export class TslNodePass {
       const why = NodePass.unsupported(renderer);
       if (why) return why;
       if (this.target.height > 1) return `a WebGLRenderer with WebGLNodesHandler reads the node pass's targets from the other end when they span more than one row (more than ${MAX_WIDTH} nodes)`;
-      this.glsl ??= new NodePass(this.sections);
-      this.show(this.glsl.target.textures);
-      this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
-      return null;
+      this.glsl ??= new NodePass(this.sections, true);
+      this.show(this.glsl.target!.textures);
+      return this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
     this.show(this.target.textures);

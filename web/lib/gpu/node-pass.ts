@@ -1,8 +1,11 @@
 /**
  * The node pass (joint-level path, WebGLRenderer): once per frame, every node's transform, normal
- * matrix and renormalisation flag from the joint poses, for every instance in one draw, into a
- * float render target that the vertex stage reads (glsl.ts, NODE_PARS). A node depends only on its
+ * matrix and renormalisation flag from the joint poses, for every instance in one draw, into float
+ * render targets that the vertex stage reads (glsl.ts, NODE_PARS). A node depends only on its
  * joints and the frame: computed here once, not once per vertex that uses it.
+ *
+ * Every pass a renderer draws shares one set of targets (node-atlas.ts): its rows of a page, and
+ * one render of the page per frame for every skin that changed, not one per skin.
  *
  * It runs at the first draw of the skin after `GpuSections.update()` (the mesh's onBeforeShadow or
  * onBeforeRender, whichever three.js calls first: shadow maps are drawn before the scene), so
@@ -13,15 +16,16 @@ import * as THREE from 'three';
 import { checkObject } from '../arguments.js';
 import { dqsPassShaders, nodePassShaders } from './glsl.js';
 import { DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
+import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_WIDTH, type PageMember } from './node-atlas.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
-
-/** The widest row of the node textures: WebGL2's guaranteed 2048. */
-const MAX_WIDTH = 2048;
 
 /** The extension float render targets need in WebGL2 (RGBA32F colour attachments). */
 export const FLOAT_TARGET_EXTENSION = 'EXT_color_buffer_float';
 
-/** What the vertex stage reads: the node textures (gcsNodes0 … gcsNodes3), instance 0's first node, nodes per instance. */
+/**
+ * What the vertex stage reads: the node textures (gcsNodes0 … gcsNodes3), instance 0's first node
+ * (gcsBase) and nodes per instance (gcsStride); for DQS, the first row of its joint texels (gcsFirstRow).
+ */
 export type NodeUniforms = GcsUniforms;
 
 type Renderer = THREE.WebGLRenderer;
@@ -33,54 +37,71 @@ type Renderer = THREE.WebGLRenderer;
  * its rotation quaternion, dual part and uniform scale, then the rows of K = Rᵀ·S), which the DQS
  * vertex stage blends.
  */
-export class NodePass {
-  /** The float render target (GPU_NODE_TEXTURES textures, one texel per node of every instance) the pass draws into. */
-  readonly target: THREE.WebGLRenderTarget;
-  /** The uniforms the vertex stage reads: the target's textures as gcsNodes0…, gcsBase and gcsStride. */
+export class NodePass implements PageMember {
+  /** The uniforms the vertex stage reads: the page's textures as gcsNodes0…, gcsBase, gcsStride and gcsFirstRow. */
   readonly uniforms: NodeUniforms;
+  /** Rows of the targets this pass writes: its nodes' (one per instance for DQS). */
+  readonly rows: number;
+  /** Texels per row this pass writes. */
+  readonly columns: number;
+  /** The mesh that draws this pass's fragments into its page. */
+  readonly quad: THREE.Mesh;
   private readonly material: THREE.ShaderMaterial;
-  private readonly scene = new THREE.Scene();
-  private readonly camera = new THREE.Camera();
   private readonly geometry = new THREE.BufferGeometry();
+  /** Where the pass draws: its page, and the renderer whose atlas holds it (null: none yet, or a page of its own). */
+  private page: NodePage | null = null;
+  private readonly ownPage: boolean;
+  private readonly firstRowUniform: { value: number };
+  private renderer: Renderer | null = null;
   /** The GpuSections.version the target holds (−1: none yet). */
-  private drawn = -1;
+  private drawnVersion = -1;
 
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
+   * @param ownPage A page of its own, exactly its rows and columns, instead of a share of the
+   * renderer's (gcs-skin/webgpu under WebGLNodesHandler reads it as a texture of one row).
    * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
-  constructor(readonly sections: GpuSections) {
+  constructor(readonly sections: GpuSections, ownPage = false) {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
     // DQS: the joint pass, two texels per joint (q, dual part, uniform scale; K), one row per
-    // instance (2 · GCS_MAX_JOINTS = MAX_WIDTH). GCS: one texel per section, rows of MAX_WIDTH.
+    // instance (2 · GCS_MAX_JOINTS = PAGE_WIDTH). GCS: one texel per section, rows of PAGE_WIDTH.
     const dqs = sections.method === 'dqs';
     const deformer = sections.deformer, N = sections.instanceCount;
     const S = dqs ? sections.uniforms.gcsStride.value as number / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
-    const nodes = N * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
-    const width = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
-    // One texel per node in each of four float targets: the node pass computes a node once and writes it whole.
-    this.target = new THREE.WebGLRenderTarget(width, height, {
-      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
-      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
-    });
+    const nodes = N * S;
+    this.columns = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
+    this.rows = dqs ? N : Math.ceil(nodes / PAGE_WIDTH);
     const u = sections.uniforms;
+    this.firstRowUniform = { value: 0 };
+    this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S }, gcsFirstRow: this.firstRowUniform };
+    for (let t = 0; t < GPU_NODE_TEXTURES; t++) this.uniforms[`gcsNodes${t}`] = { value: null };
     this.material = new THREE.ShaderMaterial({
       ...(dqs ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
         gcsJoints: u.gcsJoints!, ...(dqs ? {} : { gcsTable: u.gcsTable! }),
         gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
-        gcsJointStride: u.gcsStride, gcsTargetWidth: { value: width },
+        gcsJointStride: u.gcsStride, gcsTargetWidth: { value: PAGE_WIDTH },
+        gcsFirstRow: this.firstRowUniform, gcsRect: { value: new THREE.Vector4() },
       },
-      depthTest: false, depthWrite: false, blending: THREE.NoBlending, glslVersion: THREE.GLSL3,
+      depthTest: false, depthWrite: false, blending: THREE.NoBlending, side: THREE.DoubleSide, glslVersion: THREE.GLSL3,
     });
-    // Three vertices, no attributes read (gl_VertexID places them): one triangle over the target.
-    this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
-    const quad = new THREE.Mesh(this.geometry, this.material);
-    quad.frustumCulled = false;
-    this.scene.add(quad);
-    this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S } };
-    this.target.textures.forEach((texture, t) => { this.uniforms[`gcsNodes${t}`] = { value: texture }; });
+    // Six vertices, no attributes read (gl_VertexID places them): two triangles over the pass's rows.
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(18), 3));
+    this.quad = new THREE.Mesh(this.geometry, this.material);
+    this.ownPage = ownPage;
+    if (ownPage) new NodePage(this.columns, this.rows).add(this);
+  }
+
+  /** The float render target (GPU_NODE_TEXTURES textures) this pass draws into, shared with other passes; null before its first draw. */
+  get target(): THREE.WebGLRenderTarget | null {
+    return this.page?.target ?? null;
+  }
+
+  /** The first row of this pass's texels in `target`. */
+  get firstRow(): number {
+    return this.firstRowUniform.value;
   }
 
   /** Why `renderer` cannot run the node pass (no float render targets), or null. */
@@ -92,24 +113,57 @@ export class NodePass {
 
   /**
    * Writes every node of every instance for the current joint poses, unless already written since
-   * the last GpuSections.update(). Restores the renderer's render target (and cube face, mip level).
+   * the last GpuSections.update() — with every other stale pass of the renderer, in one render of
+   * their page. Restores the renderer's render target (and cube face, mip level). Returns why the
+   * pass cannot run (more rows than a page holds), or null.
    */
-  render(renderer: Renderer): void {
-    const version = this.sections.version;
-    if (this.drawn === version) return;
-    this.drawn = version;
-    const target = renderer.getRenderTarget(), face = renderer.getActiveCubeFace(), level = renderer.getActiveMipmapLevel();
-    const autoClear = renderer.autoClear;
-    renderer.autoClear = false; // every texel is written
-    renderer.setRenderTarget(this.target);
-    renderer.render(this.scene, this.camera);
-    renderer.setRenderTarget(target, face, level);
-    renderer.autoClear = autoClear;
+  render(renderer: Renderer): string | null {
+    if (!this.ownPage && this.renderer !== renderer) {
+      // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
+      if (this.page && this.renderer) NodeAtlas.of(this.renderer).remove(this, this.page);
+      this.page = NodeAtlas.of(renderer).add(this);
+      this.renderer = this.page ? renderer : null;
+      if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
+    }
+    if (this.stale()) this.page!.run(renderer);
+    return null;
   }
 
-  /** Frees the render target, the pass's material and its geometry. */
+  /** @internal Whether the texels are older than the joint poses. */
+  stale(): boolean {
+    return this.drawnVersion !== this.sections.version;
+  }
+
+  /** @internal The texels hold the current joint poses. */
+  drawn(): void {
+    this.drawnVersion = this.sections.version;
+  }
+
+  /** @internal The texels were lost (the page grew). */
+  lost(): void {
+    this.drawnVersion = -1;
+  }
+
+  /** @internal This pass's rows start at `firstRow` of `page`: its quad, its fragments' numbering and the vertex stage's reads follow. */
+  place(page: NodePage, firstRow: number): void {
+    this.page = page;
+    const { width, height } = page.target;
+    const u = this.material.uniforms;
+    u.gcsTargetWidth.value = width;
+    (u.gcsRect.value as THREE.Vector4).set(-1, 2 * firstRow / height - 1, 2 * this.columns / width - 1, 2 * (firstRow + this.rows) / height - 1);
+    this.firstRowUniform.value = firstRow;
+    this.uniforms.gcsBase.value = firstRow * width;
+    page.target.textures.forEach((texture, t) => { this.uniforms[`gcsNodes${t}`]!.value = texture; });
+  }
+
+  /** Frees the pass's rows (its page with the last), material and geometry. */
   dispose(): void {
-    this.target.dispose();
+    if (this.page) {
+      if (this.ownPage) this.page.dispose();
+      else if (this.renderer) NodeAtlas.of(this.renderer).remove(this, this.page);
+    }
+    this.page = null;
+    this.renderer = null;
     this.material.dispose();
     this.geometry.dispose();
   }

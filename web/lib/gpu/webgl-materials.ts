@@ -111,8 +111,8 @@ export const glslKit: GpuMaterialKit = {
       material, depth: shadow.depth, distance: shadow.distance, compileError,
       beforeDraw(renderer: unknown): string | null {
         const why = NodePass.unsupported(renderer);
-        if (!why && (renderer as { isWebGLRenderer?: boolean })?.isWebGLRenderer) pass.render(renderer as THREE.WebGLRenderer);
-        return why;
+        if (why || !(renderer as { isWebGLRenderer?: boolean })?.isWebGLRenderer) return why;
+        return pass.render(renderer as THREE.WebGLRenderer);
       },
       dispose: () => pass.dispose(),
     };

@@ -1,0 +1,160 @@
+/**
+ * Where node passes draw (WebGLRenderer): every skin a renderer draws on the joint-level path (and
+ * every GPU DQS skin) shares one set of float render targets, a *page*, each skin owning whole rows
+ * of it, and one `render()` per frame computes the nodes of every skin that changed. A pass costs a
+ * render-target switch whatever its size (about as much as a thousand nodes under SwiftShader), so
+ * sixteen characters of two skins each drawing their own would spend more on switching than on the
+ * nodes (docs/gpu.md, "The node pass").
+ *
+ * Rows are allocated first-fit and freed when a skin is disposed (a section slider rebuilds every
+ * frame: its new pass takes the rows the old one left). A page grows when no gap fits (the
+ * targets' textures keep their identity, so every material's uniforms stay valid) and every member
+ * is recomputed after a growth (the old contents are gone); it never shrinks, and is freed with its
+ * last member.
+ */
+import * as THREE from 'three';
+import { GPU_NODE_TEXTURES } from './layout.js';
+
+/** The widest row of a shared page: WebGL2's guaranteed 2048. */
+export const PAGE_WIDTH = 2048;
+
+/** The most rows a page grows to: WebGL2's guaranteed texture size. */
+export const PAGE_ROWS = 2048;
+
+/** What a page needs of a pass drawn into it. */
+export interface PageMember {
+  /** Rows the member needs (its nodes, or its instances for a joint pass). */
+  readonly rows: number;
+  /** Texels per row the member writes (its quad's width; ≤ the page's width). */
+  readonly columns: number;
+  /** The mesh that draws the member's fragments: placed by `place`, shown only while stale. */
+  readonly quad: THREE.Mesh;
+  /** Whether the member's texels are older than its joint poses. */
+  stale(): boolean;
+  /** The member's texels now hold its current joint poses. */
+  drawn(): void;
+  /** The member's texels were lost (the page grew): recompute them at the next run. */
+  lost(): void;
+  /** Its rows in `page` start at `firstRow` (after an allocation or a growth). */
+  place(page: NodePage, firstRow: number): void;
+}
+
+/** A set of float render targets shared by node passes, each owning `rows` consecutive rows. */
+export class NodePage {
+  /** The four RGBA32F targets (GPU_NODE_TEXTURES), `width` texels wide. */
+  readonly target: THREE.WebGLRenderTarget;
+  private readonly scene = new THREE.Scene();
+  private readonly camera = new THREE.Camera();
+  /** Members and their first rows, in row order. */
+  private readonly members: { member: PageMember; row: number }[] = [];
+
+  /** @param width Texels per row. @param rows Rows at first (grows as members join). */
+  constructor(readonly width: number, rows: number) {
+    this.target = new THREE.WebGLRenderTarget(width, Math.max(1, rows), {
+      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
+    });
+    this.scene.matrixWorldAutoUpdate = false;
+  }
+
+  /** Members drawn into this page. */
+  get size(): number {
+    return this.members.length;
+  }
+
+  /** The first row of a gap of `rows` rows, or the row past the last member; null when the page cannot hold them. */
+  private gap(rows: number): number | null {
+    let end = 0;
+    for (const m of this.members) {
+      if (m.row - end >= rows) return end;
+      end = m.row + m.member.rows;
+    }
+    return end + rows <= PAGE_ROWS ? end : null;
+  }
+
+  /** Takes `member` into the first gap that fits (growing the targets if needed); false when the page cannot hold it. */
+  add(member: PageMember): boolean {
+    if (member.columns > this.width) return false;
+    const row = this.gap(member.rows);
+    if (row === null) return false;
+    const at = this.members.findIndex((m) => m.row > row);
+    this.members.splice(at < 0 ? this.members.length : at, 0, { member, row });
+    member.quad.frustumCulled = false;
+    this.scene.add(member.quad);
+    const height = row + member.rows;
+    if (height > this.target.height) {
+      // The textures keep their identity (materials keep reading them); their contents are gone.
+      this.target.setSize(this.width, height);
+      for (const m of this.members) { m.member.place(this, m.row); m.member.lost(); }
+    } else {
+      member.place(this, row);
+    }
+    return true;
+  }
+
+  /** Frees `member`'s rows. */
+  remove(member: PageMember): void {
+    const i = this.members.findIndex((m) => m.member === member);
+    if (i < 0) return;
+    this.members.splice(i, 1);
+    this.scene.remove(member.quad);
+  }
+
+  /**
+   * One render of every stale member into the targets (the others hidden), restoring the renderer's
+   * render target, cube face, mip level and autoClear.
+   */
+  run(renderer: THREE.WebGLRenderer): void {
+    let any = false;
+    for (const { member } of this.members) {
+      const stale = member.stale();
+      member.quad.visible = stale;
+      if (stale) { member.drawn(); any = true; }
+    }
+    if (!any) return;
+    const target = renderer.getRenderTarget(), face = renderer.getActiveCubeFace(), level = renderer.getActiveMipmapLevel();
+    const autoClear = renderer.autoClear;
+    renderer.autoClear = false; // each member writes every texel of its rows
+    renderer.setRenderTarget(this.target);
+    renderer.render(this.scene, this.camera);
+    renderer.setRenderTarget(target, face, level);
+    renderer.autoClear = autoClear;
+  }
+
+  /** Frees the targets. */
+  dispose(): void {
+    this.target.dispose();
+  }
+}
+
+/** The pages of one WebGLRenderer (usually one). */
+export class NodeAtlas {
+  private static readonly atlases = new WeakMap<object, NodeAtlas>();
+  private readonly pages: NodePage[] = [];
+
+  /** The atlas of `renderer`, made at its first use. */
+  static of(renderer: THREE.WebGLRenderer): NodeAtlas {
+    let atlas = NodeAtlas.atlases.get(renderer);
+    if (!atlas) NodeAtlas.atlases.set(renderer, atlas = new NodeAtlas());
+    return atlas;
+  }
+
+  /** Places `member` in the first page that holds it, or in a new one; returns its page, or null when no page can hold it. */
+  add(member: PageMember): NodePage | null {
+    if (member.rows > PAGE_ROWS || member.columns > PAGE_WIDTH) return null;
+    for (const page of this.pages) if (page.add(member)) return page;
+    const page = new NodePage(PAGE_WIDTH, member.rows);
+    page.add(member);
+    this.pages.push(page);
+    return page;
+  }
+
+  /** Frees `member`'s rows, and its page when it was the last. */
+  remove(member: PageMember, page: NodePage): void {
+    page.remove(member);
+    if (page.size > 0) return;
+    const i = this.pages.indexOf(page);
+    if (i >= 0) this.pages.splice(i, 1);
+    page.dispose();
+  }
+}
