@@ -223,6 +223,24 @@ describe.skipIf(!!reason)('LBS and DQS on the GPU backend = on the CPU', () => {
 });
 
 describe.skipIf(!!reason || !!noCesium)('the node pass: once per frame; without float render targets, the section-level path', () => {
+  test('every skin of a renderer in one page: one render() for three characters (GCS and DQS), rows reused and the page grown, pictures = the CPU backend', async () => {
+    interface P { renders: number[]; rows: { first: number[]; after: number[]; heights: number[] }; shared: boolean[]; vsCpu: number[]; vsRest: number }
+    const r = await fixture.page.evaluate((m) => (window as unknown as { __gpu: { sharedPass(a: string): Promise<P> } }).__gpu.sharedPass(m), `/@fs${CESIUM}`);
+    console.log(`shared node pass: render() calls ${r.renders.join(', ')} (a frame of three characters, drawn again, a frame after a dispose and two new); ` +
+      `first rows ${r.rows.first.join(', ')} → ${r.rows.after.join(', ')} of ${r.rows.heights[0]}; ` +
+      `vs the CPU backend ${r.vsCpu.map((d) => `${(100 * d).toFixed(3)} %`).join(', ')}; vs the rest pose ${(100 * r.vsRest).toFixed(1)} %`);
+    // The frame's own render() and one page render for all three; drawn again: none.
+    expect(r.renders).toEqual([2, 1, 2]);
+    expect(r.shared).toEqual([true, true]);
+    // CesiumMan's nodes fit a row: GCS, DQS, GCS in rows 0, 1, 2; the DQS one freed, the next takes
+    // row 1 and the last grows the page to 4 rows.
+    expect(r.rows.first).toEqual([0, 1, 2]);
+    expect(r.rows.after).toEqual([0, 2, 1, 3]);
+    expect(r.rows.heights).toEqual([4, 4, 4, 4]);
+    for (const d of r.vsCpu) expect(d).toBeLessThan(PIXEL_TOLERANCE);
+    expect(r.vsRest).toBeGreaterThan(0.01);
+  });
+
   test('CesiumMan with shadows: one pass per frame; EXT_color_buffer_float absent: the skin on the section-level path with a note, a crowd stopped', async () => {
     interface P { renders: number[]; fallbackPath: string; fallbackNote: string; fallbackDiff: number; crowdError: string }
     const r = await fixture.page.evaluate((m) => (window as unknown as { __gpu: { nodePass(a: string, b: number): Promise<P> } }).__gpu.nodePass(m, 0.9), `/@fs${CESIUM}`);

@@ -11,6 +11,7 @@ import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend 
 import { GcsCrowd } from '../../../web/lib/crowd.js';
 import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
 import type { GpuMethod, TableSlots } from '../../../web/lib/gpu/layout.js';
+import type { NodePass } from '../../../web/lib/gpu/node-pass.js';
 import { firstFour } from '../../helpers/influences.js';
 import { load, stage } from '../fixture-scene.js';
 
@@ -466,7 +467,91 @@ async function nodePass(model: string, time: number): Promise<PassResult> {
   return { renders, fallbackPath, fallbackNote, fallbackDiff, crowdError };
 }
 
-declare global {
-  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials; nodePass: typeof nodePass } }
+export interface SharedPassResult {
+  /** render() calls for a frame of three characters, that frame drawn again, and a frame after a dispose and two new characters (each after the characters' first) */
+  renders: number[];
+  /** each node pass's page height and first row, after the first frame and after the changes */
+  rows: { first: number[]; after: number[]; heights: number[] };
+  /** whether every pass shares one target, before and after */
+  shared: boolean[];
+  /** share of pixels differing from the CPU backend's picture, after the first frame and after the changes */
+  vsCpu: number[];
+  /** the share of pixels that differ from the unanimated characters (the poses are applied) */
+  vsRest: number;
 }
-window.__gpu = { check, crowd, materials, nodePass };
+
+/**
+ * Every node pass of a renderer in one page: three characters (GCS, GPU DQS, GCS) posed at
+ * different times are computed by one render(), each reading its own rows; then the DQS one is
+ * disposed and two GCS ones are added (the first takes the freed row, the second grows the page,
+ * which recomputes all): the pictures equal the CPU backend's each time.
+ */
+async function sharedPass(model: string): Promise<SharedPassResult> {
+  const gcs = await gcsReady;
+  // The GPU characters and their CPU twins (same models, places, methods and clip times), each set in its own scene.
+  const sets = await Promise.all([0, 1].map(async () => {
+    const scene = new THREE.Scene();
+    scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2));
+    const loads = await Promise.all([0, 1, 2, 3, 4].map(() => load(model)));
+    const size = new THREE.Box3().setFromObject(loads[0].root).getSize(new THREE.Vector3());
+    loads.forEach((l, i) => { l.root.position.x = (i - 2) * size.x * 1.2; scene.add(l.root); l.root.visible = i < 3; });
+    const mixers = loads.map((l) => { const m = new THREE.AnimationMixer(l.root); m.clipAction(l.clips[0]).play(); return m; });
+    return { scene, loads, mixers, characters: [] as (GcsCharacter | null)[] };
+  }));
+  const [gpu, cpu] = sets;
+  gpu.scene.updateMatrixWorld(true);
+  const all = new THREE.Box3().setFromObject(gpu.scene), centre = all.getCenter(new THREE.Vector3()), extent = all.getSize(new THREE.Vector3()).length();
+  const camera = new THREE.PerspectiveCamera(40, W / H, extent / 100, extent * 10);
+  camera.position.copy(centre).add(new THREE.Vector3(0, 0.2, 1).normalize().multiplyScalar(extent * 1.1));
+  camera.lookAt(centre);
+  const rest = picture(gpu.scene, camera);
+  const methods = ['gcs', 'dqs', 'gcs', 'gcs', 'gcs'] as const;
+  const make = (i: number) => {
+    for (const set of sets) {
+      set.loads[i].root.visible = true;
+      set.characters[i] = new GcsCharacter(gcs, set.loads[i].root, { backend: set === gpu ? 'gpu' : 'cpu', method: methods[i] });
+    }
+  };
+  [0, 1, 2].forEach(make);
+  const info = renderer.info.render;
+  // Both sets posed and updated; the GPU set drawn (counting render() calls), then the CPU set.
+  const frame = (t = 0.2): { renders: number; vsCpu: number } => {
+    for (const set of sets) set.characters.forEach((c, i) => { if (c) { set.mixers[i].setTime(t + 0.37 * i); c.update(); } });
+    const before = info.frame;
+    const image = picture(gpu.scene, camera);
+    const renders = info.frame - before;
+    return { renders, vsCpu: differing(image, picture(cpu.scene, camera)) };
+  };
+  const passes = () => gpu.characters.filter((c): c is GcsCharacter => !!c).flatMap((c) => c.skins.map((s) => {
+    const m = s.mesh.material as THREE.Material | THREE.Material[];
+    return (Array.isArray(m) ? m[0] : m).userData.gcsNodePass as NodePass;
+  }));
+  frame(0.1); // a skin joins its renderer's page at its first draw, and runs it then
+  const first = frame();
+  const before = info.frame;
+  picture(gpu.scene, camera); // the same poses drawn again: no pass
+  const renders = [first.renders, info.frame - before];
+  const firstRows = passes().map((p) => p.firstRow), firstShared = new Set(passes().map((p) => p.target)).size === 1;
+  for (const set of sets) {
+    set.characters[1]!.dispose();
+    set.characters[1] = null;
+    set.loads[1].root.visible = false;
+  }
+  make(3);
+  make(4);
+  frame(0.1);
+  const after = frame();
+  renders.push(after.renders);
+  const result: SharedPassResult = {
+    renders, rows: { first: firstRows, after: passes().map((p) => p.firstRow), heights: passes().map((p) => p.target!.height) },
+    shared: [firstShared, new Set(passes().map((p) => p.target)).size === 1], vsCpu: [first.vsCpu, after.vsCpu],
+    vsRest: differing(picture(gpu.scene, camera), rest),
+  };
+  for (const set of sets) for (const c of set.characters) c?.dispose();
+  return result;
+}
+
+declare global {
+  interface Window { __gpu: { check: typeof check; crowd: typeof crowd; materials: typeof materials; nodePass: typeof nodePass; sharedPass: typeof sharedPass } }
+}
+window.__gpu = { check, crowd, materials, nodePass, sharedPass };

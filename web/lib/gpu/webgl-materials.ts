@@ -105,6 +105,7 @@ export const glslKit: GpuMaterialKit = {
     const uniforms = pass ? pass.uniforms : sections.uniforms;
     const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, method, tableSlots);
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
+    if (pass) for (const m of Array.isArray(material) ? material : [material]) m.userData.gcsNodePass = pass; // what its vertex stage reads (tests read the pass back)
     const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, method, tableSlots);
     if (!pass) return { material, depth: shadow.depth, distance: shadow.distance, compileError };
     return {
