@@ -603,16 +603,17 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
   const gl = glRenderer();
   const glsl = new NodePass(c.sections, true);
   glsl.render(gl);
-  const { width, height: rows } = pass.target;
+  // The TSL pass's rows of its page (counted from the top, its first at pass.firstRow) against the GLSL pass's own target.
+  const page = pass.target!, { width, height: rows } = glsl.target!;
   let largest = 0, scale = 0;
   const nodes = count * c.sections.deformer.sectionCount;
   for (let t = 0; t < 4; t++) {
-    const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
+    const ours = await renderer.readRenderTargetPixelsAsync(page, 0, 0, page.width, page.height, t) as Float32Array;
     const theirs = new Float32Array(4 * width * rows);
     gl.readRenderTargetPixels(glsl.target!, 0, 0, width, rows, theirs, undefined, t);
     for (let n = 0; n < nodes; n++) {
-      const x = n % width, y = Math.floor(n / width);
-      const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);
+      const at = pass.offset.value + n, x = n % width, y = Math.floor(n / width);
+      const a = 4 * ((page.height - 1 - Math.floor(at / page.width)) * page.width + at % page.width), b = 4 * (y * width + x);
       for (let k = 0; k < 4; k++) {
         largest = Math.max(largest, Math.abs(ours[a + k] - theirs[b + k]));
         if (t < 3 && k === 3) scale = Math.max(scale, Math.abs(theirs[b + k]));
@@ -688,16 +689,17 @@ async function dqsPass(model: string, times: [number, number], clipName?: string
   const gl = glRenderer();
   const glsl = new NodePass(pass.sections, true);
   glsl.render(gl);
-  const { width, height: rows } = pass.target;
+  // The TSL pass's row of its page (counted from the top: pass.offset) against the GLSL pass's own target.
+  const page = pass.target!, { width, height: rows } = glsl.target!;
   const joints = pass.sections.uniforms.gcsStride.value / 4;
   let largest = 0, scale = 0, rigid = 0;
   for (let t = 0; t < 4; t++) {
-    const ours = await renderer.readRenderTargetPixelsAsync(pass.target, 0, 0, width, rows, t) as Float32Array;
+    const ours = await renderer.readRenderTargetPixelsAsync(page, 0, 0, page.width, page.height, t) as Float32Array;
     const theirs = new Float32Array(4 * width * rows);
     gl.readRenderTargetPixels(glsl.target!, 0, 0, width, rows, theirs, undefined, t);
     for (let n = 0; n < 2 * joints; n++) {
       const x = n % width, y = Math.floor(n / width);
-      const a = 4 * ((rows - 1 - y) * width + x), b = 4 * (y * width + x);
+      const a = 4 * ((page.height - 1 - pass.offset.value - y) * page.width + x), b = 4 * (y * width + x);
       for (let k = 0; k < 4; k++) largest = Math.max(largest, Math.abs(ours[a + k] - theirs[b + k]));
       if (t === 1 && n % 2 === 0) for (let k = 0; k < 3; k++) scale = Math.max(scale, Math.abs(theirs[b + k]));
       if (t === 2 && n % 2 === 0 && theirs[b] > 0) rigid++;

@@ -39,21 +39,27 @@ export interface PageMember {
   place(page: NodePage, firstRow: number): void;
 }
 
-/** A set of float render targets shared by node passes, each owning `rows` consecutive rows. */
-export class NodePage {
-  /** The four RGBA32F targets (GPU_NODE_TEXTURES), `width` texels wide. */
-  readonly target: THREE.WebGLRenderTarget;
-  private readonly scene = new THREE.Scene();
-  private readonly camera = new THREE.Camera();
-  /** Members and their first rows, in row order. */
-  private readonly members: { member: PageMember; row: number }[] = [];
+/** The options of a page's float targets: four RGBA32F textures (GPU_NODE_TEXTURES), read texel by texel. */
+export const PAGE_TARGET_OPTIONS = {
+  type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+  depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
+} as const;
 
-  /** @param width Texels per row. @param rows Rows at first (grows as members join). */
-  constructor(readonly width: number, rows: number) {
-    this.target = new THREE.WebGLRenderTarget(width, Math.max(1, rows), {
-      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
-      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
-    });
+/** A set of float render targets shared by node passes, each owning `rows` consecutive rows. */
+export class NodePage<Target extends THREE.RenderTarget = THREE.WebGLRenderTarget> {
+  /** The four RGBA32F targets (GPU_NODE_TEXTURES), `width` texels wide. */
+  readonly target: Target;
+  protected readonly scene = new THREE.Scene();
+  protected readonly camera = new THREE.Camera();
+  /** Members and their first rows, in row order. */
+  protected readonly members: { member: PageMember; row: number }[] = [];
+
+  /**
+   * @param width Texels per row. @param rows Rows at first (grows as members join).
+   * @param makeTarget The renderer's kind of target (WebGLRenderTarget; RenderTarget for WebGPURenderer).
+   */
+  constructor(readonly width: number, rows: number, makeTarget?: (width: number, height: number) => Target) {
+    this.target = makeTarget ? makeTarget(width, Math.max(1, rows)) : new THREE.WebGLRenderTarget(width, Math.max(1, rows), PAGE_TARGET_OPTIONS) as unknown as Target;
     this.scene.matrixWorldAutoUpdate = false;
   }
 
@@ -84,12 +90,18 @@ export class NodePage {
     const height = row + member.rows;
     if (height > this.target.height) {
       // The textures keep their identity (materials keep reading them); their contents are gone.
-      this.target.setSize(this.width, height);
-      for (const m of this.members) { m.member.place(this, m.row); m.member.lost(); }
+      this.grow(height);
+      for (const m of this.members) { m.member.place(this as unknown as NodePage, m.row); m.member.lost(); }
     } else {
-      member.place(this, row);
+      member.place(this as unknown as NodePage, row);
+      member.lost();
     }
     return true;
+  }
+
+  /** The targets become `height` rows high (their contents are lost). */
+  protected grow(height: number): void {
+    this.target.setSize(this.width, height);
   }
 
   /** Frees `member`'s rows. */
@@ -104,18 +116,23 @@ export class NodePage {
    * One render of every stale member into the targets (the others hidden), restoring the renderer's
    * render target, cube face, mip level and autoClear.
    */
-  run(renderer: THREE.WebGLRenderer): void {
+  run(renderer: object): void {
     let any = false;
     for (const { member } of this.members) {
       const stale = member.stale();
       member.quad.visible = stale;
       if (stale) { member.drawn(); any = true; }
     }
-    if (!any) return;
+    if (any) this.draw(renderer);
+  }
+
+  /** One render of the page's visible quads into its targets, the renderer's state restored. */
+  protected draw(into: object): void {
+    const renderer = into as THREE.WebGLRenderer;
     const target = renderer.getRenderTarget(), face = renderer.getActiveCubeFace(), level = renderer.getActiveMipmapLevel();
     const autoClear = renderer.autoClear;
     renderer.autoClear = false; // each member writes every texel of its rows
-    renderer.setRenderTarget(this.target);
+    renderer.setRenderTarget(this.target as unknown as THREE.WebGLRenderTarget);
     renderer.render(this.scene, this.camera);
     renderer.setRenderTarget(target, face, level);
     renderer.autoClear = autoClear;
@@ -127,30 +144,32 @@ export class NodePage {
   }
 }
 
-/** The pages of one WebGLRenderer (usually one). */
-export class NodeAtlas {
-  private static readonly atlases = new WeakMap<object, NodeAtlas>();
-  private readonly pages: NodePage[] = [];
+/** The pages of one renderer (usually one). */
+export class NodeAtlas<Page extends NodePage<THREE.RenderTarget> = NodePage> {
+  private static readonly atlases = new WeakMap<object, NodeAtlas<NodePage<THREE.RenderTarget>>>();
+  private readonly pages: Page[] = [];
 
-  /** The atlas of `renderer`, made at its first use. */
-  static of(renderer: THREE.WebGLRenderer): NodeAtlas {
+  private constructor(private readonly makePage: (width: number, rows: number) => Page) {}
+
+  /** The atlas of `renderer`, made at its first use (its pages made by `makePage`: WebGLRenderer's by default). */
+  static of<P extends NodePage<THREE.RenderTarget> = NodePage>(renderer: object, makePage?: (width: number, rows: number) => P): NodeAtlas<P> {
     let atlas = NodeAtlas.atlases.get(renderer);
-    if (!atlas) NodeAtlas.atlases.set(renderer, atlas = new NodeAtlas());
-    return atlas;
+    if (!atlas) NodeAtlas.atlases.set(renderer, atlas = new NodeAtlas(makePage ?? ((width, rows) => new NodePage(width, rows))));
+    return atlas as unknown as NodeAtlas<P>;
   }
 
   /** Places `member` in the first page that holds it, or in a new one; returns its page, or null when no page can hold it. */
-  add(member: PageMember): NodePage | null {
+  add(member: PageMember): Page | null {
     if (member.rows > PAGE_ROWS || member.columns > PAGE_WIDTH) return null;
     for (const page of this.pages) if (page.add(member)) return page;
-    const page = new NodePage(PAGE_WIDTH, member.rows);
+    const page = this.makePage(PAGE_WIDTH, member.rows);
     page.add(member);
     this.pages.push(page);
     return page;
   }
 
   /** Frees `member`'s rows, and its page when it was the last. */
-  remove(member: PageMember, page: NodePage): void {
+  remove(member: PageMember, page: Page): void {
     page.remove(member);
     if (page.size > 0) return;
     const i = this.pages.indexOf(page);

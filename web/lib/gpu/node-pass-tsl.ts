@@ -16,13 +16,14 @@
  */
 import * as THREE from 'three/webgpu';
 import {
-  abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mrt, screenCoordinate, select, step, texture, textureSize, vec3, vec4,
+  abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, step, texture, textureSize, uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
 import {
   COLLAPSED, DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, RIGID_JOINT_TOLERANCE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
+import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember } from './node-atlas.js';
 import type { GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
@@ -31,9 +32,6 @@ type Int = Node<'int'>;
 type Vec4 = Node<'vec4'>;
 type Mat3 = Node<'mat3'>;
 type Mat4 = Node<'mat4'>;
-
-/** The widest row of the node textures: WebGL2's guaranteed 2048. */
-const MAX_WIDTH = 2048;
 
 /** Names of the four targets, in GPU_NODE_TEXTURES order: the rows of [M | T], then the normal texel. */
 const OUTPUTS = ['gcsRow0', 'gcsRow1', 'gcsRow2', 'gcsNormal'] as const;
@@ -234,70 +232,184 @@ function noFloatTargets(renderer: unknown): boolean {
   return backend?.isWebGLBackend === true && backend.extensions?.has(FLOAT_TARGET_EXTENSION) === false;
 }
 
+/** A page of node passes for WebGPURenderer (node-atlas.ts), with the previous frame's texels for velocity. */
+export class TslNodePage extends NodePage<THREE.RenderTarget> {
+  /**
+   * Velocity: the targets as the frame before left them (copied on the GPU once per frame, before
+   * the frame's first run), made on first use (previousTextures).
+   */
+  private previous: { target: THREE.RenderTarget; filled: boolean } | null = null;
+  /** The renderer's frame (info.frame) whose copy was made. */
+  private keptFrame = -1;
+  /** Members placed since the last copy: their previous rows are computed after their first run (no motion). */
+  private readonly unfilled = new Set<PageMember>();
+
+  constructor(width: number, rows: number) {
+    super(width, rows, (w, h) => {
+      const target = new THREE.RenderTarget(w, h, PAGE_TARGET_OPTIONS);
+      target.textures.forEach((t, i) => { t.name = OUTPUTS[i]; });
+      return target;
+    });
+  }
+
+  /** The previous frame's textures (made on first use; until a frame has passed they show this frame's). */
+  previousTextures(): THREE.Texture[] {
+    if (!this.previous) this.previous = { target: this.target.clone(), filled: false };
+    return this.previous.target.textures;
+  }
+
+  override add(member: PageMember): boolean {
+    if (!super.add(member)) return false;
+    this.unfilled.add(member);
+    return true;
+  }
+
+  protected override grow(height: number): void {
+    super.grow(height);
+    this.previous?.target.setSize(this.width, height);
+    if (this.previous) this.previous.filled = false;
+  }
+
+  /**
+   * At each draw of a member, before any run: once per frame the texels become the previous
+   * frame's (a frame drawn again without an update: no motion).
+   */
+  beginFrame(renderer: THREE.WebGPURenderer): void {
+    const previous = this.previous, frame = renderer.info.frame;
+    if (!previous || frame === this.keptFrame) return;
+    this.keptFrame = frame;
+    if (previous.filled) this.copy(renderer);
+  }
+
+  /** The stale members' run; members new to the page run once more into the previous targets (no motion rather than unwritten texels). */
+  override run(renderer: object): void {
+    const r = renderer as THREE.WebGPURenderer, previous = this.previous;
+    super.run(renderer);
+    if (!previous) { this.unfilled.clear(); return; }
+    if (!previous.filled) { this.copy(r); this.unfilled.clear(); return; }
+    if (!this.unfilled.size) return;
+    for (const { member } of this.members) member.quad.visible = this.unfilled.has(member);
+    this.unfilled.clear();
+    this.drawInto(r, previous.target);
+  }
+
+  /** Velocity, before a draw that reads the previous textures: made after this frame's run, they are filled with it. */
+  fillPrevious(renderer: THREE.WebGPURenderer): void {
+    if (this.previous && !this.previous.filled) this.copy(renderer);
+  }
+
+  /** The targets copied into the previous frame's (four small GPU copies). */
+  private copy(renderer: THREE.WebGPURenderer): void {
+    const previous = this.previous!;
+    this.target.textures.forEach((t, i) => renderer.copyTextureToTexture(t, previous.target.textures[i]));
+    previous.filled = true;
+  }
+
+  protected override draw(renderer: object): void {
+    this.drawInto(renderer as unknown as THREE.WebGPURenderer, this.target);
+  }
+
+  /** One render of the visible quads into `into`, restoring the render target, cube face, mip level, MRT and autoClear. */
+  private drawInto(r: THREE.WebGPURenderer, into: THREE.RenderTarget): void {
+    const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
+    const outputMRT = r.getMRT(), autoClear = r.autoClear;
+    r.autoClear = false; // each member writes every texel of its rows
+    r.setMRT(null);
+    r.setRenderTarget(into);
+    r.render(this.scene, this.camera);
+    r.setRenderTarget(target, face, level);
+    r.setMRT(outputMRT);
+    r.autoClear = autoClear;
+  }
+
+  override dispose(): void {
+    super.dispose();
+    this.previous?.target.dispose();
+  }
+}
+
+/** The page a WebGPURenderer's passes share. */
+const makeTslPage = (width: number, rows: number): TslNodePage => new TslNodePage(width, rows);
+
 /**
- * The pass: a QuadMesh over a RenderTarget of GPU_NODE_TEXTURES float textures, one texel per node
- * (instance k's node s is node k·sections + s, row-major, MAX_WIDTH wide); for method 'dqs' the
- * joint pass, two texels per joint, one row per instance (DQS_TEXELS_PER_JOINT; gcsDqsJointTexels). Runs at the skin's
- * first draw after `GpuSections.update()` (shadow or colour pass): every pass of that frame reads
- * the same texels, and a frame drawn twice computes them once.
+ * The pass: its rows of the renderer's page (node-atlas.ts) of GPU_NODE_TEXTURES float textures,
+ * one texel per node (instance k's node s is node k·sections + s from the pass's first texel,
+ * row-major, PAGE_WIDTH wide); for method 'dqs' the joint pass, two texels per joint, one row per
+ * instance (DQS_TEXELS_PER_JOINT; gcsDqsJointTexels). Runs at the skin's first draw after
+ * `GpuSections.update()` (shadow or colour pass), with every other stale pass of the page in one
+ * render: every pass of that frame reads the same texels, and a frame drawn twice computes them once.
  */
-export class TslNodePass {
-  readonly target: THREE.RenderTarget;
+export class TslNodePass implements PageMember {
   /** Times the pass has run (once per GpuSections.update() that was drawn). */
   runs = 0;
-  private readonly quad: THREE.QuadMesh;
+  /** Rows of the page this pass writes: its nodes' (one per instance for DQS). */
+  readonly rows: number;
+  /** Texels per row this pass writes. */
+  readonly columns: number;
+  /** The mesh that draws this pass's fragments into its page. */
+  readonly quad: THREE.Mesh;
+  /** The vertex stage's offset into the page: the pass's first texel (GCS) or first row (DQS). */
+  readonly offset = uniform(0, 'int');
   private readonly material: THREE.NodeMaterial;
-  /** The GpuSections.version the target holds (−1: none yet). */
-  private drawn = -1;
+  private readonly geometry = new THREE.BufferGeometry();
+  /** The GpuSections.version the texels hold (−1: none yet). */
+  private drawnVersion = -1;
   /** What the vertex stage reads: one texture node per target. */
   private readonly views: TextureNode[];
+  /** Velocity: views of the page's previous frame (made on first use, previousTextureNode). */
+  private previousViewNodes: TextureNode[] | null = null;
+  /** The page the pass draws into, and the renderer whose atlas holds it. */
+  private page: TslNodePage | null = null;
+  private renderer: THREE.WebGPURenderer | null = null;
   /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
   private glsl: NodePass | null = null;
-  /**
-   * Velocity: a copy of the targets as the run before wrote them (copied on the GPU before each
-   * run) and the views a velocity pass's previous positions read; made on first use
-   * (previousTextureNode).
-   */
-  private previous: { target: THREE.RenderTarget; views: TextureNode[]; filled: boolean } | null = null;
-  /** The renderer's frame (info.frame) of the last run: a frame drawn without a new run has no motion. */
-  private runFrame = -1;
+  /** The fragment's numbering: the first row, the page's width, and the quad's corners in clip space. */
+  private readonly firstRow = uniform(0, 'int');
+  private readonly pageWidth = uniform(PAGE_WIDTH, 'int');
+  private readonly rect = uniform(new THREE.Vector4());
 
   constructor(readonly sections: GpuSections) {
     // DQS: the joint pass, two texels per joint (its quaternion, dual part and uniform scale; K); GCS: one per section.
     const dqs = sections.method === 'dqs', stride = sections.uniforms.gcsStride.value;
     const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
-    const nodes = sections.instanceCount * S * (dqs ? DQS_TEXELS_PER_JOINT : 1);
-    // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = MAX_WIDTH, read without a division per joint.)
-    const width = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(MAX_WIDTH, nodes), height = Math.ceil(nodes / width);
-    this.target = new THREE.RenderTarget(width, height, {
-      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
-      depthBuffer: false, stencilBuffer: false, generateMipmaps: false, count: GPU_NODE_TEXTURES,
-    });
-    this.target.textures.forEach((t, i) => { t.name = OUTPUTS[i]; });
-    // One fragment per texel: its node from the fragment's position (texels past the last repeat the last node).
+    const nodes = sections.instanceCount * S;
+    // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = PAGE_WIDTH, read without a division per joint.)
+    this.columns = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
+    this.rows = dqs ? sections.instanceCount : Math.ceil(nodes / PAGE_WIDTH);
+    // One fragment per texel: its node from the fragment's position in the pass's rows (texels past the last repeat the last node).
     const joints = texture(sections.texture);
     const table = dqs ? null : texture(sections.table as DataTexture);
     const texels = Fn(() => {
-      const at = ivec2(screenCoordinate);
-      const texel = (min(at.y.mul(width).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
+      const at = ivec2(screenCoordinate).toVar();
+      const row = at.y.sub(this.firstRow).toVar();
       if (dqs) {
         const joint = at.x.div(DQS_TEXELS_PER_JOINT).toVar();
-        const pose = jointPose({ joints, slots: sections.tableSlots, first: at.y.mul(stride) }, joint);
+        const pose = jointPose({ joints, slots: sections.tableSlots, first: row.mul(stride) }, joint);
         return gcsDqsJointTexels(pose, at.x.notEqual(joint.mul(DQS_TEXELS_PER_JOINT)));
       }
+      const texel = (min(row.mul(this.pageWidth).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
       const instance = texel.div(S).toVar();
       const inputs: JointInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride) };
       return nodeTexels(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
     this.material = new THREE.NodeMaterial();
     this.material.name = 'gcsNodePass';
+    // Two triangles over the pass's texels (rows counted from the top, as screenCoordinate and textureLoad count them).
+    this.material.vertexNode = vec4(mix(this.rect.xy, this.rect.zw, positionGeometry.xy), 0, 1);
     // The fragment is the four outputs (an output struct: no lighting, fog or colour transform).
     this.material.fragmentNode = mrt(Object.fromEntries(OUTPUTS.map((name, i) => [name, column(texels, i)])));
     this.material.depthTest = false;
     this.material.depthWrite = false;
     this.material.blending = THREE.NoBlending;
-    this.quad = new THREE.QuadMesh(this.material);
-    this.views = this.target.textures.map((t) => texture(t));
+    this.material.side = THREE.DoubleSide;
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0]), 3));
+    this.quad = new THREE.Mesh(this.geometry, this.material);
+    this.views = OUTPUTS.map(() => texture(EMPTY));
+  }
+
+  /** The page's target this pass draws into (shared with other passes); null before its first draw. */
+  get target(): THREE.RenderTarget | null {
+    return this.page?.target ?? null;
   }
 
   /** The vertex stage's view of target i (0–2: rows of [M | T], 3: the normal texel); one node per target, shared by every material. */
@@ -308,15 +420,12 @@ export class TslNodePass {
   /**
    * Velocity: a view of target i as the frame before drew it (the run before this frame's), for a
    * velocity pass's previous positions: the nodes of the previous frame, read as this frame's are,
-   * not blended again per vertex. Until a second run, and in a frame drawn without a new run, it
-   * shows this frame's (no motion).
+   * not blended again per vertex. Until a frame has passed, and in a frame drawn without a new run,
+   * it shows this frame's (no motion).
    */
   previousTextureNode(i: number): TextureNode {
-    if (!this.previous) {
-      const target = this.target.clone();
-      this.previous = { target, views: target.textures.map((t) => texture(t)), filled: false };
-    }
-    return this.previous.views[i];
+    this.previousViewNodes ??= OUTPUTS.map((_, t) => texture(this.page ? this.page.previousTextures()[t] : EMPTY));
+    return this.previousViewNodes[i];
   }
 
   /** The vertex stage's views of the previous frame's targets (previousTextureNode), as textureNode gives this frame's. */
@@ -326,74 +435,85 @@ export class TslNodePass {
 
   /**
    * Writes every node of every instance for the current joint poses, unless already written since
-   * the last GpuSections.update(); returns why `renderer` cannot, or null. WebGPURenderer: this
-   * pass (restoring the render target, cube face, mip level and MRT). A WebGLRenderer with
-   * three.js's WebGLNodesHandler: the GLSL pass (node-pass.ts), same layout, whose targets the
-   * views then show — while the targets are one row high: the handler's texture reads count rows
-   * from the top (WebGPU's convention) and the GLSL pass writes them from the bottom.
+   * the last GpuSections.update(), with every other stale pass of the renderer's page in one
+   * render; returns why `renderer` cannot, or null. WebGPURenderer: the page's render (restoring the
+   * render target, cube face, mip level and MRT). A WebGLRenderer with three.js's WebGLNodesHandler:
+   * the GLSL pass (node-pass.ts) on a page of its own, same layout, whose targets the views then
+   * show — while the pass is one row high: the handler's texture reads count rows from the top
+   * (WebGPU's convention) and the GLSL pass writes them from the bottom.
    */
   render(renderer: unknown): string | null {
     const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
     if (r?.isWebGLRenderer) {
       const why = NodePass.unsupported(renderer);
       if (why) return why;
-      if (this.target.height > 1) return `a WebGLRenderer with WebGLNodesHandler reads the node pass's targets from the other end when they span more than one row (more than ${MAX_WIDTH} nodes)`;
+      if (this.rows > 1) return `a WebGLRenderer with WebGLNodesHandler reads the node pass's targets from the other end when they span more than one row (more than ${PAGE_WIDTH} nodes)`;
       this.glsl ??= new NodePass(this.sections, true);
-      this.show(this.glsl.target!.textures);
+      this.show(this.glsl.target!.textures, null);
+      this.offset.value = 0;
       return this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
-    this.show(this.target.textures);
-    const version = this.sections.version, frame = r.info.frame;
-    const previous = this.previous;
-    if (this.drawn === version) {
-      // Drawn again in a new frame without an update: no motion (the previous frame's nodes are these).
-      if (previous && frame !== this.runFrame) { this.keepPrevious(r); this.runFrame = frame; }
-      return null;
+    if (this.renderer !== r) {
+      // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
+      if (this.page && this.renderer) NodeAtlas.of(this.renderer, makeTslPage).remove(this, this.page);
+      this.page = NodeAtlas.of(r, makeTslPage).add(this);
+      this.renderer = this.page ? r : null;
+      if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
     }
-    // The nodes this run overwrites become the previous frame's (the first run has none: no motion).
-    if (previous && this.drawn >= 0) this.keepPrevious(r);
-    this.drawn = version;
-    this.runFrame = frame;
-    this.runs++;
-    const target = r.getRenderTarget(), face = r.getActiveCubeFace(), level = r.getActiveMipmapLevel();
-    const outputMRT = r.getMRT(), autoClear = r.autoClear;
-    r.autoClear = false; // every texel is written
-    r.setMRT(null);
-    r.setRenderTarget(this.target);
-    this.quad.render(r);
-    r.setRenderTarget(target, face, level);
-    r.setMRT(outputMRT);
-    r.autoClear = autoClear;
+    this.page!.beginFrame(r);
+    if (this.stale()) this.page!.run(r);
     return null;
   }
 
-  /**
-   * Velocity, before each draw that reads previousTextureNode: until the previous frame's copy has
-   * been made (its targets were made by the draw's shader build, after this frame's run), this
-   * frame's nodes are copied in (no motion rather than an unwritten texture).
-   */
+  /** Velocity, before each draw that reads previousTextureNode: the page's previous textures filled with this frame's until a frame has passed. */
   fillPrevious(renderer: unknown): void {
-    const r = renderer as THREE.WebGPURenderer & { isWebGLRenderer?: boolean };
-    if (this.previous && !this.previous.filled && this.drawn >= 0 && r?.isWebGPURenderer) this.keepPrevious(r);
+    const r = renderer as THREE.WebGPURenderer;
+    if (this.page && this.previousViewNodes && r?.isWebGPURenderer) this.page.fillPrevious(r);
   }
 
-  /** Copies the targets into the previous frame's (four small GPU copies). */
-  private keepPrevious(renderer: THREE.WebGPURenderer): void {
-    const previous = this.previous!;
-    this.target.textures.forEach((t, i) => renderer.copyTextureToTexture(t, previous.target.textures[i]));
-    previous.filled = true;
+  /** @internal Whether the texels are older than the joint poses. */
+  stale(): boolean {
+    return this.drawnVersion !== this.sections.version;
   }
 
-  /** Points the vertex stage's views at `textures` (this pass's, or the GLSL pass's). */
-  private show(textures: THREE.Texture[]): void {
+  /** @internal The texels hold the current joint poses. */
+  drawn(): void {
+    this.drawnVersion = this.sections.version;
+    this.runs++;
+  }
+
+  /** @internal The texels were lost (the page grew, or the pass is new to it). */
+  lost(): void {
+    this.drawnVersion = -1;
+  }
+
+  /** @internal This pass's rows start at `firstRow` of `page`: its quad, its fragments' numbering and the vertex stage's reads follow. */
+  place(page: NodePage, firstRow: number): void {
+    const tslPage = page as unknown as TslNodePage;
+    const { width, height } = tslPage.target;
+    this.firstRow.value = firstRow;
+    this.pageWidth.value = width;
+    this.rect.value.set(-1, 1 - 2 * firstRow / height, 2 * this.columns / width - 1, 1 - 2 * (firstRow + this.rows) / height);
+    this.offset.value = this.sections.method === 'dqs' ? firstRow : firstRow * width;
+    this.show(tslPage.target.textures, this.previousViewNodes ? tslPage.previousTextures() : null);
+  }
+
+  /** Points the vertex stage's views at `textures` (the page's, or the GLSL pass's) and the previous views at `previous`. */
+  private show(textures: THREE.Texture[], previous: THREE.Texture[] | null): void {
     for (let i = 0; i < this.views.length; i++) if (this.views[i].value !== textures[i]) this.views[i].value = textures[i];
+    if (previous && this.previousViewNodes) for (let i = 0; i < previous.length; i++) this.previousViewNodes[i].value = previous[i];
   }
 
   dispose(): void {
-    this.target.dispose();
-    this.previous?.target.dispose();
+    if (this.page && this.renderer) NodeAtlas.of(this.renderer, makeTslPage).remove(this, this.page);
+    this.page = null;
+    this.renderer = null;
     this.material.dispose();
+    this.geometry.dispose();
     this.glsl?.dispose();
   }
 }
+
+/** What a view shows before its pass has a page: one float texel. */
+const EMPTY = new THREE.DataTexture(new Float32Array(4), 1, 1, THREE.RGBAFormat, THREE.FloatType);

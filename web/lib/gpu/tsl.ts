@@ -368,7 +368,9 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
     const first = (instanced ? baseNode.add(int(instanceIndex).mul(strideNode)) : baseNode).toVar();
     // This instance's first node in the pass's targets (DQS's joint pass: its row).
     const perInstance = sections.method === 'dqs' ? 1 : sections.deformer.sectionCount;
-    const nodeFirst = (instanced ? int(instanceIndex).mul(perInstance) : int(0)).toVar();
+    // (The pass's rows start at its offset in the page it shares with the renderer's other passes.)
+    const offset = pass ? pass.offset : int(0);
+    const nodeFirst = (instanced ? offset.add(int(instanceIndex).mul(perInstance)) : offset).toVar();
     const vertex = vertexTransform(sections, perFrame, first, pass, nodeFirst);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
