@@ -50,8 +50,10 @@ function layout(roots: THREE.Object3D[], spacing: number): void {
 /** gcs-skin/three's classes, or gcs-skin/webgpu's under WebGPURenderer (set by run() before any method is made). */
 const entry: { Character: typeof GcsCharacter; Crowd: typeof GcsCrowd } = { Character: GcsCharacter, Crowd: GcsCrowd };
 
-function characters(options: GcsCharacterOptions): (gcs: GcsSkin, sources: THREE.Object3D[]) => Drawn {
+/** `updates`: update() calls that reach the characters (then none: the frozen pose, no node pass; the vertex stage's share of the cost). */
+function characters(options: GcsCharacterOptions, updates = Infinity): (gcs: GcsSkin, sources: THREE.Object3D[]) => Drawn {
   return (gcs, sources) => {
+    let left = updates;
     const scene = stageScene();
     const list = sources.map((root) => {
       scene.add(root);
@@ -59,7 +61,7 @@ function characters(options: GcsCharacterOptions): (gcs: GcsSkin, sources: THREE
     });
     return {
       scene,
-      update: () => { for (const c of list) c.update(); },
+      update: () => { if (left-- > 0) for (const c of list) c.update(); },
       bytesPerCharacter: () => list.reduce((n, c) => n + c.skins.reduce((m, s) => m + s.bytesPerFrame, 0), 0) / list.length,
       note: () => [...new Set(list.flatMap((c) => c.skins.map((s) => s.backendNote)).filter(Boolean))].join('; '),
       dispose: () => { for (const c of list) c.dispose(); },
@@ -137,6 +139,8 @@ const METHODS: Method[] = [
   { name: 'bind', label: 'bind pose, no skinning (floor)', make: bindPose },
   { name: 'gpu', label: "GcsCharacter, backend 'gpu' (default: node pass)", make: gpu('gcs') },
   { name: 'crowd', label: 'GcsCrowd (node pass)', make: crowd },
+  // The warm-up's 3 frames pose them; then the same nodes are drawn: the default's frame without its node pass.
+  { name: 'vertex', label: "GcsCharacter 'gpu', vertex stage only (no pass)", make: characters({ backend: 'gpu', method: 'gcs' }, 3) },
   { name: 'plain', label: "GcsCharacter 'gpu', smooth: false", make: gpu('gcs', { gcs: { smooth: false } }) },
   { name: 'sections', label: "GcsCharacter 'gpu', gpuPath: 'sections'", make: gpu('gcs', { gpuPath: 'sections' }) },
   { name: 'dqs', label: "DQS, backend 'gpu'", make: gpu('dqs') },
