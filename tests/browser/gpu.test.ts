@@ -223,20 +223,22 @@ describe.skipIf(!!reason)('LBS and DQS on the GPU backend = on the CPU', () => {
 });
 
 describe.skipIf(!!reason || !!noCesium)('the node pass: once per frame; without float render targets, the section-level path', () => {
-  test('every skin of a renderer in one page: one render() for three characters (GCS and DQS), rows reused and the page grown, pictures = the CPU backend', async () => {
-    interface P { renders: number[]; rows: { first: number[]; after: number[]; heights: number[] }; shared: boolean[]; vsCpu: number[]; vsRest: number }
+  test('every skin of a renderer in one page: one render() of the joint passes and one of the node passes for three characters (GCS and DQS), rows reused and the pages grown, pictures = the CPU backend', async () => {
+    interface P { renders: number[]; rows: { first: number[][]; after: number[][] }; heights: number[]; shared: boolean[]; vsCpu: number[]; vsRest: number }
     const r = await fixture.page.evaluate((m) => (window as unknown as { __gpu: { sharedPass(a: string): Promise<P> } }).__gpu.sharedPass(m), `/@fs${CESIUM}`);
-    console.log(`shared node pass: render() calls ${r.renders.join(', ')} (a frame of three characters, drawn again, a frame after a dispose and two new); ` +
-      `first rows ${r.rows.first.join(', ')} → ${r.rows.after.join(', ')} of ${r.rows.heights[0]}; ` +
+    const rows = (list: number[][]) => list.map(([n, j]) => `${n}/${j}`).join(', ');
+    console.log(`shared passes: render() calls ${r.renders.join(', ')} (a frame of three characters, drawn again, a frame after a dispose and two new); ` +
+      `node/joint rows ${rows(r.rows.first)} → ${rows(r.rows.after)} of ${r.heights.join('/')}; ` +
       `vs the CPU backend ${r.vsCpu.map((d) => `${(100 * d).toFixed(3)} %`).join(', ')}; vs the rest pose ${(100 * r.vsRest).toFixed(1)} %`);
-    // The frame's own render() and one page render for all three; drawn again: none.
-    expect(r.renders).toEqual([2, 1, 2]);
+    // The frame's own render(), one of the joint page and one of the node page for all three; drawn again: none.
+    expect(r.renders).toEqual([3, 1, 3]);
     expect(r.shared).toEqual([true, true]);
-    // CesiumMan's nodes fit a row: GCS, DQS, GCS in rows 0, 1, 2; the DQS one freed, the next takes
-    // row 1 and the last grows the page to 4 rows.
-    expect(r.rows.first).toEqual([0, 1, 2]);
-    expect(r.rows.after).toEqual([0, 2, 1, 3]);
-    expect(r.rows.heights).toEqual([4, 4, 4, 4]);
+    // CesiumMan's nodes fit a row, its joints too: the GCS characters' node passes in rows 0 and 1, the
+    // joint passes of all three (DQS's is its only pass) in rows 0, 1, 2. The DQS one freed, the next
+    // takes its joint row, and the last grows both pages to 4 rows.
+    expect(r.rows.first).toEqual([[0, 0], [-1, 1], [1, 2]]);
+    expect(r.rows.after).toEqual([[0, 0], [1, 2], [2, 1], [3, 3]]);
+    expect(r.heights).toEqual([4, 4]);
     for (const d of r.vsCpu) expect(d).toBeLessThan(PIXEL_TOLERANCE);
     expect(r.vsRest).toBeGreaterThan(0.01);
   });
@@ -246,8 +248,8 @@ describe.skipIf(!!reason || !!noCesium)('the node pass: once per frame; without 
     const r = await fixture.page.evaluate((m) => (window as unknown as { __gpu: { nodePass(a: string, b: number): Promise<P> } }).__gpu.nodePass(m, 0.9), `/@fs${CESIUM}`);
     console.log(`render() calls per frame: ${r.renders.join(', ')} (first frame, drawn again, next frame); no float targets: ${r.fallbackPath} (${r.fallbackNote}), ` +
       `${(100 * r.fallbackDiff).toFixed(3)} % of pixels differ from the CPU backend; crowd: ${r.crowdError}`);
-    // The frame's own render() plus one node pass, before the shadow map; the same pose drawn again: no pass.
-    expect(r.renders).toEqual([2, 1, 2]);
+    // The frame's own render() plus the joint pass and the node pass, before the shadow map; the same pose drawn again: no pass.
+    expect(r.renders).toEqual([3, 1, 3]);
     expect(r.fallbackPath).toBe('sections');
     expect(r.fallbackNote).toMatch(/EXT_color_buffer_float/);
     expect(r.fallbackDiff).toBeLessThan(PIXEL_TOLERANCE);

@@ -470,9 +470,11 @@ async function nodePass(model: string, time: number): Promise<PassResult> {
 export interface SharedPassResult {
   /** render() calls for a frame of three characters, that frame drawn again, and a frame after a dispose and two new characters (each after the characters' first) */
   renders: number[];
-  /** each node pass's page height and first row, after the first frame and after the changes */
-  rows: { first: number[]; after: number[]; heights: number[] };
-  /** whether every pass shares one target, before and after */
+  /** per character, the first row of its node pass (−1 for DQS) and of its joint pass, after the first frame and after the changes */
+  rows: { first: number[][]; after: number[][] };
+  /** the heights of the node page and the joint page after the changes */
+  heights: number[];
+  /** whether the node passes share one target and the joint passes another, before and after */
   shared: boolean[];
   /** share of pixels differing from the CPU backend's picture, after the first frame and after the changes */
   vsCpu: number[];
@@ -522,16 +524,20 @@ async function sharedPass(model: string): Promise<SharedPassResult> {
     const renders = info.frame - before;
     return { renders, vsCpu: differing(image, picture(cpu.scene, camera)) };
   };
+  // Per character: its node pass (null for DQS) and its joint pass.
   const passes = () => gpu.characters.filter((c): c is GcsCharacter => !!c).flatMap((c) => c.skins.map((s) => {
     const m = s.mesh.material as THREE.Material | THREE.Material[];
-    return (Array.isArray(m) ? m[0] : m).userData.gcsNodePass as NodePass;
+    const pass = (Array.isArray(m) ? m[0] : m).userData.gcsNodePass as NodePass;
+    return pass.jointPass ? { nodes: pass, joints: pass.jointPass } : { nodes: null, joints: pass };
   }));
+  const rowsOf = () => passes().map((p) => [p.nodes ? p.nodes.firstRow : -1, p.joints.firstRow]);
+  const shared = () => new Set(passes().flatMap((p) => (p.nodes ? [p.nodes.target] : []))).size === 1 && new Set(passes().map((p) => p.joints.target)).size === 1;
   frame(0.1); // a skin joins its renderer's page at its first draw, and runs it then
   const first = frame();
   const before = info.frame;
   picture(gpu.scene, camera); // the same poses drawn again: no pass
   const renders = [first.renders, info.frame - before];
-  const firstRows = passes().map((p) => p.firstRow), firstShared = new Set(passes().map((p) => p.target)).size === 1;
+  const firstRows = rowsOf(), firstShared = shared();
   for (const set of sets) {
     set.characters[1]!.dispose();
     set.characters[1] = null;
@@ -543,8 +549,8 @@ async function sharedPass(model: string): Promise<SharedPassResult> {
   const after = frame();
   renders.push(after.renders);
   const result: SharedPassResult = {
-    renders, rows: { first: firstRows, after: passes().map((p) => p.firstRow), heights: passes().map((p) => p.target!.height) },
-    shared: [firstShared, new Set(passes().map((p) => p.target)).size === 1], vsCpu: [first.vsCpu, after.vsCpu],
+    renders, rows: { first: firstRows, after: rowsOf() }, heights: [passes()[0].nodes!.target!.height, passes()[0].joints.target!.height],
+    shared: [firstShared, shared()], vsCpu: [first.vsCpu, after.vsCpu],
     vsRest: differing(picture(gpu.scene, camera), rest),
   };
   for (const set of sets) for (const c of set.characters) c?.dispose();

@@ -33,8 +33,8 @@ function standInRenderer() {
 describe('NodeAtlas', () => {
   test('rows are taken first-fit, freed rows reused, and a growth re-places and recomputes every member', () => {
     const { renderer, drawn } = standInRenderer();
-    const atlas = NodeAtlas.of(renderer);
-    expect(NodeAtlas.of(renderer)).toBe(atlas);
+    const atlas = NodeAtlas.of(renderer, 'nodes');
+    expect(NodeAtlas.of(renderer, 'nodes')).toBe(atlas);
     const [a, b, c] = [new Member(2), new Member(1), new Member(3)];
     const page = atlas.add(a)!;
     expect(atlas.add(b)).toBe(page);
@@ -71,7 +71,7 @@ describe('NodeAtlas', () => {
 
   test('the page is freed with its last member; a pass larger than a page is refused', () => {
     const { renderer } = standInRenderer();
-    const atlas = NodeAtlas.of(renderer);
+    const atlas = NodeAtlas.of(renderer, 'nodes');
     const a = new Member(1);
     const page = atlas.add(a)!;
     let freed = 0;

@@ -166,7 +166,16 @@ vec4 gcsNormalTexel( const in mat3 k ) {
 }
 `;
 
-/** The node maths: joint poses (per frame) and the section table (static) → one node's transform and normal matrix. */
+/** Slot k of a section's table (its joint id and weight; the second set past 4); a slot of weight 0 is skipped. */
+const TABLE_SLOT = /* glsl */ `
+		#if GCS_TABLE_SLOTS > 4
+		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ], w = k < 4 ? weights[ k ] : weights1[ k - 4 ];
+		#else
+		float id = joints[ k ], w = weights[ k ];
+		#endif
+		if ( ! ( w > 0.0 ) ) continue;`;
+
+/** The joint poses (per frame): joint j's pose, the rotation of a quaternion, the normal texel of a scale part. */
 const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
 vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
@@ -194,49 +203,74 @@ void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out ve
 	t = vec3( r0.w, r1.w, r2.w );
 }
 ${ROTATION}
-${NORMAL_TEXEL}// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
+${NORMAL_TEXEL}`;
+
+/**
+ * The node pass's maths: a node from its joints' parts, as the joint pass wrote them once per joint
+ * and frame (DQS_PASS_FRAGMENT: the quaternion, dual part and uniform scale; the rows of K).
+ */
+const NODE_FROM_PARTS = /* glsl */ `
+uniform highp sampler2D gcsJointParts0;
+uniform highp sampler2D gcsJointParts1;
+uniform highp sampler2D gcsJointParts2;
+uniform int gcsJointRow;
+// Joint j's scale part K (columns) from its second texel in the joint pass's row \`row\`.
+mat3 gcsPartScale( const in float j, const in int row ) {
+	ivec2 at = ivec2( int( j ) * ${DQS_TEXELS_PER_JOINT} + 1, row );
+	return transpose( mat3( texelFetch( gcsJointParts0, at, 0 ).xyz, texelFetch( gcsJointParts1, at, 0 ).xyz, texelFetch( gcsJointParts2, at, 0 ).xyz ) );
+}
+// The dual-quaternion blend of up to GCS_TABLE_SLOTS joints (ids in joints, joints1; weights in
 // weights, weights1; a slot of weight 0 adds nothing) into x ↦ M x + T and the normal texel N
-// (gcsNormalTexel): K_j = R_jᵀ S_j blended linearly, applied first; with a centre of rotation
-// (w = 1; w = 0: none) the blend's M about it. One joint alone (joints.y < 0) is S_j itself.
-// \`base\`: the instance's first joint texel. The CPU's blendPoses, step for step.
-void gcsBlend( const in int base, const in vec4 joints, const in vec4 weights, const in vec4 joints1, const in vec4 weights1,
+// (gcsNormalTexel), from their parts in the joint pass's row \`row\`: where every joint is a uniform
+// scale, M = s·R (s = Σ w u) and N = (1/s, 1, 0, 0); otherwise K = Σ w K_j applied first, M = R·K.
+// With a centre of rotation (w = 1; w = 0: none) the blend's M about it, the centre moved by
+// LBS (the joint poses from \`base\`). One joint alone (joints.y < 0) is S_j itself.
+// The CPU's blendPoses, step for step.
+void gcsBlend( const in int base, const in int row, const in vec4 joints, const in vec4 weights, const in vec4 joints1, const in vec4 weights1,
 	const in vec4 centre, out mat3 M, out vec3 T, out vec4 N ) {
-	mat3 S; vec3 t; vec4 q;
-	gcsJoint( base, int( joints.x ), S, t, q );
-	#ifndef GCS_PER_VERTEX
-	// (Per vertex, DQS, a vertex of one joint takes the blend of one: the same up to rounding, and a
-	// shader with one path costs less where every path runs.)
 	if ( joints.y < 0.0 ) {
-		M = S; T = t;
-		N = gcsNormalTexel( transpose( gcsRotation( q, 2.0 ) ) * S );
+		vec4 q;
+		gcsJoint( base, int( joints.x ), M, T, q );
+		N = gcsNormalTexel( gcsPartScale( joints.x, row ) );
 		return;
 	}
-	#endif
-	vec4 pivot = q, br = vec4( 0.0 ), bd = vec4( 0.0 );
-	mat3 K = mat3( 0.0 );
-	vec3 moved = vec3( 0.0 ); // Σ w_i (S_i p − p): where LBS moves the centre p
-	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {
-		#if GCS_TABLE_SLOTS > 4
-		float id = k < 4 ? joints[ k ] : joints1[ k - 4 ];
-		float w = k < 4 ? weights[ k ] : weights1[ k - 4 ];
-		#else
-		float id = joints[ k ], w = weights[ k ];
-		#endif
-		if ( ! ( w > 0.0 ) ) continue;
-		if ( k > 0 ) gcsJoint( base, int( id ), S, t, q );
-		vec4 d = 0.5 * vec4( q.w * t + cross( t, q.xyz ), - dot( t, q.xyz ) );
+	vec4 pivot = texelFetch( gcsJointParts0, ivec2( int( joints.x ) * ${DQS_TEXELS_PER_JOINT}, row ), 0 ), br = vec4( 0.0 ), bd = vec4( 0.0 );
+	float s = 0.0;
+	bool rigid = true; // every joint's K a uniform scale: the blend of scales is s·I
+	for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${TABLE_SLOT}
+		ivec2 at = ivec2( int( id ) * ${DQS_TEXELS_PER_JOINT}, row );
+		vec4 q = texelFetch( gcsJointParts0, at, 0 );
 		float sw = dot( q, pivot ) < 0.0 ? - w : w;
 		br += sw * q;
-		bd += sw * d;
-		K += w * ( transpose( gcsRotation( q, 2.0 ) ) * S );
-		moved += w * ( S * centre.xyz + t - centre.xyz );
+		bd += sw * texelFetch( gcsJointParts1, at, 0 );
+		float u = texelFetch( gcsJointParts2, at, 0 ).x;
+		s += w * u;
+		rigid = rigid && u > 0.0;
 	}
 	float inv2 = 1.0 / dot( br, br );
 	T = ( 2.0 * inv2 ) * ( br.w * bd.xyz - bd.w * br.xyz - cross( bd.xyz, br.xyz ) );
-	M = gcsRotation( br, 2.0 * inv2 ) * K;
-	// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
-	if ( centre.w > 0.5 ) T = moved - ( M * centre.xyz - centre.xyz );
-	N = gcsNormalTexel( K );
+	mat3 R = gcsRotation( br, 2.0 * inv2 );
+	if ( rigid ) {
+		M = s * R;
+		N = vec4( 1.0 / s, 1.0, 0.0, 0.0 );
+	} else {
+		mat3 K = mat3( 0.0 );
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${TABLE_SLOT}
+			K += w * gcsPartScale( id, row );
+		}
+		M = R * K;
+		N = gcsNormalTexel( K );
+	}
+	if ( centre.w > 0.5 ) {
+		// With a centre: turn about it, the centre moved by LBS (M p + T = Σ w_i S_i p).
+		vec3 moved = vec3( 0.0 ); // Σ w_i (S_i p − p): where LBS moves the centre p
+		for ( int k = 0; k < GCS_TABLE_SLOTS; k ++ ) {${TABLE_SLOT}
+			mat3 S; vec3 t; vec4 q;
+			gcsJoint( base, int( id ), S, t, q );
+			moved += w * ( S * centre.xyz + t - centre.xyz );
+		}
+		T = moved - ( M * centre.xyz - centre.xyz );
+	}
 }
 `;
 
@@ -261,23 +295,23 @@ layout( location = 3 ) out highp vec4 gcsNormal;
  * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
  */
 const NODE_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}uniform highp sampler2D gcsTable;
-${NODE_MATHS}
+${NODE_MATHS}${NODE_FROM_PARTS}
 // Section s: its joints, weights and centre of rotation from the static table (GCS_TABLE_TEXELS per
 // section: per 4 slots a texel of joints, −1 past the last, then one of weights; last, the centre).
-void gcsSectionBlend( const in int base, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
-	int row = GCS_TABLE_TEXELS * s;
+void gcsSectionBlend( const in int base, const in int row, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
+	int at = GCS_TABLE_TEXELS * s;
 	vec4 joints1 = vec4( - 1.0 ), weights1 = vec4( 0.0 );
 	#if GCS_TABLE_SLOTS > 4
-	joints1 = gcsTexel( gcsTable, row + 2 ); weights1 = gcsTexel( gcsTable, row + 3 );
+	joints1 = gcsTexel( gcsTable, at + 2 ); weights1 = gcsTexel( gcsTable, at + 3 );
 	#endif
-	gcsBlend( base, gcsTexel( gcsTable, row ), gcsTexel( gcsTable, row + 1 ), joints1, weights1, gcsTexel( gcsTable, row + GCS_TABLE_TEXELS - 1 ), M, T, N );
+	gcsBlend( base, row, gcsTexel( gcsTable, at ), gcsTexel( gcsTable, at + 1 ), joints1, weights1, gcsTexel( gcsTable, at + GCS_TABLE_TEXELS - 1 ), M, T, N );
 }
 void main() {
 	int node = ( int( gl_FragCoord.y ) - gcsFirstRow ) * gcsTargetWidth + int( gl_FragCoord.x );
 	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
 	int instance = node / gcsSectionCount;
 	mat3 M; vec3 T; vec4 N;
-	gcsSectionBlend( instance * gcsJointStride, node - instance * gcsSectionCount, M, T, N );
+	gcsSectionBlend( instance * gcsJointStride, gcsJointRow + instance, node - instance * gcsSectionCount, M, T, N );
 	gcsNormal = N;
 	gcsRow0 = vec4( M[ 0 ][ 0 ], M[ 1 ][ 0 ], M[ 2 ][ 0 ], T.x );
 	gcsRow1 = vec4( M[ 0 ][ 1 ], M[ 1 ][ 1 ], M[ 2 ][ 1 ], T.y );

@@ -21,6 +21,9 @@ export const PAGE_WIDTH = 2048;
 /** The most rows a page grows to: WebGL2's guaranteed texture size. */
 export const PAGE_ROWS = 2048;
 
+/** What a pass writes: one texel per node (of every instance), or two per joint, one row per instance (the joint pass). */
+export type PassKind = 'nodes' | 'joints';
+
 /** What a page needs of a pass drawn into it. */
 export interface PageMember {
   /** Rows the member needs (its nodes, or its instances for a joint pass). */
@@ -146,15 +149,21 @@ export class NodePage<Target extends THREE.RenderTarget = THREE.WebGLRenderTarge
 
 /** The pages of one renderer (usually one). */
 export class NodeAtlas<Page extends NodePage<THREE.RenderTarget> = NodePage> {
-  private static readonly atlases = new WeakMap<object, NodeAtlas<NodePage<THREE.RenderTarget>>>();
+  private static readonly atlases = new WeakMap<object, Map<string, NodeAtlas<NodePage<THREE.RenderTarget>>>>();
   private readonly pages: Page[] = [];
 
   private constructor(private readonly makePage: (width: number, rows: number) => Page) {}
 
-  /** The atlas of `renderer`, made at its first use (its pages made by `makePage`: WebGLRenderer's by default). */
-  static of<P extends NodePage<THREE.RenderTarget> = NodePage>(renderer: object, makePage?: (width: number, rows: number) => P): NodeAtlas<P> {
-    let atlas = NodeAtlas.atlases.get(renderer);
-    if (!atlas) NodeAtlas.atlases.set(renderer, atlas = new NodeAtlas(makePage ?? ((width, rows) => new NodePage(width, rows))));
+  /**
+   * The atlas of `renderer` for passes of one kind ('nodes', or 'joints': the joint passes the
+   * node passes read, drawn first), made at its first use (its pages made by `makePage`:
+   * WebGLRenderer's by default).
+   */
+  static of<P extends NodePage<THREE.RenderTarget> = NodePage>(renderer: object, kind: PassKind, makePage?: (width: number, rows: number) => P): NodeAtlas<P> {
+    let kinds = NodeAtlas.atlases.get(renderer);
+    if (!kinds) NodeAtlas.atlases.set(renderer, kinds = new Map());
+    let atlas = kinds.get(kind);
+    if (!atlas) kinds.set(kind, atlas = new NodeAtlas(makePage ?? ((width, rows) => new NodePage(width, rows))));
     return atlas as unknown as NodeAtlas<P>;
   }
 

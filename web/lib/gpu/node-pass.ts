@@ -16,7 +16,7 @@ import * as THREE from 'three';
 import { checkObject } from '../arguments.js';
 import { dqsPassShaders, nodePassShaders } from './glsl.js';
 import { DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
-import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_WIDTH, type PageMember } from './node-atlas.js';
+import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** The extension float render targets need in WebGL2 (RGBA32F colour attachments). */
@@ -51,25 +51,30 @@ export class NodePass implements PageMember {
   /** Where the pass draws: its page, and the renderer whose atlas holds it (null: none yet, or a page of its own). */
   private page: NodePage | null = null;
   private readonly ownPage: boolean;
-  private readonly firstRowUniform: { value: number };
+  /** @internal The first row's uniform (the node pass reads its joint pass's). */
+  readonly firstRowUniform: { value: number };
   private renderer: Renderer | null = null;
   /** The GpuSections.version the target holds (−1: none yet). */
   private drawnVersion = -1;
+
+  /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
+  readonly jointPass: NodePass | null;
 
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
    * @param ownPage A page of its own, exactly its rows and columns, instead of a share of the
    * renderer's (gcs-skin/webgpu under WebGLNodesHandler reads it as a texture of one row).
+   * @param kind 'joints': the joint pass (GPU DQS's, and what a GCS node pass reads); 'nodes': the node pass (GCS), with its joint pass.
    * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
-  constructor(readonly sections: GpuSections, ownPage = false) {
+  constructor(readonly sections: GpuSections, ownPage = false, readonly kind: PassKind = sections?.method === 'dqs' ? 'joints' : 'nodes') {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
-    // DQS: the joint pass, two texels per joint (q, dual part, uniform scale; K), one row per
-    // instance (2 · GCS_MAX_JOINTS = PAGE_WIDTH). GCS: one texel per section, rows of PAGE_WIDTH.
-    const dqs = sections.method === 'dqs';
+    // The joint pass: two texels per joint (q, dual part, uniform scale; K), one row per instance
+    // (2 · GCS_MAX_JOINTS = PAGE_WIDTH). The node pass: one texel per section, rows of PAGE_WIDTH.
+    const dqs = kind === 'joints';
     const deformer = sections.deformer, N = sections.instanceCount;
-    const S = dqs ? sections.uniforms.gcsStride.value as number / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
+    const S = dqs ? sections.transforms.texelsPerInstance / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
     const nodes = N * S;
     this.columns = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
     this.rows = dqs ? N : Math.ceil(nodes / PAGE_WIDTH);
@@ -77,10 +82,15 @@ export class NodePass implements PageMember {
     this.firstRowUniform = { value: 0 };
     this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S }, gcsFirstRow: this.firstRowUniform };
     for (let t = 0; t < GPU_NODE_TEXTURES; t++) this.uniforms[`gcsNodes${t}`] = { value: null };
+    this.jointPass = dqs ? null : new NodePass(sections, ownPage, 'joints');
+    const parts = this.jointPass ? {
+      gcsTable: u.gcsTable!, gcsJointRow: this.jointPass.firstRowUniform,
+      gcsJointParts0: this.jointPass.uniforms.gcsNodes0!, gcsJointParts1: this.jointPass.uniforms.gcsNodes1!, gcsJointParts2: this.jointPass.uniforms.gcsNodes2!,
+    } : {};
     this.material = new THREE.ShaderMaterial({
       ...(dqs ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
-        gcsJoints: u.gcsJoints!, ...(dqs ? {} : { gcsTable: u.gcsTable! }),
+        gcsJoints: u.gcsJoints!, ...parts,
         gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: PAGE_WIDTH },
         gcsFirstRow: this.firstRowUniform, gcsRect: { value: new THREE.Vector4() },
@@ -118,10 +128,12 @@ export class NodePass implements PageMember {
    * pass cannot run (more rows than a page holds), or null.
    */
   render(renderer: Renderer): string | null {
+    const why = this.jointPass?.render(renderer); // the parts this pass reads, first
+    if (why) return why;
     if (!this.ownPage && this.renderer !== renderer) {
       // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
-      if (this.page && this.renderer) NodeAtlas.of(this.renderer).remove(this, this.page);
-      this.page = NodeAtlas.of(renderer).add(this);
+      if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind).remove(this, this.page);
+      this.page = NodeAtlas.of(renderer, this.kind).add(this);
       this.renderer = this.page ? renderer : null;
       if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
     }
@@ -160,11 +172,12 @@ export class NodePass implements PageMember {
   dispose(): void {
     if (this.page) {
       if (this.ownPage) this.page.dispose();
-      else if (this.renderer) NodeAtlas.of(this.renderer).remove(this, this.page);
+      else if (this.renderer) NodeAtlas.of(this.renderer, this.kind).remove(this, this.page);
     }
     this.page = null;
     this.renderer = null;
     this.material.dispose();
     this.geometry.dispose();
+    this.jointPass?.dispose();
   }
 }
