@@ -16,14 +16,14 @@
  */
 import * as THREE from 'three/webgpu';
 import {
-  abs, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, step, texture, textureSize, uniform, vec3, vec4,
+  abs, bool, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, step, texture, textureSize, uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
 import {
   COLLAPSED, DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, RIGID_JOINT_TOLERANCE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
-import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember } from './node-atlas.js';
+import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
 import type { GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
@@ -226,6 +226,76 @@ export function jointBlend(inputs: Omit<JointInputs, 'table'>, ids: Vec4[], weig
   return gcsNodeBlend[inputs.slots](...poses, ...used, centre);
 }
 
+/** The node pass's inputs: the joint poses (a rigid core, a centre's LBS motion), the table, and the joint pass's parts (its targets 0–2, this instance's row). */
+export interface PartsInputs extends JointInputs { parts: TextureNode[]; row: Int }
+
+/**
+ * Node s's four texels from its joints' parts as the joint pass wrote them once per joint and frame
+ * (the GLSL's gcsSectionBlend and gcsBlend): a rigid core is its joint's pose (normal texel from its
+ * K); otherwise the dual-quaternion blend of the parts: M = s·R where every joint is a uniform
+ * scale (normal texel (1/s, 1, 0, 0)), else M = R·K with K = Σ w K_j; with a centre of rotation
+ * (w = 1) turned about it, the centre moved by LBS.
+ */
+export function nodeTexelsFromParts(inputs: PartsInputs, s: Int): Mat4 {
+  const texels = tableTexelsPerSection(inputs.slots);
+  const at = s.mul(texels).toVar();
+  const ids: Vec4[] = [], weights: Vec4[] = [];
+  for (let g = 0; g < inputs.slots / 4; g++) {
+    ids.push(texel(inputs.table, at.add(2 * g)).toVar());
+    weights.push(texel(inputs.table, at.add(2 * g + 1)).toVar());
+  }
+  const [p0, p1, p2] = inputs.parts;
+  const first = (c: number) => ivec2(int(max(ids[c >> 2][LANES[c & 3]], 0)).mul(DQS_TEXELS_PER_JOINT), inputs.row);
+  const scale = (c: number): Mat3 => {
+    const k = first(c).add(ivec2(1, 0)).toVar();
+    return mat3(p0.load(k).xyz, p1.load(k).xyz, p2.load(k).xyz).transpose();
+  };
+  const out = mat4(vec4(0), vec4(0), vec4(0), vec4(0)).toVar();
+  If(ids[0].y.lessThan(0), () => {
+    const pose = jointPose(inputs, int(ids[0].x));
+    out.assign(mat4(column(pose, 0), column(pose, 1), column(pose, 2), gcsNormalTexel(scale(0))));
+  }).Else(() => {
+    // A joint past the last (−1) gets weight 0: it adds nothing (the GLSL's continue).
+    const weight = (c: number) => weights[c >> 2][LANES[c & 3]].mul(step(0, ids[c >> 2][LANES[c & 3]]));
+    const pivot = p0.load(first(0)).toVar();
+    const br = vec4(0).toVar(), bd = vec4(0).toVar(), sum = float(0).toVar(), rigid = bool(true).toVar();
+    for (let c = 0; c < inputs.slots; c++) {
+      const w = weight(c).toVar(), where = first(c).toVar();
+      const q = p0.load(where).toVar();
+      const sw = select(dot(q, pivot).lessThan(0), w.negate(), w);
+      br.addAssign(q.mul(sw));
+      bd.addAssign(p1.load(where).mul(sw));
+      const u = p2.load(where).x.toVar();
+      sum.addAssign(w.mul(u));
+      rigid.assign(rigid.and(u.greaterThan(0).or(w.greaterThan(0).not())));
+    }
+    const inv2 = float(1).div(dot(br, br)).toVar();
+    const t = br.w.mul(bd.xyz).sub(bd.w.mul(br.xyz)).sub(cross(bd.xyz, br.xyz)).mul(inv2.mul(2)).toVar();
+    const r = gcsRotation(br, inv2.mul(2)).toVar();
+    const m = r.mul(sum).toVar(), n = vec4(float(1).div(sum), 1, 0, 0).toVar();
+    If(rigid.not(), () => {
+      const k = mat3(vec3(0), vec3(0), vec3(0)).toVar();
+      for (let c = 0; c < inputs.slots; c++) k.addAssign(scale(c).mul(weight(c)));
+      m.assign(r.mul(k));
+      n.assign(gcsNormalTexel(k));
+    });
+    const centre = texel(inputs.table, at.add(texels - 1)); // the last texel: the centre of rotation, or none
+    If(centre.w.greaterThan(0.5), () => {
+      const moved = vec3(0).toVar(); // Σ w_i (S_i p − p): where LBS moves the centre p
+      for (let c = 0; c < inputs.slots; c++) {
+        const pose = jointPose(inputs, int(max(ids[c >> 2][LANES[c & 3]], 0)));
+        const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2);
+        const sj = mat3(r0.xyz, r1.xyz, r2.xyz).transpose(), tj = vec3(r0.w, r1.w, r2.w);
+        moved.addAssign(sj.mul(centre.xyz).add(tj).sub(centre.xyz).mul(weight(c)));
+      }
+      t.assign(moved.sub(m.mul(centre.xyz).sub(centre.xyz)));
+    });
+    const rows = m.transpose().toVar();
+    out.assign(mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), n));
+  });
+  return out;
+}
+
 /** Whether `renderer` draws through WebGL2 without float render targets (the pass cannot run there). */
 function noFloatTargets(renderer: unknown): boolean {
   const backend = (renderer as { backend?: { isWebGLBackend?: boolean; extensions?: { has(name: string): boolean } } })?.backend;
@@ -368,9 +438,16 @@ export class TslNodePass implements PageMember {
   private readonly pageWidth = uniform(PAGE_WIDTH, 'int');
   private readonly rect = uniform(new THREE.Vector4());
 
-  constructor(readonly sections: GpuSections) {
-    // DQS: the joint pass, two texels per joint (its quaternion, dual part and uniform scale; K); GCS: one per section.
-    const dqs = sections.method === 'dqs', stride = sections.uniforms.gcsStride.value;
+  /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
+  readonly jointPass: TslNodePass | null;
+
+  /**
+   * @param sections The GPU sections whose joint poses and section table the pass reads.
+   * @param kind 'joints': the joint pass (GPU DQS's, and what a GCS node pass reads); 'nodes': the node pass (GCS), with its joint pass.
+   */
+  constructor(readonly sections: GpuSections, readonly kind: PassKind = sections.method === 'dqs' ? 'joints' : 'nodes') {
+    // The joint pass: two texels per joint (its quaternion, dual part and uniform scale; K); the node pass: one per section.
+    const dqs = kind === 'joints', stride = sections.transforms.texelsPerInstance;
     const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
     const nodes = sections.instanceCount * S;
     // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = PAGE_WIDTH, read without a division per joint.)
@@ -379,6 +456,8 @@ export class TslNodePass implements PageMember {
     // One fragment per texel: its node from the fragment's position in the pass's rows (texels past the last repeat the last node).
     const joints = texture(sections.texture);
     const table = dqs ? null : texture(sections.table as DataTexture);
+    this.jointPass = dqs ? null : new TslNodePass(sections, 'joints');
+    const jointPass = this.jointPass;
     const texels = Fn(() => {
       const at = ivec2(screenCoordinate).toVar();
       const row = at.y.sub(this.firstRow).toVar();
@@ -389,8 +468,9 @@ export class TslNodePass implements PageMember {
       }
       const texel = (min(row.mul(this.pageWidth).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
       const instance = texel.div(S).toVar();
-      const inputs: JointInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride) };
-      return nodeTexels(inputs, texel.sub(instance.mul(S)));
+      const parts = [0, 1, 2].map((i) => jointPass!.textureNode(i));
+      const inputs: PartsInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride), parts, row: jointPass!.offset.add(instance) };
+      return nodeTexelsFromParts(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
     this.material = new THREE.NodeMaterial();
     this.material.name = 'gcsNodePass';
@@ -454,10 +534,12 @@ export class TslNodePass implements PageMember {
       return this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
+    const why = this.jointPass?.render(renderer); // the parts this pass reads, first
+    if (why) return why;
     if (this.renderer !== r) {
       // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
-      if (this.page && this.renderer) NodeAtlas.of(this.renderer, makeTslPage).remove(this, this.page);
-      this.page = NodeAtlas.of(r, makeTslPage).add(this);
+      if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind, makeTslPage).remove(this, this.page);
+      this.page = NodeAtlas.of(r, this.kind, makeTslPage).add(this);
       this.renderer = this.page ? r : null;
       if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
     }
@@ -495,7 +577,7 @@ export class TslNodePass implements PageMember {
     this.firstRow.value = firstRow;
     this.pageWidth.value = width;
     this.rect.value.set(-1, 1 - 2 * firstRow / height, 2 * this.columns / width - 1, 1 - 2 * (firstRow + this.rows) / height);
-    this.offset.value = this.sections.method === 'dqs' ? firstRow : firstRow * width;
+    this.offset.value = this.kind === 'joints' ? firstRow : firstRow * width;
     this.show(tslPage.target.textures, this.previousViewNodes ? tslPage.previousTextures() : null);
   }
 
@@ -506,12 +588,13 @@ export class TslNodePass implements PageMember {
   }
 
   dispose(): void {
-    if (this.page && this.renderer) NodeAtlas.of(this.renderer, makeTslPage).remove(this, this.page);
+    if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind, makeTslPage).remove(this, this.page);
     this.page = null;
     this.renderer = null;
     this.material.dispose();
     this.geometry.dispose();
     this.glsl?.dispose();
+    this.jointPass?.dispose();
   }
 }
 

@@ -83,7 +83,7 @@ export class NodePass implements PageMember {
     this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S }, gcsFirstRow: this.firstRowUniform };
     for (let t = 0; t < GPU_NODE_TEXTURES; t++) this.uniforms[`gcsNodes${t}`] = { value: null };
     this.jointPass = dqs ? null : new NodePass(sections, ownPage, 'joints');
-    const parts = this.jointPass ? {
+    const parts: Record<string, THREE.IUniform> = this.jointPass ? {
       gcsTable: u.gcsTable!, gcsJointRow: this.jointPass.firstRowUniform,
       gcsJointParts0: this.jointPass.uniforms.gcsNodes0!, gcsJointParts1: this.jointPass.uniforms.gcsNodes1!, gcsJointParts2: this.jointPass.uniforms.gcsNodes2!,
     } : {};
