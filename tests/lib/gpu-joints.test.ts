@@ -1,8 +1,8 @@
 // The joint-level GPU path's math, pinned in node (weights criterion): the per-frame joint poses
 // (gcs_gcs_compute_joint_poses, JointPoses: the rows of S_j and its rotation quaternion) and the
 // static per-section table (gcs_gcs_section_influences), evaluated in plain JavaScript exactly as
-// the node pass and the vertex stage do it (web/lib/gpu/glsl.ts: each node's dual-quaternion blend
-// of its joints, the scale parts blended linearly and applied first, written to float32 texels with
+// the node pass and the vertex stage do it (web/lib/gpu/glsl.ts: each node's dual-quaternion blend of its joints'
+// parts, M = s·R where every joint is a uniform scale, else the scale parts blended linearly and applied first, written to float32 texels with
 // its normal texel; per vertex, the normal matrix N = cof(M·x)·y and the smooth-mode length fix), give gcs_deformer_deform's positions (within 1e-6 of the height)
 // and normals (within 1e-5, not renormalised) — on the default human's walk and run and on
 // CesiumMan and Soldier (../shared/models, skipped with the reason printed when absent), plain and
@@ -17,6 +17,7 @@ import { createHuman } from '../../web/lib/human/index.js';
 import { sampleClip } from '../../packages/cli/src/gltf-node.js';
 import { identitySkin } from '../../web/lib/measure.js';
 import { sectionTable } from '../../web/lib/gpu/sections.js';
+import { RIGID_JOINT_TOLERANCE } from '../../web/lib/gpu/layout.js';
 import { loadGlb, MODELS_DIR } from '../helpers/models.js';
 import { maxDistance, scaledSkin as scaled } from '../helpers/skins.js';
 
@@ -75,6 +76,15 @@ function nodeAsRead(p: Float64Array, k: number[]): Blend {
   return { p: Float64Array.from(rows), n: Float64Array.from(cofactor(a).map((v) => v * y)), renorm: t.renorm };
 }
 
+/** The joint pass's u_j: s where K_j is a positive uniform scale s·I within RIGID_JOINT_TOLERANCE × s (the diagonal itself where its entries are equal), else 0. */
+function rigidScale(k: number[]): number {
+  const s = (k[0] + k[4] + k[8]) / 3;
+  let e = 0;
+  for (let c = 0; c < 9; c++) e = Math.max(e, Math.abs(k[c] - (c % 4 === 0 ? s : 0)));
+  if (!(s > 0 && e <= RIGID_JOINT_TOLERANCE * s)) return 0;
+  return k[0] === k[4] && k[4] === k[8] ? k[0] : s;
+}
+
 /** The node pass's section blend from the joint texels of one instance (at texel `base`) and the static table, as the vertex stage reads it. */
 function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s: number): Blend {
   const at = (j: number) => (base + j * GPU_TEXELS_PER_JOINT) * 4;
@@ -94,6 +104,7 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
   const o0 = at(joint(0));
   const pivot = [poses[o0 + 12], poses[o0 + 13], poses[o0 + 14], poses[o0 + 15]];
   const br = [0, 0, 0, 0], bd = [0, 0, 0, 0], k = new Array<number>(9).fill(0), moved = [0, 0, 0];
+  let scale = 0, rigid = true; // Σ w u_j, and whether every joint's K_j is a uniform scale (the joint pass's u_j > 0)
   for (let i = 0; i < 4 && joint(i) >= 0; i++) {
     const o = at(joint(i)), w = weight(i);
     // Σ w_i (S_i p − p): where linear blend skinning moves the centre p.
@@ -108,7 +119,12 @@ function sectionBlend(poses: Float32Array, base: number, table: Float32Array, s:
     for (let c = 0; c < 4; c++) { br[c] += sw * q[c]; bd[c] += sw * d[c]; }
     const kj = scaleOf(o, quatRows(q[0], q[1], q[2], q[3]));
     for (let c = 0; c < 9; c++) k[c] += w * kj[c];
+    const u = rigidScale(kj);
+    scale += w * u;
+    rigid &&= u > 0;
   }
+  // Every joint a uniform scale: M = s·R (and K = s·I for the normal texel), as the node pass takes it from the joint pass's parts.
+  if (rigid) for (let c = 0; c < 9; c++) k[c] = c % 4 === 0 ? scale : 0;
   const inv2 = 1 / (br[0] ** 2 + br[1] ** 2 + br[2] ** 2 + br[3] ** 2);
   // t = 2·(br.w·dv − bd.w·rv − dv × rv)/|br|²
   const cx = bd[1] * br[2] - bd[2] * br[1], cy = bd[2] * br[0] - bd[0] * br[2], cz = bd[0] * br[1] - bd[1] * br[0];
