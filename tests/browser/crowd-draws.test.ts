@@ -1,6 +1,7 @@
 // A crowd's draw calls, counted on WebGL itself: the demo's crowd page (?crowd=N, GPU backend,
-// the joint-level path) issues one instanced draw per skin for all N characters and one node pass
-// (a draw into the float render target holding every instance's nodes), whatever N. Every draw
+// the joint-level path) issues one instanced draw per skin for all N characters, one joint pass and
+// one node pass (each a draw into float render targets holding every instance's joints or nodes),
+// whatever N. Every draw
 // call of a frame is recorded in the page (the context's draw functions wrapped before the page's
 // own code runs), with its instance count and whether it drew into a framebuffer of its own.
 import { describe, expect, test } from 'vitest';
@@ -29,7 +30,7 @@ function recordDraws(): void {
 const reason = skipReason();
 if (reason) console.log(reason);
 
-describe.skipIf(!!reason)('a crowd draws once per skin plus one node pass', () => {
+describe.skipIf(!!reason)('a crowd draws once per skin plus one joint pass and one node pass', () => {
   const demo = demoInChromium();
 
   /** The crowd page with N characters, and the draws of one of its frames once it runs. */
@@ -47,14 +48,14 @@ describe.skipIf(!!reason)('a crowd draws once per skin plus one node pass', () =
     return { draws, page };
   }
 
-  test('100 characters: one instanced draw of all 100, one node pass, and no more draws than with 10', async () => {
+  test('100 characters: one instanced draw of all 100, one joint pass and one node pass, and no more draws than with 10', async () => {
     const many = await drawsOf(100), few = await drawsOf(10);
     const summary = (d: Draw[]) => d.map((x) => `${x.call}×${x.instances}${x.offscreen ? ' (offscreen)' : ''}`).join(', ');
     console.log(`crowd of 100, one frame's draws: ${summary(many.draws)}; crowd of 10: ${summary(few.draws)}`);
     // The human has one skin: one draw of its 100 instances…
     expect(many.draws.filter((d) => d.instances === 100 && !d.offscreen)).toHaveLength(1);
-    // …and one node pass, into the render target every instance's nodes share.
-    expect(many.draws.filter((d) => d.offscreen)).toHaveLength(1);
+    // …one joint pass and one node pass, into the render targets every instance's joints and nodes share.
+    expect(many.draws.filter((d) => d.offscreen)).toHaveLength(2);
     // Nothing else grows with the count: the same draws as 10 characters (the scene's ground and the like).
     expect(many.draws.length).toBe(few.draws.length);
     expect(many.draws.filter((d) => d.instances > 1)).toHaveLength(1);
