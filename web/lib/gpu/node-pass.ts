@@ -31,11 +31,11 @@ export type NodeUniforms = GcsUniforms;
 type Renderer = THREE.WebGLRenderer;
 
 /**
- * Computes every node's transform and normal matrix once per frame into float render targets that
- * the joint-level vertex stage reads (see the module comment). For GPU DQS (sections of method
- * 'dqs') it is the joint pass: two texels per joint, one row per instance (DQS_TEXELS_PER_JOINT:
- * its rotation quaternion, dual part and uniform scale, then the rows of K = Rᵀ·S), which the DQS
- * vertex stage blends.
+ * Kind 'nodes' (GCS, joint-level path): every node's transform and normal matrix once per frame,
+ * blended from the parts its joint pass wrote, into float render targets that the vertex stage
+ * reads (see the module comment). Kind 'joints' (a GCS node pass's own, and GPU DQS's): two texels
+ * per joint, one row per instance (DQS_TEXELS_PER_JOINT: its rotation quaternion, dual part and
+ * uniform scale, then the rows of K = Rᵀ·S).
  */
 export class NodePass implements PageMember {
   /** The uniforms the vertex stage reads: the page's textures as gcsNodes0…, gcsBase, gcsStride and gcsFirstRow. */
@@ -50,10 +50,10 @@ export class NodePass implements PageMember {
   private readonly geometry = new THREE.BufferGeometry();
   /** Where the pass draws: its page, and the renderer whose atlas holds it (null: none yet, or a page of its own). */
   private page: NodePage | null = null;
+  private renderer: Renderer | null = null;
   private readonly ownPage: boolean;
   /** @internal The first row's uniform (the node pass reads its joint pass's). */
   readonly firstRowUniform: { value: number };
-  private renderer: Renderer | null = null;
   /** The GpuSections.version the target holds (−1: none yet). */
   private drawnVersion = -1;
 
