@@ -1,18 +1,21 @@
 /**
- * The node pass for WebGPURenderer (joint-level path; real WebGPU and its WebGL2 fallback): once
- * per frame, every node's transform and normal texel from the joint poses, for every instance in
- * one draw, into four float targets that the vertex stage reads (tsl.ts) — the TSL twin of
- * node-pass.ts, in the same texel layout (layout.ts, GPU_NODE_TEXTURES).
+ * The joint and node passes for WebGPURenderer (joint-level path and GPU DQS; real WebGPU and its
+ * WebGL2 fallback): once per frame, each joint's parts and every node's transform and normal texel
+ * from the joint poses, for every instance in one draw, into four float targets that the vertex
+ * stage reads (tsl.ts) — the TSL twin of node-pass.ts, in the same texel layout (layout.ts,
+ * GPU_NODE_TEXTURES).
  *
- * A render-to-texture pass (a QuadMesh whose fragment is one node, written through `mrt()`), not
+ * A render-to-texture pass (a mesh whose fragments are its texels, written through `mrt()`), not
  * a compute node: on the WebGL2 fallback three.js runs compute through transform feedback into
  * vertex buffers, which the vertex stage could only read as storage attributes; a render target
  * runs the same way on both backends and is read with `textureLoad`, as the GLSL path reads it.
  *
- * The node maths lives here once, as small laid-out functions (like three.js's Skinning.js):
- * `nodeTexels` is called by the pass's fragment and, for the previous frame of a velocity pass
- * only, by the vertex stage. For DQS the same pass is the joint pass (`gcsDqsJointTexels`: each
- * joint's quaternion, dual part, uniform scale and scale part), as glsl.ts's.
+ * The maths lives here once, as small laid-out functions (like three.js's Skinning.js): the joint
+ * pass (`gcsDqsJointTexels`: each joint's quaternion, dual part, uniform scale and scale part, once
+ * per joint and frame; GPU DQS's only pass) and the node pass that blends those parts
+ * (`nodeTexelsFromParts`), as glsl.ts's; `nodeTexels` computes a node from the joint poses alone
+ * for a vertex stage built without a pass. Every pass a renderer draws shares its targets
+ * (node-atlas.ts, `TslNodePage`): one render of the joint passes and one of the node passes a frame.
  */
 import * as THREE from 'three/webgpu';
 import {
@@ -186,11 +189,10 @@ export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
 }
 
 /**
- * Node s's four texels (the GLSL's gcsSectionBlend): a rigid core is its joint's pose (normal
- * texel from K = Rᵀ S); otherwise its joints' poses blended (gcsNodeBlend).
+ * Section s's row of the table: per 4 slots a texel of joints (−1 past the last) then one of
+ * weights; last, its centre of rotation (w = 0: none).
  */
-export function nodeTexels(inputs: JointInputs, s: Int): Mat4 {
-  // Per 4 slots, a texel of joints (−1 past the last) then one of weights; last, the centre.
+function sectionRow(inputs: JointInputs, s: Int): { joints: Vec4[]; weights: Vec4[]; centre: () => Vec4 } {
   const texels = tableTexelsPerSection(inputs.slots);
   const row = s.mul(texels).toVar();
   const joints: Vec4[] = [], weights: Vec4[] = [];
@@ -198,11 +200,21 @@ export function nodeTexels(inputs: JointInputs, s: Int): Mat4 {
     joints.push(texel(inputs.table, row.add(2 * g)).toVar());
     weights.push(texel(inputs.table, row.add(2 * g + 1)).toVar());
   }
+  return { joints, weights, centre: () => texel(inputs.table, row.add(texels - 1)) };
+}
+
+/**
+ * Node s's four texels from the joint poses alone (for a vertex stage built without a pass, which
+ * then computes a node per vertex that uses it): a rigid core is its joint's pose (normal texel from
+ * K = Rᵀ S); otherwise its joints' poses blended (gcsNodeBlend). The pass blends the joint pass's
+ * parts instead (nodeTexelsFromParts): the same node up to rounding.
+ */
+export function nodeTexels(inputs: JointInputs, s: Int): Mat4 {
+  const { joints, weights, centre } = sectionRow(inputs, s);
   const pose = jointPose(inputs, int(joints[0].x)).toVar();
   const out = mat4(pose).toVar();
   If(joints[0].y.greaterThanEqual(0), () => {
-    const centre = texel(inputs.table, row.add(texels - 1)); // the last texel: the centre of rotation, or none
-    out.assign(jointBlend(inputs, joints, weights, centre, pose));
+    out.assign(jointBlend(inputs, joints, weights, centre(), pose));
   }).Else(() => {
     const r0 = column(pose, 0), r1 = column(pose, 1), r2 = column(pose, 2), q = column(pose, 3);
     const k = gcsRotation(q, float(2)).transpose().mul(mat3(r0.xyz, r1.xyz, r2.xyz).transpose());
@@ -237,13 +249,7 @@ export interface PartsInputs extends JointInputs { parts: TextureNode[]; row: In
  * (w = 1) turned about it, the centre moved by LBS.
  */
 export function nodeTexelsFromParts(inputs: PartsInputs, s: Int): Mat4 {
-  const texels = tableTexelsPerSection(inputs.slots);
-  const at = s.mul(texels).toVar();
-  const ids: Vec4[] = [], weights: Vec4[] = [];
-  for (let g = 0; g < inputs.slots / 4; g++) {
-    ids.push(texel(inputs.table, at.add(2 * g)).toVar());
-    weights.push(texel(inputs.table, at.add(2 * g + 1)).toVar());
-  }
+  const { joints: ids, weights, centre: centreOf } = sectionRow(inputs, s);
   const [p0, p1, p2] = inputs.parts;
   const first = (c: number) => ivec2(int(max(ids[c >> 2][LANES[c & 3]], 0)).mul(DQS_TEXELS_PER_JOINT), inputs.row);
   const scale = (c: number): Mat3 => {
@@ -279,7 +285,7 @@ export function nodeTexelsFromParts(inputs: PartsInputs, s: Int): Mat4 {
       m.assign(r.mul(k));
       n.assign(gcsNormalTexel(k));
     });
-    const centre = texel(inputs.table, at.add(texels - 1)); // the last texel: the centre of rotation, or none
+    const centre = centreOf();
     If(centre.w.greaterThan(0.5), () => {
       const moved = vec3(0).toVar(); // Σ w_i (S_i p − p): where LBS moves the centre p
       for (let c = 0; c < inputs.slots; c++) {
