@@ -476,7 +476,6 @@ const JOINT_POSITION = /* glsl */ `
 
 /** Declarations: the joint poses (per frame) and the vertex's influences. */
 const SKIN_PARS = /* glsl */ `
-#define GCS_PER_VERTEX
 uniform int gcsBase;
 uniform int gcsStride;
 attribute vec4 ${INFLUENCE_ATTRIBUTES[0]};
