@@ -55,7 +55,6 @@ try {
   for (const c of cases) {
     for (const [w, h] of sizes) for (const renderer of renderers) {
       const page = await context.newPage();
-      if (process.env.GCS_ONCE) await page.addInitScript(() => { globalThis.GCS_ONCE = true; });
       const errors = [];
       page.on('pageerror', (e) => errors.push(String(e)));
       const model = c.model === 'human' ? 'human' : `/@fs${c.model}`;
