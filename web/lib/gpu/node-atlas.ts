@@ -13,7 +13,8 @@
  * last member.
  */
 import * as THREE from 'three';
-import { GPU_NODE_TEXTURES } from './layout.js';
+import { DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
+import type { GpuSections } from './sections.js';
 
 /** The widest row of a shared page: WebGL2's guaranteed 2048. */
 export const PAGE_WIDTH = 2048;
@@ -184,5 +185,78 @@ export class NodeAtlas<Page extends NodePage<THREE.RenderTarget> = NodePage> {
     const i = this.pages.indexOf(page);
     if (i >= 0) this.pages.splice(i, 1);
     page.dispose();
+  }
+}
+
+/**
+ * What the GLSL and TSL passes share: the rows and columns a pass writes, whether its texels are
+ * current (GpuSections.version), and its rows in its renderer's atlas, taken at its first draw and
+ * moved when another renderer draws it.
+ */
+export abstract class PagedPass<Page extends NodePage<THREE.RenderTarget>> implements PageMember {
+  /** Rows of the page this pass writes: its nodes' (one per instance for the joint pass). */
+  readonly rows: number;
+  /** Texels per row this pass writes. */
+  readonly columns: number;
+  /** Per instance: its joints (the joint pass) or its sections (the node pass). */
+  protected readonly perInstance: number;
+  /** The mesh that draws this pass's fragments into its page. */
+  abstract readonly quad: THREE.Mesh;
+  /** The page the pass draws into (null before its first draw). */
+  protected page: Page | null = null;
+  /** The renderer whose atlas holds `page` (null: none yet, or a page of the pass's own). */
+  private renderer: object | null = null;
+  /** The GpuSections.version the texels hold (−1: none yet). */
+  private drawnVersion = -1;
+
+  /**
+   * @param sections The GPU sections whose joint poses (and section table) the pass reads.
+   * @param kind 'joints': two texels per joint, one row per instance (2 · GCS_MAX_JOINTS = PAGE_WIDTH,
+   * read without a division per joint); 'nodes': one texel per section, rows of PAGE_WIDTH.
+   */
+  constructor(readonly sections: GpuSections, readonly kind: PassKind) {
+    const joints = kind === 'joints';
+    this.perInstance = joints ? sections.transforms.texelsPerInstance / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
+    const nodes = sections.instanceCount * this.perInstance;
+    this.columns = joints ? this.perInstance * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
+    this.rows = joints ? sections.instanceCount : Math.ceil(nodes / PAGE_WIDTH);
+  }
+
+  /** @internal Whether the texels are older than the joint poses. */
+  stale(): boolean {
+    return this.drawnVersion !== this.sections.version;
+  }
+
+  /** @internal The texels hold the current joint poses. */
+  drawn(): void {
+    this.drawnVersion = this.sections.version;
+  }
+
+  /** @internal The texels were lost (the page grew, or the pass is new to it). */
+  lost(): void {
+    this.drawnVersion = -1;
+  }
+
+  /** @internal This pass's rows start at `firstRow` of `page`. */
+  abstract place(page: NodePage, firstRow: number): void;
+
+  /**
+   * Rows in `renderer`'s atlas (pages made by `makePage`), taken at the first draw and moved when
+   * another renderer draws the pass; why it cannot have them (more rows than a page holds), or null.
+   */
+  protected seat(renderer: object, makePage?: (width: number, rows: number) => Page): string | null {
+    if (this.renderer === renderer) return null;
+    this.leave(makePage);
+    this.page = NodeAtlas.of(renderer, this.kind, makePage).add(this);
+    if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
+    this.renderer = renderer;
+    return null;
+  }
+
+  /** Frees the pass's rows in its renderer's atlas (the page with its last pass). */
+  protected leave(makePage?: (width: number, rows: number) => Page): void {
+    if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind, makePage).remove(this, this.page);
+    this.page = null;
+    this.renderer = null;
   }
 }

@@ -26,7 +26,7 @@ import {
   COLLAPSED, DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT, RIGID_JOINT_TOLERANCE, UNIFORM_SCALE_TOLERANCE, tableTexelsPerSection, type TableSlots,
 } from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
-import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
+import { NodePage, PagedPass, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
 import type { GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
@@ -415,28 +415,21 @@ const makeTslPage = (width: number, rows: number): TslNodePage => new TslNodePag
  * `GpuSections.update()` (shadow or colour pass), with every other stale pass of the page in one
  * render: every pass of that frame reads the same texels, and a frame drawn twice computes them once.
  */
-export class TslNodePass implements PageMember {
+export class TslNodePass extends PagedPass<TslNodePage> {
   /** Times the pass has run (once per GpuSections.update() that was drawn). */
   runs = 0;
-  /** Rows of the page this pass writes: its nodes' (one per instance for DQS). */
-  readonly rows: number;
-  /** Texels per row this pass writes. */
-  readonly columns: number;
   /** The mesh that draws this pass's fragments into its page. */
   readonly quad: THREE.Mesh;
   /** The vertex stage's offset into the page: the pass's first texel (GCS) or first row (DQS). */
   readonly offset = uniform(0, 'int');
+  /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
+  readonly jointPass: TslNodePass | null;
   private readonly material: THREE.NodeMaterial;
   private readonly geometry = new THREE.BufferGeometry();
-  /** The GpuSections.version the texels hold (−1: none yet). */
-  private drawnVersion = -1;
   /** What the vertex stage reads: one texture node per target. */
   private readonly views: TextureNode[];
   /** Velocity: views of the page's previous frame (made on first use, previousTextureNode). */
   private previousViewNodes: TextureNode[] | null = null;
-  /** The page the pass draws into, and the renderer whose atlas holds it. */
-  private page: TslNodePage | null = null;
-  private renderer: THREE.WebGPURenderer | null = null;
   /** WebGLRenderer with WebGLNodesHandler: the GLSL pass run instead (made at its first draw). */
   private glsl: NodePass | null = null;
   /** The fragment's numbering: the first row, the page's width, and the quad's corners in clip space. */
@@ -444,38 +437,33 @@ export class TslNodePass implements PageMember {
   private readonly pageWidth = uniform(PAGE_WIDTH, 'int');
   private readonly rect = uniform(new THREE.Vector4());
 
-  /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
-  readonly jointPass: TslNodePass | null;
-
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
    * @param kind 'joints': the joint pass (GPU DQS's, and what a GCS node pass reads); 'nodes': the node pass (GCS), with its joint pass.
    */
-  constructor(readonly sections: GpuSections, readonly kind: PassKind = sections.method === 'dqs' ? 'joints' : 'nodes') {
-    // The joint pass: two texels per joint (its quaternion, dual part and uniform scale; K); the node pass: one per section.
-    const dqs = kind === 'joints', stride = sections.transforms.texelsPerInstance;
-    const S = dqs ? stride / GPU_TEXELS_PER_JOINT : sections.deformer.sectionCount;
-    const nodes = sections.instanceCount * S;
-    // (DQS: one row per instance, 2 · GCS_MAX_JOINTS = PAGE_WIDTH, read without a division per joint.)
-    this.columns = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
-    this.rows = dqs ? sections.instanceCount : Math.ceil(nodes / PAGE_WIDTH);
+  constructor(sections: GpuSections, kind: PassKind = sections.method === 'dqs' ? 'joints' : 'nodes') {
+    super(sections, kind);
+    const writesJoints = kind === 'joints', stride = sections.transforms.texelsPerInstance;
+    const S = this.perInstance, nodes = sections.instanceCount * S;
     // One fragment per texel: its node from the fragment's position in the pass's rows (texels past the last repeat the last node).
     const joints = texture(sections.texture);
-    const table = dqs ? null : texture(sections.table as DataTexture);
-    this.jointPass = dqs ? null : new TslNodePass(sections, 'joints');
-    const jointPass = this.jointPass;
+    const table = writesJoints ? null : texture(sections.table as DataTexture);
+    this.jointPass = writesJoints ? null : new TslNodePass(sections, 'joints');
+    const parts = this.jointPass;
     const texels = Fn(() => {
       const at = ivec2(screenCoordinate).toVar();
       const row = at.y.sub(this.firstRow).toVar();
-      if (dqs) {
+      if (writesJoints) {
         const joint = at.x.div(DQS_TEXELS_PER_JOINT).toVar();
         const pose = jointPose({ joints, slots: sections.tableSlots, first: row.mul(stride) }, joint);
         return gcsDqsJointTexels(pose, at.x.notEqual(joint.mul(DQS_TEXELS_PER_JOINT)));
       }
       const texel = (min(row.mul(this.pageWidth).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
       const instance = texel.div(S).toVar();
-      const parts = [0, 1, 2].map((i) => jointPass!.textureNode(i));
-      const inputs: PartsInputs = { joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride), parts, row: jointPass!.offset.add(instance) };
+      const inputs: PartsInputs = {
+        joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride),
+        parts: [0, 1, 2].map((i) => parts!.textureNode(i)), row: parts!.offset.add(instance),
+      };
       return nodeTexelsFromParts(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
     this.material = new THREE.NodeMaterial();
@@ -540,15 +528,8 @@ export class TslNodePass implements PageMember {
       return this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
-    const why = this.jointPass?.render(renderer); // the parts this pass reads, first
+    const why = this.jointPass?.render(renderer) ?? this.seat(r, makeTslPage); // the parts this pass reads, first
     if (why) return why;
-    if (this.renderer !== r) {
-      // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
-      if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind, makeTslPage).remove(this, this.page);
-      this.page = NodeAtlas.of(r, this.kind, makeTslPage).add(this);
-      this.renderer = this.page ? r : null;
-      if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
-    }
     this.page!.beginFrame(r);
     if (this.stale()) this.page!.run(r);
     return null;
@@ -560,20 +541,10 @@ export class TslNodePass implements PageMember {
     if (this.page && this.previousViewNodes && r?.isWebGPURenderer) this.page.fillPrevious(r);
   }
 
-  /** @internal Whether the texels are older than the joint poses. */
-  stale(): boolean {
-    return this.drawnVersion !== this.sections.version;
-  }
-
-  /** @internal The texels hold the current joint poses. */
-  drawn(): void {
-    this.drawnVersion = this.sections.version;
+  /** @internal The texels hold the current joint poses (one more run). */
+  override drawn(): void {
+    super.drawn();
     this.runs++;
-  }
-
-  /** @internal The texels were lost (the page grew, or the pass is new to it). */
-  lost(): void {
-    this.drawnVersion = -1;
   }
 
   /** @internal This pass's rows start at `firstRow` of `page`: its quad, its fragments' numbering and the vertex stage's reads follow. */
@@ -594,9 +565,7 @@ export class TslNodePass implements PageMember {
   }
 
   dispose(): void {
-    if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind, makeTslPage).remove(this, this.page);
-    this.page = null;
-    this.renderer = null;
+    this.leave(makeTslPage);
     this.material.dispose();
     this.geometry.dispose();
     this.glsl?.dispose();

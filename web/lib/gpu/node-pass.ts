@@ -15,8 +15,8 @@
 import * as THREE from 'three';
 import { checkObject } from '../arguments.js';
 import { dqsPassShaders, nodePassShaders } from './glsl.js';
-import { DQS_TEXELS_PER_JOINT, GPU_NODE_TEXTURES, GPU_TEXELS_PER_JOINT } from './layout.js';
-import { NodeAtlas, NodePage, PAGE_ROWS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
+import { GPU_NODE_TEXTURES } from './layout.js';
+import { NodePage, PagedPass, PAGE_WIDTH, type PassKind } from './node-atlas.js';
 import type { GcsUniforms, GpuSections } from './sections.js';
 
 /** The extension float render targets need in WebGL2 (RGBA32F colour attachments). */
@@ -37,28 +37,18 @@ type Renderer = THREE.WebGLRenderer;
  * per joint, one row per instance (DQS_TEXELS_PER_JOINT: its rotation quaternion, dual part and
  * uniform scale, then the rows of K = Rᵀ·S).
  */
-export class NodePass implements PageMember {
+export class NodePass extends PagedPass<NodePage> {
   /** The uniforms the vertex stage reads: the page's textures as gcsNodes0…, gcsBase, gcsStride and gcsFirstRow. */
   readonly uniforms: NodeUniforms;
-  /** Rows of the targets this pass writes: its nodes' (one per instance for DQS). */
-  readonly rows: number;
-  /** Texels per row this pass writes. */
-  readonly columns: number;
   /** The mesh that draws this pass's fragments into its page. */
   readonly quad: THREE.Mesh;
-  private readonly material: THREE.ShaderMaterial;
-  private readonly geometry = new THREE.BufferGeometry();
-  /** Where the pass draws: its page, and the renderer whose atlas holds it (null: none yet, or a page of its own). */
-  private page: NodePage | null = null;
-  private renderer: Renderer | null = null;
-  private readonly ownPage: boolean;
-  /** @internal The first row's uniform (the node pass reads its joint pass's). */
-  readonly firstRowUniform: { value: number };
-  /** The GpuSections.version the target holds (−1: none yet). */
-  private drawnVersion = -1;
-
   /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
   readonly jointPass: NodePass | null;
+  /** @internal The first row's uniform (the node pass reads its joint pass's). */
+  readonly firstRowUniform = { value: 0 };
+  private readonly material: THREE.ShaderMaterial;
+  private readonly geometry = new THREE.BufferGeometry();
+  private readonly ownPage: boolean;
 
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
@@ -67,31 +57,24 @@ export class NodePass implements PageMember {
    * @param kind 'joints': the joint pass (GPU DQS's, and what a GCS node pass reads); 'nodes': the node pass (GCS), with its joint pass.
    * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
-  constructor(readonly sections: GpuSections, ownPage = false, readonly kind: PassKind = sections?.method === 'dqs' ? 'joints' : 'nodes') {
+  constructor(sections: GpuSections, ownPage = false, kind: PassKind = sections?.method === 'dqs' ? 'joints' : 'nodes') {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
-    // The joint pass: two texels per joint (q, dual part, uniform scale; K), one row per instance
-    // (2 · GCS_MAX_JOINTS = PAGE_WIDTH). The node pass: one texel per section, rows of PAGE_WIDTH.
-    const dqs = kind === 'joints';
-    const deformer = sections.deformer, N = sections.instanceCount;
-    const S = dqs ? sections.transforms.texelsPerInstance / GPU_TEXELS_PER_JOINT : deformer.sectionCount;
-    const nodes = N * S;
-    this.columns = dqs ? S * DQS_TEXELS_PER_JOINT : Math.min(PAGE_WIDTH, nodes);
-    this.rows = dqs ? N : Math.ceil(nodes / PAGE_WIDTH);
+    super(sections, kind);
+    const writesJoints = kind === 'joints', S = this.perInstance;
     const u = sections.uniforms;
-    this.firstRowUniform = { value: 0 };
     this.uniforms = { gcsBase: { value: 0 }, gcsStride: { value: S }, gcsFirstRow: this.firstRowUniform };
     for (let t = 0; t < GPU_NODE_TEXTURES; t++) this.uniforms[`gcsNodes${t}`] = { value: null };
-    this.jointPass = dqs ? null : new NodePass(sections, ownPage, 'joints');
+    this.jointPass = writesJoints ? null : new NodePass(sections, ownPage, 'joints');
     const parts: Record<string, THREE.IUniform> = this.jointPass ? {
       gcsTable: u.gcsTable!, gcsJointRow: this.jointPass.firstRowUniform,
       gcsJointParts0: this.jointPass.uniforms.gcsNodes0!, gcsJointParts1: this.jointPass.uniforms.gcsNodes1!, gcsJointParts2: this.jointPass.uniforms.gcsNodes2!,
     } : {};
     this.material = new THREE.ShaderMaterial({
-      ...(dqs ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
+      ...(writesJoints ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
         gcsJoints: u.gcsJoints!, ...parts,
-        gcsNodeCount: { value: nodes }, gcsSectionCount: { value: S },
+        gcsNodeCount: { value: sections.instanceCount * S }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: PAGE_WIDTH },
         gcsFirstRow: this.firstRowUniform, gcsRect: { value: new THREE.Vector4() },
       },
@@ -128,32 +111,10 @@ export class NodePass implements PageMember {
    * pass cannot run (more rows than a page holds), or null.
    */
   render(renderer: Renderer): string | null {
-    const why = this.jointPass?.render(renderer); // the parts this pass reads, first
+    const why = this.jointPass?.render(renderer) ?? (this.ownPage ? null : this.seat(renderer)); // the parts this pass reads, first
     if (why) return why;
-    if (!this.ownPage && this.renderer !== renderer) {
-      // First draw, or drawn by another renderer: its rows move to that renderer's atlas.
-      if (this.page && this.renderer) NodeAtlas.of(this.renderer, this.kind).remove(this, this.page);
-      this.page = NodeAtlas.of(renderer, this.kind).add(this);
-      this.renderer = this.page ? renderer : null;
-      if (!this.page) return `the node pass needs ${this.rows} rows of ${this.columns} texels, more than one float target holds (${PAGE_ROWS} × ${PAGE_WIDTH})`;
-    }
     if (this.stale()) this.page!.run(renderer);
     return null;
-  }
-
-  /** @internal Whether the texels are older than the joint poses. */
-  stale(): boolean {
-    return this.drawnVersion !== this.sections.version;
-  }
-
-  /** @internal The texels hold the current joint poses. */
-  drawn(): void {
-    this.drawnVersion = this.sections.version;
-  }
-
-  /** @internal The texels were lost (the page grew). */
-  lost(): void {
-    this.drawnVersion = -1;
   }
 
   /** @internal This pass's rows start at `firstRow` of `page`: its quad, its fragments' numbering and the vertex stage's reads follow. */
@@ -170,12 +131,8 @@ export class NodePass implements PageMember {
 
   /** Frees the pass's rows (its page with the last), material and geometry. */
   dispose(): void {
-    if (this.page) {
-      if (this.ownPage) this.page.dispose();
-      else if (this.renderer) NodeAtlas.of(this.renderer, this.kind).remove(this, this.page);
-    }
-    this.page = null;
-    this.renderer = null;
+    if (this.ownPage) this.page?.dispose();
+    this.leave();
     this.material.dispose();
     this.geometry.dispose();
     this.jointPass?.dispose();
