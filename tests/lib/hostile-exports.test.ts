@@ -83,7 +83,7 @@ function argumentLists(arity: number, plausible: unknown[]): [string, unknown[]]
 
 /** Names no hostile call is made to: disposal (checked elsewhere), private methods and @internal raw-pointer ones. */
 const SKIPPED = new Set(['constructor', 'dispose', 'raise', 'copyIn', 'viewF32', 'viewU32', 'viewI32', 'refreshViews', 'commit', 'discard', 'prepare',
-  'computeSectionsAt', 'computeJointPosesAt', 'gather', 'readString', 'live', 'swappedView', 'perVertex', 'checkRenderer', 'startVelocity',
+  'computeSectionsAt', 'computeJointPosesAt', 'computeCompactJointPosesAt', 'gather', 'readString', 'live', 'swappedView', 'perVertex', 'checkRenderer', 'startVelocity',
   'stopVelocity', 'syncAttributes', 'exactBounds', 'run', 'checkCompiled', 'stop', 'show']);
 /** Functions that loop for as long as they are asked to (a frame count, a vertex count): called with bounded hostile values only. */
 const SLOW = new Set(['timeFrames', 'timeInterleaved', 'createHuman', 'createHumanData', 'humanToGlb']);

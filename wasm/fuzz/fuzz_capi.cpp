@@ -948,6 +948,41 @@ bool jointCentre(const float* ibm, double out[3]) {
 // rejected call (0 instances, a wrong joint count, NaN in the last joint of the second instance)
 // writes nothing. Y / axial: no table, and compute_joint_poses is refused. `skins` holds two
 // instances, the second's last joint already NaN.
+// The compact format of the same two instances (`full`: what compute_joint_poses wrote): the full
+// format exactly, or 6 floats per joint that decode to the rotation within the tolerance of S and
+// to its translation bit for bit.
+void checkCompactJointPoses(GcsDeformer* d, const std::vector<float>& skins, uint32_t J, const std::vector<float>& full) {
+  std::vector<float> out(full.size(), 0.0f);
+  const int format = gcs_gcs_compute_joint_poses_compact(d, skins.data(), J, 2, out.data());
+  checkOk("compute_joint_poses_compact");
+  CHECK(format == GCS_JOINT_POSES_FULL || format == GCS_JOINT_POSES_COMPACT, "compute_joint_poses_compact returned %d", format);
+  if (format == GCS_JOINT_POSES_FULL) {
+    CHECK(std::memcmp(full.data(), out.data(), out.size() * 4) == 0, "the full format of compute_joint_poses_compact differs");
+    return;
+  }
+  for (uint32_t k = 0; k < 2 * J; ++k) {
+    const float* o = &out[GCS_COMPACT_FLOATS_PER_JOINT * size_t(k)];
+    const float* m = &skins[16 * size_t(k)];
+    uint32_t b0, b1;
+    std::memcpy(&b0, &o[0], 4);
+    std::memcpy(&b1, &o[1], 4);
+    const uint32_t dropped = (b0 & 1u) | ((b1 & 1u) << 1);
+    const double c[3] = {o[0], o[1], o[2]};
+    double q[4], rest = 1.0 - (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    CHECK(rest >= 0.25 - 1e-5, "compact joint %u: dropped component %g below 1/2", k, std::sqrt(std::max(rest, 0.0)));
+    for (uint32_t i = 0, n = 0; i < 4; ++i) q[i] = i == dropped ? std::sqrt(std::max(rest, 0.0)) : c[n++];
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y),   // columns of R(q)
+                         2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x),
+                         2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)};
+    for (int col = 0; col < 3; ++col)
+      for (int row = 0; row < 3; ++row)
+        CHECK(std::fabs(r[3 * col + row] - m[4 * col + row]) <= GCS_COMPACT_POSE_TOLERANCE + 1e-6, "compact joint %u: R(q)[%d][%d] %g, S has %g",
+              k, col, row, r[3 * col + row], double(m[4 * col + row]));
+    for (int i = 0; i < 3; ++i) CHECK(std::memcmp(&o[3 + i], &m[12 + i], 4) == 0, "compact joint %u translation %d", k, i);
+  }
+}
+
 void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skins) {
   GcsDeformer* d = b.d;
   const uint32_t S = b.sections, J = in.jointCount;
@@ -1023,6 +1058,7 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
     const double len = std::sqrt(double(o[12]) * o[12] + double(o[13]) * o[13] + double(o[14]) * o[14] + double(o[15]) * o[15]);
     CHECK(std::fabs(len - 1.0) < 1e-5, "joint pose %u quaternion length %g", k, len);
   }
+  checkCompactJointPoses(d, skins, J, out);
   std::vector<float> kept(out);
   CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 0, out.data()) == 0, "compute_joint_poses took 0 instances");
   checkRejected("compute_joint_poses(0 instances)", [](int c) { return c == GCS_ERR_OUT_OF_RANGE; });
@@ -1032,6 +1068,9 @@ void checkJointPoses(const Built& b, const RigInput& in, std::vector<float> skin
   CHECK(gcs_gcs_compute_joint_poses(d, skins.data(), J, 2, out.data()) == 0, "compute_joint_poses took NaN");
   checkRejected("compute_joint_poses(NaN)", [](int c) { return c == GCS_ERR_NON_FINITE; });
   CHECK(std::memcmp(kept.data(), out.data(), out.size() * 4) == 0, "a rejected compute_joint_poses wrote its output");
+  CHECK(gcs_gcs_compute_joint_poses_compact(d, skins.data(), J, 2, out.data()) == 0, "compute_joint_poses_compact took NaN");
+  checkRejected("compute_joint_poses_compact(NaN)", [](int c) { return c == GCS_ERR_NON_FINITE; });
+  CHECK(std::memcmp(kept.data(), out.data(), out.size() * 4) == 0, "a rejected compute_joint_poses_compact wrote its output");
 }
 
 // The GPU path (gcs_gcs_compute_sections): for two instances posed by this frame, the packed rows

@@ -1,5 +1,6 @@
 // The C API (gcs_skin.h): argument checks, error recording, and nothing else.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -377,27 +378,82 @@ uint32_t gcs_gcs_section_influence_slots(const GcsDeformer* d) {
   return g && !g->influenceTable.empty() ? g->influenceTableSlots : 0;
 }
 
-int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
-                                uint32_t instanceCount, float* out) {
-  gcs::clearError();
-  if (!deformer) return fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+// The checks both joint-pose calls make before writing anything; the GCS deformer, or null with the error recorded.
+static const gcs::GcsDeformerImpl* jointPoseInput(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                                                  uint32_t instanceCount, const float* out) {
   const gcs::GcsDeformerImpl* g = asGcs(deformer);
-  if (!g) return fail(GCS_ERR_INVALID_ARGUMENT, "joint poses are for GCS deformers (weights criterion) only");
-  if (g->settings.criterion != GCS_CRITERION_WEIGHTS)
-    return fail(GCS_ERR_INVALID_ARGUMENT,
-                "joint poses drive the weights criterion only; the Y and axial criteria need gcs_gcs_compute_sections");
-  if (!validGpuInput(*g, skinMatrices, jointCount, instanceCount, out, uint64_t(jointCount) * 16 * GCS_GPU_TEXELS_PER_JOINT,
-                     jointCount, "joints"))
-    return 0;
-  const glm::mat4* skins = reinterpret_cast<const glm::mat4*>(skinMatrices);
-  float* o = out;
-  for (uint64_t k = 0; k < uint64_t(instanceCount) * jointCount; ++k, o += 16) {
+  if (!deformer) fail(GCS_ERR_INVALID_ARGUMENT, "the deformer is null (destroyed or never created)");
+  else if (!g) fail(GCS_ERR_INVALID_ARGUMENT, "joint poses are for GCS deformers (weights criterion) only");
+  else if (g->settings.criterion != GCS_CRITERION_WEIGHTS)
+    fail(GCS_ERR_INVALID_ARGUMENT, "joint poses drive the weights criterion only; the Y and axial criteria need gcs_gcs_compute_sections");
+  else if (validGpuInput(*g, skinMatrices, jointCount, instanceCount, out, uint64_t(jointCount) * 16 * GCS_GPU_TEXELS_PER_JOINT,
+                         jointCount, "joints"))
+    return g;
+  return nullptr;
+}
+
+// The full format: per joint the rows of S_j, bit for bit, then its rotation quaternion.
+static void writeFullJointPoses(const glm::mat4* skins, uint64_t count, float* o) {
+  for (uint64_t k = 0; k < count; ++k, o += 16) {
     const glm::mat4 m = skins[k];
     const glm::quat q = gcs::rotationOf(m);
     for (int r = 0; r < 3; ++r) o[4 * r] = m[0][r], o[4 * r + 1] = m[1][r], o[4 * r + 2] = m[2][r], o[4 * r + 3] = m[3][r];
     o[12] = q.x, o[13] = q.y, o[14] = q.z, o[15] = q.w;
   }
+}
+
+// Sets the lowest mantissa bit of f to `bit` (one unit in the last place at most); a value below
+// FLT_MIN in magnitude becomes ±FLT_MIN first, so no GPU flushes it (and the bit) to zero.
+static void setLowestBit(float& f, uint32_t bit) {
+  if (!(std::fabs(f) >= FLT_MIN)) f = std::copysign(FLT_MIN, f);
+  uint32_t u;
+  std::memcpy(&u, &f, 4);
+  u = (u & ~1u) | bit;
+  std::memcpy(&f, &u, 4);
+}
+
+// One joint in the compact format (gcs_gcs_compute_joint_poses_compact), or false where its 3×3
+// part is not within GCS_COMPACT_POSE_TOLERANCE of its rotation (a scale, a shear, a mirror).
+static bool writeCompactJointPose(const glm::mat4& m, float* o) {
+  const glm::quat q = gcs::rotationOf(m);
+  const glm::dmat3 r = glm::mat3_cast(glm::dquat(q.w, q.x, q.y, q.z));
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 3; ++i)
+      if (!(std::fabs(double(m[c][i]) - r[c][i]) <= double(GCS_COMPACT_POSE_TOLERANCE))) return false;
+  const float v[4] = {q.x, q.y, q.z, q.w};
+  uint32_t dropped = 0;
+  for (uint32_t i = 1; i < 4; ++i)
+    if (std::fabs(v[i]) > std::fabs(v[dropped])) dropped = i;
+  const float sign = v[dropped] < 0.0f ? -1.0f : 1.0f;  // ±q: the dropped component positive
+  for (uint32_t i = 0, n = 0; i < 4; ++i)
+    if (i != dropped) o[n++] = sign * v[i];
+  o[3] = m[3][0], o[4] = m[3][1], o[5] = m[3][2];
+  setLowestBit(o[0], dropped & 1u);
+  setLowestBit(o[1], dropped >> 1);
+  return true;
+}
+
+int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                                uint32_t instanceCount, float* out) {
+  gcs::clearError();
+  if (!jointPoseInput(deformer, skinMatrices, jointCount, instanceCount, out)) return 0;
+  writeFullJointPoses(reinterpret_cast<const glm::mat4*>(skinMatrices), uint64_t(instanceCount) * jointCount, out);
   return 1;
+}
+
+int gcs_gcs_compute_joint_poses_compact(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
+                                        uint32_t instanceCount, float* out) {
+  gcs::clearError();
+  if (!jointPoseInput(deformer, skinMatrices, jointCount, instanceCount, out)) return 0;
+  const glm::mat4* skins = reinterpret_cast<const glm::mat4*>(skinMatrices);
+  const uint64_t count = uint64_t(instanceCount) * jointCount;
+  // The compact floats are a prefix of the full format's: a joint out of tolerance rewrites the whole call.
+  for (uint64_t k = 0; k < count; ++k)
+    if (!writeCompactJointPose(skins[k], out + k * GCS_COMPACT_FLOATS_PER_JOINT)) {
+      writeFullJointPoses(skins, count, out);
+      return GCS_JOINT_POSES_FULL;
+    }
+  return GCS_JOINT_POSES_COMPACT;
 }
 
 }  // extern "C"

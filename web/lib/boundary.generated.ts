@@ -92,6 +92,8 @@ export interface CoreFunctions {
   gcs_gcs_section_influence_slots(deformer: number): number;
   /** int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount, uint32_t instanceCount, float* out) */
   gcs_gcs_compute_joint_poses(deformer: number, skinMatrices: number, jointCount: number, instanceCount: number, out: number): number;
+  /** int gcs_gcs_compute_joint_poses_compact(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount, uint32_t instanceCount, float* out) */
+  gcs_gcs_compute_joint_poses_compact(deformer: number, skinMatrices: number, jointCount: number, instanceCount: number, out: number): number;
   /** GcsDeformer* gcs_build_classic(const GcsRig* rig, uint32_t contours, uint32_t rays, float bulge) */
   gcs_build_classic(rig: number, contours: number, rays: number, bulge: number): number;
   /** int gcs_classic_set_bulge(GcsDeformer* deformer, float bulge) */
@@ -154,6 +156,7 @@ export const ARGUMENT_COUNTS = {
   gcs_gcs_section_centres: 1,
   gcs_gcs_section_influence_slots: 1,
   gcs_gcs_compute_joint_poses: 5,
+  gcs_gcs_compute_joint_poses_compact: 5,
   gcs_build_classic: 4,
   gcs_classic_set_bulge: 2,
   gcs_classic_part_count: 1,
@@ -222,6 +225,10 @@ export const GCS_SECTION_INFO_FLOATS = 8;
 export const GCS_GPU_TEXELS_PER_SECTION = 3;
 export const GCS_MAX_INSTANCES = 65536;
 export const GCS_GPU_TEXELS_PER_JOINT = 4;
+export const GCS_COMPACT_FLOATS_PER_JOINT = 6;
+export const GCS_COMPACT_POSE_TOLERANCE = 0.000002;
+export const GCS_JOINT_POSES_FULL = 1;
+export const GCS_JOINT_POSES_COMPACT = 2;
 export const GCS_CLASSIC_MIN_CONTOURS = 2;
 export const GCS_CLASSIC_MAX_CONTOURS = 256;
 export const GCS_CLASSIC_MIN_RAYS = 3;

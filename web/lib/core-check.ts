@@ -12,7 +12,7 @@ export const CORE_FUNCTIONS = [
   'gcs_deformer_positions', 'gcs_deformer_previous_positions', 'gcs_deformer_set_morph_influences',
   'gcs_deformer_set_morph_targets', 'gcs_deformer_set_tangents', 'gcs_deformer_source_vertex', 'gcs_deformer_stat',
   'gcs_deformer_tangents', 'gcs_deformer_vertex_count', 'gcs_free', 'gcs_gcs_blend_factor', 'gcs_gcs_blend_other',
-  'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_compute_joint_poses', 'gcs_gcs_compute_sections',
+  'gcs_gcs_blend_third', 'gcs_gcs_blend_third_factor', 'gcs_gcs_compute_joint_poses', 'gcs_gcs_compute_joint_poses_compact', 'gcs_gcs_compute_sections',
   'gcs_gcs_section_centres', 'gcs_gcs_section_influence_slots', 'gcs_gcs_section_influences', 'gcs_gcs_section_info',
   'gcs_gcs_section_matrices', 'gcs_gcs_section_of_vertex', 'gcs_heap_in_use', 'gcs_last_error_code', 'gcs_last_error_message', 'gcs_rig_create',
   'gcs_rig_destroy', 'gcs_rig_height', 'gcs_rig_joint_count', 'gcs_rig_vertex_count', 'gcs_version',

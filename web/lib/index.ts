@@ -20,7 +20,7 @@
 import {
   GCS_CLASSIC_DEFAULT_BULGE, GCS_CLASSIC_DEFAULT_CONTOURS, GCS_CLASSIC_DEFAULT_RAYS, GCS_CLASSIC_MAX_BULGE, GCS_CLASSIC_MAX_CONTOURS,
   GCS_CLASSIC_MAX_RAYS, GCS_CLASSIC_MIN_CONTOURS, GCS_CLASSIC_MIN_RAYS, GCS_CLASSIC_PART_INTS, GCS_DEFAULT_CENTRES, GCS_DEFAULT_CRITERION,
-  GCS_DEFAULT_INFLUENCE_WIDTH, GCS_DEFAULT_SECTIONS, GCS_DEFAULT_TWIST_SPREAD, GCS_GPU_TEXELS_PER_JOINT, GCS_GPU_TEXELS_PER_SECTION,
+  GCS_DEFAULT_INFLUENCE_WIDTH, GCS_DEFAULT_SECTIONS, GCS_DEFAULT_TWIST_SPREAD, GCS_COMPACT_FLOATS_PER_JOINT, GCS_GPU_TEXELS_PER_JOINT, GCS_GPU_TEXELS_PER_SECTION, GCS_JOINT_POSES_COMPACT,
   GCS_MAX_INFLUENCES, GCS_MAX_INSTANCES, GCS_MAX_JOINTS, GCS_MAX_SECTIONS, GCS_MIN_SECTIONS, GCS_SECTION_INFO_FLOATS, GCS_SMOOTH_BY_CRITERION,
   GcsClassicPartField, GcsClassicReasonNames, GcsCriterionNames, GcsDeformerKindNames, GcsSectionInfoField, GcsSectionKind,
   GcsSettingsBytes, GcsStat, weightGridSteps as gridSteps, writeGcsSettings,
@@ -967,12 +967,26 @@ export class GcsDeformer extends Deformer {
     if (!this.gcs.core.gcs_gcs_compute_joint_poses(h, skinPtr, this.jointCount, instanceCount, outPtr))
       this.gcs.raise('computing the joint poses failed');
   }
+  /**
+   * As computeJointPosesAt, but in the compact format (COMPACT_FLOATS_PER_JOINT floats per joint:
+   * the "smallest three" of its rotation quaternion, then its translation;
+   * gcs_gcs_compute_joint_poses_compact) where every joint of every instance is rigid with unit
+   * scale, else in the full format. Returns true where it wrote the compact one. No allocation.
+   */
+  computeCompactJointPosesAt(skinPtr: number, instanceCount: number, outPtr: number): boolean {
+    const h = this.live();
+    const format = this.gcs.core.gcs_gcs_compute_joint_poses_compact(h, skinPtr, this.jointCount, instanceCount, outPtr);
+    if (!format) this.gcs.raise('computing the joint poses failed');
+    return format === GCS_JOINT_POSES_COMPACT;
+  }
 }
 
 /** RGBA32F texels per GCS section in the GPU path's buffer (the rows of its affine 3×4 transform). */
 export const GPU_TEXELS_PER_SECTION = GCS_GPU_TEXELS_PER_SECTION;
 /** RGBA32F texels per joint in the joint-level GPU path's buffer (the rows of S_j, its rotation quaternion). */
 export const GPU_TEXELS_PER_JOINT = GCS_GPU_TEXELS_PER_JOINT;
+/** Floats per joint in the joint poses' compact format (rigid joints of unit scale: the "smallest three" of the quaternion, the translation). */
+export const COMPACT_FLOATS_PER_JOINT = GCS_COMPACT_FLOATS_PER_JOINT;
 /** Most instances one computeSectionsAt call takes. */
 export const MAX_INSTANCES = GCS_MAX_INSTANCES;
 
@@ -1175,7 +1189,15 @@ export class SectionTransforms extends PoseTexels {
  * (gcs_gcs_compute_joint_poses); O(joints) per instance per frame. See PoseTexels.
  */
 export class JointPoses extends PoseTexels {
-  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048) {
+  /**
+   * Whether the last compute() wrote the compact format: joint j of instance k at float
+   * (k·J + j)·COMPACT_FLOATS_PER_JOINT of `texels` (gcs_gcs_compute_joint_poses_compact). Only
+   * where `compact` was asked for and every joint of every instance was rigid with unit scale.
+   */
+  compactFormat = false;
+
+  /** `compact`: write the compact format where a frame allows it (see compactFormat). */
+  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, readonly compact = false) {
     super(deformer, instanceCount, maxWidth, () => {
       if (!deformer.jointLevel) throw new GcsError('INVALID_ARGUMENT', 'joint poses drive the weights criterion only; the Y and axial criteria need SectionTransforms');
       return deformer.jointCount * GPU_TEXELS_PER_JOINT;
@@ -1184,6 +1206,7 @@ export class JointPoses extends PoseTexels {
   }
 
   protected run(skinPtr: number, count: number, outPtr: number): void {
-    this.deformer.computeJointPosesAt(skinPtr, count, outPtr);
+    if (this.compact) this.compactFormat = this.deformer.computeCompactJointPosesAt(skinPtr, count, outPtr);
+    else this.deformer.computeJointPosesAt(skinPtr, count, outPtr);
   }
 }
