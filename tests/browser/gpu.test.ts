@@ -38,7 +38,7 @@ const fixture = fixtureForTests('gpu-fixture', '__gpu', !!reason);
 interface Result {
   skins: number; backends: string[]; paths: string[]; anisotropy: number; notes: string[]; height: number; positionError: number; normalError: number; normalErrorRaw: number;
   motion: number; vertices: number; frames: number; pixelDiff: number[]; coverage: number; pixelMotion: number; extColorBufferFloat: boolean;
-  tableSlots: number[]; secondSet: number;
+  tableSlots: number[]; secondSet: number; formats: string[];
 }
 
 type Path = 'joints' | 'sections';
@@ -48,9 +48,21 @@ async function check(model: string, smooth: boolean, times: number[], clip: stri
     .__gpu.check(m as string, { smooth: s, centres: k, method: x }, t as number[], c as string | undefined, p as string, b as number[] | undefined), [model, smooth, times, clip, path, boneScale, centres, method] as const);
 }
 
+/** Frames × skins per joint-pose format, e.g. "compact ×3". */
+const summary = (formats: string[]): string => [...new Set(formats)].map((f) => `${f} ×${formats.filter((x) => x === f).length}`).join(', ');
+
+/**
+ * Every frame of every skin uploaded its joint poses in `format` (the compact one where every joint
+ * is rigid with unit scale; the full one where a joint scales; LBS and the section-level path: the full one only).
+ */
+function expectFormat(r: Result, format: 'compact' | 'full' | 'full only'): void {
+  expect(r.formats.length).toBe(r.frames * r.skins);
+  expect(summary(r.formats)).toBe(`${format} ×${r.formats.length}`);
+}
+
 function expectEqual(r: Result, label: string, path: Path, method = 'gcs'): void {
   console.log(`${label}: ${r.skins} skin(s), ${r.vertices} vertices, ${r.frames} frames; GPU − CPU positions ≤ ${r.positionError.toExponential(2)} of the height ` +
-    `(the frames move the skin up to ${r.motion.toFixed(3)} of it), normals ≤ ${r.normalError.toExponential(2)} (as written: ${r.normalErrorRaw.toExponential(2)}); pixels differing ${r.pixelDiff.map((x) => (100 * x).toFixed(3) + ' %').join(', ')} (character covers ${(100 * r.coverage).toFixed(1)} %; ${(100 * r.pixelMotion).toFixed(1)} % change between frames)`);
+    `(the frames move the skin up to ${r.motion.toFixed(3)} of it), normals ≤ ${r.normalError.toExponential(2)} (as written: ${r.normalErrorRaw.toExponential(2)}); pixels differing ${r.pixelDiff.map((x) => (100 * x).toFixed(3) + ' %').join(', ')} (character covers ${(100 * r.coverage).toFixed(1)} %; ${(100 * r.pixelMotion).toFixed(1)} % change between frames); joint poses uploaded ${summary(r.formats)}`);
   expect(r.extColorBufferFloat).toBe(true);
   expect(r.backends.every((b) => b === 'gpu'), r.notes.join('; ')).toBe(true);
   expect(r.paths.every((p) => p === path)).toBe(true);
@@ -74,7 +86,9 @@ describe.skipIf(!!reason)('GPU backend = CPU backend (headless Chromium)', () =>
     for (const smooth of [false, true]) {
       const mode = `${smooth ? 'smooth' : 'plain'}, ${gpuPath} path`;
       test(`default human, weights criterion, ${mode}`, async () => {
-        expectEqual(await check('human', smooth, [0.15, 0.45, 0.8], 'run', gpuPath), `human ${mode}`, gpuPath);
+        const r = await check('human', smooth, [0.15, 0.45, 0.8], 'run', gpuPath);
+        expectEqual(r, `human ${mode}`, gpuPath);
+        expectFormat(r, gpuPath === 'joints' ? 'compact' : 'full only');
       });
       for (const m of SHARED) {
         const path = join(MODELS_DIR, m.file);
@@ -95,6 +109,7 @@ describe.skipIf(!!reason)('GPU backend = CPU backend (headless Chromium)', () =>
       const r = await check('human', smooth, [0.15, 0.45], 'run', 'joints', [1.3, 0.7, 1.1]);
       expect(r.anisotropy).toBeGreaterThan(1.5); // the scale reached the skin matrices (1.3 / 0.7 ≈ 1.86 along the hips' axes)
       expectEqual(r, `human scaled ${smooth ? 'smooth' : 'plain'}`, 'joints');
+      expectFormat(r, 'full'); // a scaled joint: the whole frame in the full format
     });
   }
 });
@@ -143,11 +158,12 @@ describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (Ces
 
   for (const gpuPath of ['joints', 'sections'] as const) {
     test(`a crowd of 3 (${gpuPath} path): each instance's shader output = the CPU on its own pose; instance 0 drawn = the CPU backend's picture`, async () => {
-      const r = await fixture.page.evaluate(([f, p]) => (window as unknown as { __gpu: { crowd(a: string, b: number[], c?: string, d?: string): Promise<{ path: string; tableSlots: number; instances: number; positionError: number; pixelDiff: number; coverage: number }> } })
+      const r = await fixture.page.evaluate(([f, p]) => (window as unknown as { __gpu: { crowd(a: string, b: number[], c?: string, d?: string): Promise<{ path: string; tableSlots: number; instances: number; format: string; positionError: number; pixelDiff: number; coverage: number }> } })
         .__gpu.crowd(f, [0.3, 0.9, 1.6], undefined, p), [`/@fs${file}`, gpuPath] as const);
       console.log(`crowd of ${r.instances}, ${r.path} path (table ${r.tableSlots} joints per section): GPU − CPU ≤ ${r.positionError.toExponential(2)} of the height; ` +
         `instance 0 vs the CPU picture ${(100 * r.pixelDiff).toFixed(3)} % of pixels (character covers ${(100 * r.coverage).toFixed(1)} %)`);
       expect(r.path).toBe(gpuPath);
+      expect(r.format).toBe(gpuPath === 'joints' ? 'compact' : 'full only'); // CesiumMan's three poses: rigid within the tolerance
       expect(r.tableSlots).toBe(gpuPath === 'joints' ? 8 : 4);
       expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
       expect(r.coverage).toBeGreaterThan(0.02);
@@ -196,12 +212,15 @@ describe.skipIf(!!reason || !!noCesium)('every built-in material, shadows includ
 describe.skipIf(!!reason)('LBS and DQS on the GPU backend = on the CPU', () => {
   for (const method of ['lbs', 'dqs'] as const) {
     test(`default human, ${method}`, async () => {
-      expectEqual(await check('human', false, [0.15, 0.45, 0.8], 'run', 'joints', undefined, false, method), `human ${method}`, 'joints', method);
+      const r = await check('human', false, [0.15, 0.45, 0.8], 'run', 'joints', undefined, false, method);
+      expectEqual(r, `human ${method}`, 'joints', method);
+      expectFormat(r, method === 'dqs' ? 'compact' : 'full only'); // LBS reads its joints' matrix rows per vertex: the full format
     });
     test(`default human, ${method}, hips scaled (1.3, 0.7, 1.1)`, async () => {
       const r = await check('human', false, [0.15, 0.45], 'run', 'joints', [1.3, 0.7, 1.1], false, method);
       expect(r.anisotropy).toBeGreaterThan(1.5);
       expectEqual(r, `human ${method} scaled`, 'joints', method);
+      expectFormat(r, method === 'dqs' ? 'full' : 'full only');
     });
     for (const m of SHARED) {
       const path = join(MODELS_DIR, m.file);

@@ -82,8 +82,10 @@ describe('GPU backend (three.js adapter)', () => {
     const sections = skin.gpuSections!;
     const J = skin.deformer.jointCount;
     expect(sections.path).toBe('joints');
-    // One row of J × 4 texels: 64 bytes per joint (19 joints: 1,216 bytes), whatever the section count.
-    expect(skin.bytesPerFrame).toBe(J * 64);
+    // A walk is rigid with unit scale: the compact joint poses, 24 bytes per joint in one row (19 joints: 29 texels, 464 bytes), whatever the section count.
+    expect(sections.uniforms.gcsCompactPoses!.value).toBe(1);
+    expect(skin.bytesPerFrame).toBe(Math.ceil(J * 1.5) * 16);
+    expect(sections.uniforms.gcsCompactJoints!.value).toBe(sections.compactTexture);
     expect(sections.uniforms.gcsJoints!.value).toBe(sections.texture);
     expect(sections.uniforms.gcsTable!.value).toBe(sections.table);
     const table = sections.table!.image.data as Float32Array;
@@ -95,16 +97,18 @@ describe('GPU backend (three.js adapter)', () => {
       expect(Array.from(table.subarray(12 * s + 8, 12 * s + 12))).toEqual(Array.from(centres.subarray(4 * s, 4 * s + 4)));
     }
     const positionVersion = position.version, textureVersion = sections.texture.version, tableVersion = sections.table!.version;
+    const compactVersion = sections.compactTexture!.version;
     mixer.setTime(0.6);
     character.update();
     expect(position.version).toBe(positionVersion);
-    expect(sections.texture.version).toBe(textureVersion + 1);
+    expect(sections.compactTexture!.version).toBe(compactVersion + 1); // this frame's (compact) joint poses go up
+    expect(sections.texture.version).toBe(textureVersion); // the full format's texture is not read this frame: not uploaded
     expect(sections.table!.version).toBe(tableVersion); // static
-    // The texture views wasm memory (no copy) and holds this frame's joint poses: the rows of S_j.
-    const data = sections.texture.image.data as Float32Array;
+    // The texture views wasm memory (no copy) and holds this frame's joint poses: per joint 3 quaternion components, then t_j (S_j's translation).
+    const data = sections.compactTexture!.image.data as Float32Array;
     expect(data.buffer).toBe(gcs.memory.buffer);
     const S = (skin as unknown as { skin: Float32Array }).skin; // this frame's S_j
-    for (let j = 0; j < J; j++) for (let r = 0; r < 3; r++) for (let c = 0; c < 4; c++) expect(data[16 * j + 4 * r + c]).toBe(S[16 * j + 4 * c + r]);
+    for (let j = 0; j < J; j++) for (let r = 0; r < 3; r++) expect(data[6 * j + 3 + r]).toBe(S[16 * j + 12 + r]);
     character.dispose();
   });
 
@@ -169,7 +173,8 @@ describe('GPU backend (three.js adapter)', () => {
       expect(skin.mesh.geometry.getAttribute('gcsInfluences0')).toBeDefined();
       expect(skin.mesh.geometry.getAttribute('gcsBlend')).toBeUndefined();
       expect((skin.mesh.material as THREE.Material).customProgramCacheKey()).toContain(`gcs-${method}-4`);
-      expect(skin.bytesPerFrame).toBe(skin.deformer.jointCount * 64); // the joint poses only
+      // The joint poses only: LBS's in the full format (64 bytes per joint), DQS's compact (24) on this rigid frame.
+      expect(skin.bytesPerFrame).toBe(method === 'lbs' ? skin.deformer.jointCount * 64 : Math.ceil(skin.deformer.jointCount * 1.5) * 16);
     }
     character.rebuild('gcs', { gcs: { smooth: true } });
     expect(skin.backend).toBe('gpu');
@@ -223,26 +228,28 @@ describe('GPU backend (three.js adapter)', () => {
       const S = crowd.deformer.sectionCount, J = crowd.jointCount;
       const perInstance = gpuPath === 'joints' ? J * 16 : S * 12; // floats
       expect(crowd.sections.transforms.texelsPerInstance * 4).toBe(perInstance);
-      expect(crowd.bytesPerFrame).toBe(crowd.sections.transforms.width * crowd.sections.transforms.height * 16);
-      expect(crowd.bytesPerFrame).toBeLessThan(N * perInstance * 4 + 2048 * 16);
+      // The joints path uploads the compact joint poses (a rigid frame: 6 floats per joint), the sections path its section texture.
+      const image = (gpuPath === 'joints' ? crowd.sections.compactTexture! : crowd.sections.texture).image as { width: number; height: number };
+      expect(crowd.bytesPerFrame).toBe(image.width * image.height * 16);
+      expect(crowd.bytesPerFrame).toBeLessThan(N * (gpuPath === 'joints' ? J * 6 : perInstance) * 4 + 2048 * 16);
       const walk = bakeClip(mesh, human.clips.find((c) => c.name === 'walk')!, 30);
       expect(walk.frames).toBe(Math.round(walk.duration * 30));
       const times = [0, 0.21, 0.5, -0.3, 7.9];
       times.forEach((t, i) => crowd.setBakedPose(i, walk, t));
-      const version = crowd.sections.texture.version;
+      const uploaded = gpuPath === 'joints' ? crowd.sections.compactTexture! : crowd.sections.texture, version = uploaded.version;
       crowd.update();
-      expect(crowd.sections.texture.version).toBe(version + 1);
-      // Instance i's texels are those of its own pose (the baked frame at its time).
-      const one = gpuPath === 'joints' ? new JointPoses(crowd.deformer, 1) : new SectionTransforms(crowd.deformer, 1);
-      const all = crowd.sections.transforms.texels;
+      expect(uploaded.version).toBe(version + 1);
+      // Instance i's texels are those of its own pose (the baked frame at its time); the joints path's are compact (6 floats per joint).
+      const one = gpuPath === 'joints' ? new JointPoses(crowd.deformer, 1, 2048, true) : new SectionTransforms(crowd.deformer, 1);
+      const all = crowd.sections.transforms.texels, floats = gpuPath === 'joints' ? J * 6 : perInstance;
       times.forEach((t, i) => {
         let f = Math.floor(t * walk.fps) % walk.frames;
         if (f < 0) f += walk.frames;
         one.skins.set(walk.data.subarray(f * J * 16, (f + 1) * J * 16));
         one.compute();
-        expect(Array.from(all.subarray(i * perInstance, (i + 1) * perInstance))).toEqual(Array.from(one.texels.subarray(0, perInstance)));
+        expect(Array.from(all.subarray(i * floats, (i + 1) * floats))).toEqual(Array.from(one.texels.subarray(0, floats)));
       });
-      expect(Array.from(all.subarray(0, perInstance))).not.toEqual(Array.from(all.subarray(perInstance, 2 * perInstance)));
+      expect(Array.from(all.subarray(0, floats))).not.toEqual(Array.from(all.subarray(floats, 2 * floats)));
       one.dispose();
       expect(() => crowd.offsetOf(N)).toThrow(GcsError);
       expect(() => new GcsCrowd(gcs, mesh, 0)).toThrow(GcsError);

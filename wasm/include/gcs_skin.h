@@ -482,8 +482,11 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  * of 16, for the joint-level path's per-frame upload. Same arguments, checks and errors as
  * gcs_gcs_compute_joint_poses; `out` holds the full format's instanceCount × jointCount × 16 floats.
  *   Compact (every joint of every instance rigid with unit scale: each entry of its 3×3 part S_j
- *   within GCS_COMPACT_POSE_TOLERANCE of the rotation R_j that gcs_gcs_compute_joint_poses splits
- *   off; real clips measure ≤ 1.3e-6, a scale or shear key well above): joint j of instance k at
+ *   within GCS_COMPACT_POSE_TOLERANCE × min(1, height / reach) of the rotation R_j that
+ *   gcs_gcs_compute_joint_poses splits off, height the bind mesh's largest bounding-box extent and
+ *   reach its farthest vertex from the origin, so that R_j·x and S_j·x differ by at most
+ *   3 · GCS_COMPACT_POSE_TOLERANCE of the height at any bind vertex x; real clips measure ≤ 2e-6
+ *   from float rounding, a scale or shear key well above): joint j of instance k at
  *   floats (k · jointCount + j) · GCS_COMPACT_FLOATS_PER_JOINT, the first instanceCount · jointCount ·
  *   6 floats of `out` (the rest is not written): the "smallest three" of R_j's unit quaternion
  *   (x, y, z, w in order without its largest-magnitude component, ±q chosen so that the dropped one
@@ -492,8 +495,7 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
  *   index i (0 x, 1 y, 2 z, 3 w) is in the lowest mantissa bit of the first two floats: bit 0 of i
  *   in the first, bit 1 in the second (each moved by at most one unit in the last place; a value
  *   smaller in magnitude than FLT_MIN is first written as ±FLT_MIN, so the bits survive a GPU that
- *   flushes denormals). The reader takes S_j = R(q_j): within the tolerance (relative to the
- *   distance from the origin) plus float rounding of where S_j itself would move a point.
+ *   flushes denormals). The reader takes S_j = R(q_j).
  *   Full (any joint scaled, sheared, mirrored, collapsed or out of tolerance): exactly what
  *   gcs_gcs_compute_joint_poses writes.
  * Returns GCS_JOINT_POSES_COMPACT or GCS_JOINT_POSES_FULL, the format of the whole call; or 0 with

@@ -413,13 +413,13 @@ static void setLowestBit(float& f, uint32_t bit) {
 }
 
 // One joint in the compact format (gcs_gcs_compute_joint_poses_compact), or false where its 3×3
-// part is not within GCS_COMPACT_POSE_TOLERANCE of its rotation (a scale, a shear, a mirror).
-static bool writeCompactJointPose(const glm::mat4& m, float* o) {
+// part is not within `tolerance` of its rotation (a scale, a shear, a mirror).
+static bool writeCompactJointPose(const glm::mat4& m, float tolerance, float* o) {
   const glm::quat q = gcs::rotationOf(m);
   const glm::dmat3 r = glm::mat3_cast(glm::dquat(q.w, q.x, q.y, q.z));
   for (int c = 0; c < 3; ++c)
     for (int i = 0; i < 3; ++i)
-      if (!(std::fabs(double(m[c][i]) - r[c][i]) <= double(GCS_COMPACT_POSE_TOLERANCE))) return false;
+      if (!(std::fabs(double(m[c][i]) - r[c][i]) <= double(tolerance))) return false;
   const float v[4] = {q.x, q.y, q.z, q.w};
   uint32_t dropped = 0;
   for (uint32_t i = 1; i < 4; ++i)
@@ -444,12 +444,13 @@ int gcs_gcs_compute_joint_poses(const GcsDeformer* deformer, const float* skinMa
 int gcs_gcs_compute_joint_poses_compact(const GcsDeformer* deformer, const float* skinMatrices, uint32_t jointCount,
                                         uint32_t instanceCount, float* out) {
   gcs::clearError();
-  if (!jointPoseInput(deformer, skinMatrices, jointCount, instanceCount, out)) return 0;
+  const gcs::GcsDeformerImpl* g = jointPoseInput(deformer, skinMatrices, jointCount, instanceCount, out);
+  if (!g) return 0;
   const glm::mat4* skins = reinterpret_cast<const glm::mat4*>(skinMatrices);
   const uint64_t count = uint64_t(instanceCount) * jointCount;
   // The compact floats are a prefix of the full format's: a joint out of tolerance rewrites the whole call.
   for (uint64_t k = 0; k < count; ++k)
-    if (!writeCompactJointPose(skins[k], out + k * GCS_COMPACT_FLOATS_PER_JOINT)) {
+    if (!writeCompactJointPose(skins[k], g->compactTolerance, out + k * GCS_COMPACT_FLOATS_PER_JOINT)) {
       writeFullJointPoses(skins, count, out);
       return GCS_JOINT_POSES_FULL;
     }

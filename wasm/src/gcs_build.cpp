@@ -58,6 +58,12 @@ std::vector<uint32_t> layoutRuns(const Rig& rig, GcsDeformerImpl& m, const std::
   }
   m.indices.resize(rig.indices.size());
   for (size_t i = 0; i < rig.indices.size(); ++i) m.indices[i] = outputOf[rig.indices[i]];
+  // The compact joint poses' tolerance (gcs_gcs_compute_joint_poses_compact): R(q)·x for S·x moves
+  // a vertex by up to 3 · tolerance · |x|, so a skin far from the origin for its size (a visor 1.7 m
+  // up, 12 cm tall) gets a tighter one: its error stays a fraction of its own height.
+  float reach = 0.0f;
+  for (uint32_t v = 0; v < V; ++v) reach = std::max(reach, glm::length(rig.positions[v]));
+  m.compactTolerance = GCS_COMPACT_POSE_TOLERANCE * (reach > rig.height ? rig.height / reach : 1.0f);
   return outputOf;
 }
 

@@ -104,6 +104,7 @@ class GcsDeformerImpl final : public Deformer {
   };
   std::vector<BlendRun> blendRuns;
   float adjustTolerance = 0.0f;
+  float compactTolerance = 0.0f;        // GCS_COMPACT_POSE_TOLERANCE × min(1, height / reach): see gcs_build
 
   // Per-frame state, allocated at build time.
   std::vector<Motion> motions;          // D_j per part joint

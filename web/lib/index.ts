@@ -1196,12 +1196,16 @@ export class JointPoses extends PoseTexels {
    */
   compactFormat = false;
 
+  /** Whether compute() writes the compact format where a frame allows it (see compactFormat); else always the full one. */
+  readonly compact: boolean;
+
   /** `compact`: write the compact format where a frame allows it (see compactFormat). */
-  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, readonly compact = false) {
+  constructor(deformer: GcsDeformer, instanceCount = 1, maxWidth = 2048, compact = false) {
     super(deformer, instanceCount, maxWidth, () => {
       if (!deformer.jointLevel) throw new GcsError('INVALID_ARGUMENT', 'joint poses drive the weights criterion only; the Y and axial criteria need SectionTransforms');
       return deformer.jointCount * GPU_TEXELS_PER_JOINT;
     }, GPU_TEXELS_PER_JOINT);
+    this.compact = compact;
     this.compute();
   }
 

@@ -9,7 +9,7 @@ import * as THREE from 'three';
 import { initGcsSkin, type GcsDeformer, type GcsOptions } from '../../../web/lib/index.js';
 import { GcsCharacter, rigInputFromSkinnedMesh, writeSkinMatrices, type Backend } from '../../../web/lib/three.js';
 import { GcsCrowd } from '../../../web/lib/crowd.js';
-import { patchVertexShader, type GpuPath } from '../../../web/lib/gpu.js';
+import { patchVertexShader, type GpuPath, type GpuSections } from '../../../web/lib/gpu.js';
 import type { GpuMethod, TableSlots } from '../../../web/lib/gpu/layout.js';
 import type { NodePass } from '../../../web/lib/gpu/node-pass.js';
 import { firstFour } from '../../helpers/influences.js';
@@ -123,6 +123,14 @@ export interface CheckResult {
   tableSlots: number[];
   /** how far (of the height) the CPU result moves when each skin is cut to its first 4 influences: what the second set contributes */
   secondSet: number;
+  /** per frame and skin, the joint poses' format uploaded: 'compact', 'full', or 'full only' (LBS, the section-level path) */
+  formats: string[];
+}
+
+/** The format of the joint poses `sections` uploaded at its last update(). */
+function poseFormat(sections: GpuSections): string {
+  if (!sections.compactTexture) return 'full only';
+  return sections.uniforms.gcsCompactPoses!.value === 1 ? 'compact' : 'full';
 }
 
 /** The scene drawn on black, read back as RGBA bytes. */
@@ -160,7 +168,7 @@ async function check(model: string, options: GcsOptions & { method?: GpuMethod }
   const result: CheckResult = { skins: character.skins.length, backends: character.skins.map((s) => s.backend), paths: character.skins.map((s) => s.gpuPath ?? 'none'), notes: character.skins.map((s) => s.backendNote),
     height: 0, positionError: 0, normalError: 0, normalErrorRaw: 0, motion: 0, vertices: 0, frames: times.length, pixelDiff: [], coverage: 0, pixelMotion: 0,
     extColorBufferFloat: renderer.extensions.has('EXT_color_buffer_float'), anisotropy: 1,
-    tableSlots: character.skins.map((s) => s.gpuSections?.tableSlots ?? 0), secondSet: 0 };
+    tableSlots: character.skins.map((s) => s.gpuSections?.tableSlots ?? 0), secondSet: 0, formats: [] };
   // The same skins cut to their first 4 influences (on the CPU), for secondSet.
   const cut = character.skins.map((s) => {
     const rig = gcs.createRig(firstFour(rigInputFromSkinnedMesh(s.source)));
@@ -185,6 +193,7 @@ async function check(model: string, options: GcsOptions & { method?: GpuMethod }
     character.skins.forEach((skin, k) => {
       const mesh = skin.mesh as THREE.Mesh;
       const sections = skin.gpuSections!;
+      result.formats.push(poseFormat(sections));
       const gpuOut = readBack(mesh, vertexUniforms(mesh), sections.smooth, sections.path, sections.method, sections.tableSlots);
       const d = skin.deformer as GcsDeformer;
       const S = (skin as unknown as { skin: Float32Array }).skin;
@@ -233,6 +242,8 @@ async function check(model: string, options: GcsOptions & { method?: GpuMethod }
 
 export interface CrowdResult {
   path: string; tableSlots: number; instances: number;
+  /** the joint poses' format uploaded (poseFormat) */
+  format: string;
   /** worst |GPU − CPU| over every instance's vertices (each instance at its own clip time), of the height */
   positionError: number;
   /** share of pixels differing between the crowd's instance 0 (one instanced draw) and the CPU backend's character at the same pose */
@@ -267,7 +278,7 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   renderer.render(drawn, camera);
   drawn.remove(c.mesh);
   const sections = c.sections, height = c.rig.height;
-  const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, positionError: 0, pixelDiff: 1, coverage: 0 };
+  const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, format: poseFormat(sections), positionError: 0, pixelDiff: 1, coverage: 0 };
   const uniforms = vertexUniforms(c.mesh);
   const base = uniforms.gcsBase!.value as number, stride = uniforms.gcsStride!.value as number;
   times.forEach((_, i) => {

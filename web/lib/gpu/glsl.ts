@@ -175,7 +175,7 @@ const TABLE_SLOT = /* glsl */ `
 		#endif
 		if ( ! ( w > 0.0 ) ) continue;`;
 
-/** The joint poses (per frame): joint j's pose, the rotation of a quaternion, the normal texel of a scale part. */
+/** The joint poses (per frame, the full format): joint j's texels, the rotation of a quaternion, the normal texel of a scale part. */
 const NODE_MATHS = /* glsl */ `
 uniform highp sampler2D gcsJoints;
 vec4 gcsTexel( const in highp sampler2D t, const in int i ) {
@@ -195,15 +195,40 @@ void gcsJointTexels( const in int base, const in int j, out vec4 r0, out vec4 r1
 	r2 = texelFetch( gcsJoints, at, 0 ); at = gcsNextTexel( at, w );
 	q = texelFetch( gcsJoints, at, 0 );
 }
-// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w).
+${ROTATION}
+${NORMAL_TEXEL}`;
+
+/**
+ * What the passes read of a joint (node pass, DQS's joint pass; never per vertex): its pose from
+ * the full format (gcsJoints) or, on a frame whose every joint is rigid with unit scale
+ * (gcsCompactPoses = 1, one uniform for the whole frame), from the compact one (gcsCompactJoints:
+ * COMPACT_FLOATS_PER_JOINT floats, 1.5 texels, per joint; gcs_gcs_compute_joint_poses_compact).
+ */
+const JOINT_POSE = /* glsl */ `
+uniform highp sampler2D gcsCompactJoints;
+uniform int gcsCompactPoses;
+// Joint j's pose: S_j (3×3 part and translation) and its rotation quaternion (x, y, z, w). Compact:
+// the smallest three of q (the dropped one's index in the lowest bits of the first two; the dropped
+// one positive, ≥ 1/2) and t; S_j = R(q).
 void gcsJoint( const in int base, const in int j, out mat3 s, out vec3 t, out vec4 q ) {
+	if ( gcsCompactPoses == 1 ) {
+		int g = base / ${GPU_TEXELS_PER_JOINT} + j, i = ( 3 * g ) >> 1; // joint g's first texel: its 6 floats start at lane 0 (g even) or 2 (odd)
+		vec4 a = gcsTexel( gcsCompactJoints, i ), b = gcsTexel( gcsCompactJoints, i + 1 );
+		bool odd = ( g & 1 ) == 1;
+		vec3 c = odd ? vec3( a.zw, b.x ) : a.xyz;
+		t = odd ? b.yzw : vec3( a.w, b.xy );
+		uint dropped = ( floatBitsToUint( c.x ) & 1u ) | ( ( floatBitsToUint( c.y ) & 1u ) << 1 );
+		float d = sqrt( max( 1.0 - dot( c, c ), 0.0 ) );
+		q = dropped == 0u ? vec4( d, c ) : dropped == 1u ? vec4( c.x, d, c.yz ) : dropped == 2u ? vec4( c.xy, d, c.z ) : vec4( c, d );
+		s = gcsRotation( q, 2.0 );
+		return;
+	}
 	vec4 r0, r1, r2;
 	gcsJointTexels( base, j, r0, r1, r2, q );
 	s = transpose( mat3( r0.xyz, r1.xyz, r2.xyz ) );
 	t = vec3( r0.w, r1.w, r2.w );
 }
-${ROTATION}
-${NORMAL_TEXEL}`;
+`;
 
 /**
  * The node pass's maths: a node from its joints' parts, as the joint pass wrote them once per joint
@@ -295,7 +320,7 @@ layout( location = 3 ) out highp vec4 gcsNormal;
  * s), four outputs (GPU_NODE_TEXTURES): the rows of [M | T] and the normal texel.
  */
 const NODE_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}uniform highp sampler2D gcsTable;
-${NODE_MATHS}${NODE_FROM_PARTS}
+${NODE_MATHS}${JOINT_POSE}${NODE_FROM_PARTS}
 // Section s: its joints, weights and centre of rotation from the static table (GCS_TABLE_TEXELS per
 // section: per 4 slots a texel of joints, −1 past the last, then one of weights; last, the centre).
 void gcsSectionBlend( const in int base, const in int row, const in int s, out mat3 M, out vec3 T, out vec4 N ) {
@@ -326,7 +351,7 @@ void main() {
  * one), then the rows of its scale part K = Rᵀ S — what each vertex's dual-quaternion blend needs
  * per joint, computed once per joint and frame instead of once per vertex and influence.
  */
-const DQS_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}${NODE_MATHS}
+const DQS_PASS_FRAGMENT = /* glsl */ `${PASS_HEAD}${NODE_MATHS}${JOINT_POSE}
 // s where k is a positive uniform scale s·I within ${RIGID_JOINT_TOLERANCE} × s (the CPU's test for a
 // uniform frame, per joint; s exactly the diagonal where its entries are equal), else 0.
 float gcsRigidScale( const in mat3 k ) {

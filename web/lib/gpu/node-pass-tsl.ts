@@ -19,7 +19,7 @@
  */
 import * as THREE from 'three/webgpu';
 import {
-  abs, bool, cross, dot, float, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, step, texture, textureSize, uniform, vec3, vec4,
+  abs, bitAnd, bitOr, bool, cross, dot, float, floatBitsToUint, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, shiftLeft, sqrt, step, texture, textureSize, uint, uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
 import {
@@ -27,7 +27,7 @@ import {
 } from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import { NodePage, PagedPass, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
-import type { GpuSections } from './sections.js';
+import { compactPoses, type GpuSections } from './sections.js';
 
 type Bool = Node<'bool'>;
 type Float = Node<'float'>;
@@ -182,11 +182,56 @@ const gcsDqsJointTexels = Fn(([pose, second]: [Mat4, Bool]) => {
 /** The node maths' inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
 export interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
 
-/** Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion. */
+/**
+ * Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion.
+ * Where the texture has a compact twin (GpuSections.compactTexture: GCS and DQS), a frame whose
+ * poses are compact (one uniform for the frame) reads those instead: the GLSL's gcsJoint.
+ */
 export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
   const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
-  return mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
+  const full = () => mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
+  const compact = compactReader(inputs.joints);
+  if (!compact) return full();
+  const pose = mat4(vec4(0), vec4(0), vec4(0), vec4(0)).toVar();
+  If(compact.format.equal(1), () => {
+    const g = i.div(GPU_TEXELS_PER_JOINT).toVar(), first = g.mul(3).div(2).toVar(); // 6 floats from lane 0 (g even) or 2 (odd)
+    pose.assign(gcsCompactPose(texel(compact.texture, first), texel(compact.texture, first.add(1)), g.bitAnd(1).equal(1)));
+  }).Else(() => { pose.assign(full()); });
+  return pose;
 }
+
+/** The compact twin of a joint-pose texture and its format uniform, as nodes made once per texture. */
+const compactReaders = new WeakMap<object, { texture: TextureNode; format: Int }>();
+function compactReader(joints: TextureNode): { texture: TextureNode; format: Int } | null {
+  const twin = compactPoses.get(joints.value as THREE.Texture);
+  if (!twin) return null;
+  let reader = compactReaders.get(twin);
+  if (!reader) {
+    const format = twin.format;
+    reader = { texture: texture(twin.texture), format: uniform(format.value, 'int').onObjectUpdate(() => format.value) as unknown as Int };
+    compactReaders.set(twin, reader);
+  }
+  return reader;
+}
+
+/**
+ * A joint's pose from its compact floats (texels a, b; from a's lane 2 where `odd`): the smallest
+ * three of q, the dropped one's index in the lowest bits of the first two, then t; S = R(q). The
+ * same mat4 as the full format's four texels.
+ */
+const gcsCompactPose = Fn(([a, b, odd]: [Vec4, Vec4, Bool]) => {
+  const c = select(odd, vec3(a.z, a.w, b.x), a.xyz).toVar();
+  const t = select(odd, b.yzw, vec3(a.w, b.x, b.y)).toVar();
+  const lowest = (v: Float) => bitAnd(floatBitsToUint(v) as unknown as Node<'uint'>, uint(1));
+  const dropped = int(bitOr(lowest(c.x), shiftLeft(lowest(c.y), uint(1)))).toVar();
+  const d = sqrt(max(float(1).sub(dot(c, c)), 0)).toVar();
+  const q = vec4(c, d).toVar();
+  If(dropped.equal(0), () => { q.assign(vec4(d, c)); })
+    .ElseIf(dropped.equal(1), () => { q.assign(vec4(c.x, d, c.y, c.z)); })
+    .ElseIf(dropped.equal(2), () => { q.assign(vec4(c.x, c.y, d, c.z)); });
+  const rows = gcsRotation(q, float(2)).transpose().toVar();
+  return mat4(vec4(column(rows, 0), t.x), vec4(column(rows, 1), t.y), vec4(column(rows, 2), t.z), q);
+}).setLayout({ name: 'gcsCompactPose', type: 'mat4', inputs: [{ name: 'a', type: 'vec4' }, { name: 'b', type: 'vec4' }, { name: 'odd', type: 'bool' }] });
 
 /**
  * Section s's row of the table: per 4 slots a texel of joints (−1 past the last) then one of

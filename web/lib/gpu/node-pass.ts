@@ -73,7 +73,7 @@ export class NodePass extends PagedPass<NodePage> {
     this.material = new THREE.ShaderMaterial({
       ...(writesJoints ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
       uniforms: {
-        gcsJoints: u.gcsJoints!, ...parts,
+        gcsJoints: u.gcsJoints!, gcsCompactJoints: u.gcsCompactJoints ?? { value: null }, gcsCompactPoses: u.gcsCompactPoses ?? { value: 0 }, ...parts,
         gcsNodeCount: { value: sections.instanceCount * S }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: PAGE_WIDTH },
         gcsFirstRow: this.firstRowUniform, gcsRect: { value: new THREE.Vector4() },

@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { checkMethods, checkObject } from '../arguments.js';
 import { GcsError } from '../errors.js';
-import { JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
+import { COMPACT_FLOATS_PER_JOINT, JointPoses, SectionTransforms, type GcsDeformer, type PoseTexels } from '../index.js';
 import { keepLive } from '../three/live-views.js';
 import { BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, SECTION_ATTRIBUTE, tableTexelsPerSection, type GpuMethod, type GpuPath, type TableSlots } from './layout.js';
 
@@ -24,6 +24,16 @@ export interface GcsUniforms {
   gcsJoints?: {
     /** The uniform's value. */
     value: THREE.DataTexture;
+  };
+  /** Path 'joints' read by a pass (GCS, DQS): the joint poses in the compact format (per frame, see GpuSections.compactTexture). */
+  gcsCompactJoints?: {
+    /** The uniform's value. */
+    value: THREE.DataTexture;
+  };
+  /** 1 where this frame's joint poses are in the compact format (gcsCompactJoints), 0 where in the full one (gcsJoints). */
+  gcsCompactPoses?: {
+    /** The uniform's value. */
+    value: number;
   };
   /** Path 'joints': each section's joints and weights (static). */
   gcsTable?: {
@@ -58,8 +68,17 @@ export class GpuSections {
   readonly path: GpuPath;
   /** The per-frame buffers in wasm memory (JointPoses or SectionTransforms). */
   readonly transforms: PoseTexels;
-  /** The per-frame texture (joint poses or section transforms). */
+  /** The per-frame texture (joint poses or section transforms); path 'joints': the full format's. */
   readonly texture: THREE.DataTexture;
+  /**
+   * GCS and DQS on path 'joints' (read by their passes only): the joint poses in the compact
+   * format, uploaded instead of `texture` on a frame whose every joint is rigid with unit scale
+   * (JointPoses.compactFormat; uniform gcsCompactPoses = 1): COMPACT_FLOATS_PER_JOINT floats per
+   * joint, joint j of instance k at float (k·J + j)·6, i.e. 1.5 texels, the first texels of the
+   * same wasm buffer. Null for LBS (each vertex reads its joints' matrix rows: the full format
+   * always) and path 'sections'.
+   */
+  readonly compactTexture: THREE.DataTexture | null;
   /** Path 'joints': the static texture of each section's joints, weights and centre of rotation; null otherwise. */
   readonly table: THREE.DataTexture | null;
   /** Path 'joints': joints per section in `table` (4, or 8 where a section blends more); 4 otherwise. */
@@ -71,7 +90,7 @@ export class GpuSections {
   /** Counts update() calls: what a node pass computed from is told apart from what it must recompute. */
   version = 0;
   /** Velocity: the per-frame texels as the previous frame drew them (see previousTexture). */
-  private previous: { texture: THREE.DataTexture; drawn: Float32Array; frameId: number } | null = null;
+  private previous: PreviousPoses | null = null;
 
   /** What the vertex stage runs: GCS, or LBS / DQS of each vertex's own joints (joint poses only, no table). */
   readonly method: GpuMethod;
@@ -93,11 +112,20 @@ export class GpuSections {
     this.method = skinning?.method ?? 'gcs';
     this.ownsDeformer = skinning !== undefined;
     this.path = skinning ? 'joints' : path ?? (deformer.jointLevel ? 'joints' : 'sections');
-    this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth) : new SectionTransforms(deformer, instanceCount, maxWidth);
+    const compact = this.path === 'joints' && skinning?.method !== 'lbs';
+    this.transforms = this.path === 'joints' ? new JointPoses(deformer, instanceCount, maxWidth, compact) : new SectionTransforms(deformer, instanceCount, maxWidth);
     const t = this.transforms;
     this.texture = floatTexture(t.texels, t.width, t.height);
     keepLive(this.texture.image as { data: ArrayBufferView }, 'data', () => (t.disposed ? null : t.texels)); // live after memory growth
-    const base = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
+    this.compactTexture = null;
+    let base: GcsUniforms = { gcsBase: { value: 0 }, gcsStride: { value: t.texelsPerInstance } };
+    if (compact) {
+      const size = compactSize(t, maxWidth);
+      this.compactTexture = floatTexture(t.texels.subarray(0, size.floats), size.width, size.height);
+      keepLive(this.compactTexture.image as { data: ArrayBufferView }, 'data', () => (t.disposed ? null : t.texels.subarray(0, size.floats)));
+      base = { ...base, gcsCompactJoints: { value: this.compactTexture }, gcsCompactPoses: { value: (t as JointPoses).compactFormat ? 1 : 0 } };
+      compactPoses.set(this.texture, { texture: this.compactTexture, format: base.gcsCompactPoses! });
+    }
     this.tableSlots = 4;
     if (skinning) {
       this.tableSlots = skinning.slots;
@@ -128,9 +156,13 @@ export class GpuSections {
     return this.transforms.skins;
   }
 
-  /** Bytes one update() uploads: the whole per-frame texture (width × height × 16), twice while velocity is drawn. */
+  /**
+   * Bytes one update() uploads: the whole per-frame texture (width × height × 16) of the format
+   * it wrote (compactTexture's on a compact frame), twice while velocity is drawn.
+   */
   get bytesPerUpdate(): number {
-    return this.transforms.width * this.transforms.height * 16 * (this.previous ? 2 : 1);
+    const image = (this.uniforms.gcsCompactPoses?.value ? this.compactTexture! : this.texture).image as { width: number; height: number };
+    return image.width * image.height * 16 * (this.previous ? 2 : 1);
   }
 
   /**
@@ -141,8 +173,17 @@ export class GpuSections {
    */
   previousTexture(): THREE.DataTexture {
     if (!this.previous) {
-      const t = this.transforms;
-      this.previous = { texture: floatTexture(Float32Array.from(t.texels), t.width, t.height), drawn: Float32Array.from(t.texels), frameId: -1 };
+      const t = this.transforms, format = this.uniforms.gcsCompactPoses?.value ?? 0;
+      const texture = floatTexture(Float32Array.from(t.texels), t.width, t.height), drawn = Float32Array.from(t.texels);
+      const compact = this.compactTexture?.image as { width: number; height: number } | undefined;
+      const floats = compact ? compact.width * compact.height * 4 : 0;
+      const shown = texture.image.data as Float32Array;
+      this.previous = {
+        texture, drawn, frameId: -1, format: { value: format }, drawnFormat: format,
+        compactTexture: compact ? floatTexture(shown.subarray(0, floats), compact.width, compact.height) : null,
+        compactViews: compact ? new Map([[shown, shown.subarray(0, floats)], [drawn, drawn.subarray(0, floats)]]) : null,
+      };
+      if (this.previous.compactTexture) compactPoses.set(texture, { texture: this.previous.compactTexture, format: this.previous.format });
     }
     return this.previous.texture;
   }
@@ -160,7 +201,13 @@ export class GpuSections {
     p.drawn = image.data;
     image.data = drawn;
     p.drawn.set(this.transforms.texels);
-    p.texture.needsUpdate = true;
+    p.format.value = p.drawnFormat;
+    p.drawnFormat = this.uniforms.gcsCompactPoses?.value ?? 0;
+    if (p.compactTexture) {
+      (p.compactTexture.image as { data: Float32Array }).data = p.compactViews!.get(drawn)!;
+      p.compactTexture.needsUpdate = p.format.value === 1;
+      p.texture.needsUpdate = p.format.value === 0;
+    } else p.texture.needsUpdate = true;
   }
 
   /** Joint poses or section transforms of every instance from `skins`, then the texture is flagged for upload. No allocation. */
@@ -170,13 +217,23 @@ export class GpuSections {
     const texels = this.transforms.texels; // re-created after memory growth
     const image = this.texture.image as { data: Float32Array };
     if (image.data !== texels) image.data = texels;
+    const compact = this.uniforms.gcsCompactPoses;
+    if (compact) {
+      compact.value = (this.transforms as JointPoses).compactFormat ? 1 : 0;
+      if (compact.value) {
+        this.compactTexture!.needsUpdate = true; // only the compact texels go up; the full texture is not read this frame
+        return;
+      }
+    }
     this.texture.needsUpdate = true;
   }
 
   /** Frees the textures and the wasm buffers (the deformer stays the caller's). */
   dispose(): void {
     this.texture.dispose();
+    this.compactTexture?.dispose();
     this.previous?.texture.dispose();
+    this.previous?.compactTexture?.dispose();
     this.table?.dispose();
     this.transforms.dispose();
     if (this.ownsDeformer) this.deformer.dispose();
@@ -198,6 +255,33 @@ export function sectionTable(deformer: GcsDeformer): Float32Array {
     table.set(centres.subarray(4 * s, 4 * s + 4), perSection * s + 2 * slots);
   }
   return table;
+}
+
+/** Velocity: the per-frame texels as drawn the frame before, and their format. */
+interface PreviousPoses {
+  texture: THREE.DataTexture;
+  /** The texels drawn this frame, shown by `texture` from the next. */
+  drawn: Float32Array;
+  frameId: number;
+  /** Compact-capable sections: the previous frame's compact texture, its format uniform, and each full array's compact view (made once: no allocation per frame). */
+  compactTexture: THREE.DataTexture | null;
+  format: { value: number };
+  drawnFormat: number;
+  compactViews: Map<Float32Array, Float32Array> | null;
+}
+
+/**
+ * A per-frame texture of joint poses in the full format → its compact twin and the uniform saying
+ * which one a frame wrote (GpuSections.texture and its previousTexture): how a TSL reader of the
+ * texture (node-pass-tsl.ts, jointPose) finds the other.
+ */
+export const compactPoses = new WeakMap<THREE.Texture, { texture: THREE.DataTexture; format: { value: number } }>();
+
+/** The compact texture's size: instanceCount · J · COMPACT_FLOATS_PER_JOINT floats in RGBA texels, at most `maxWidth` wide. */
+function compactSize(t: PoseTexels, maxWidth: number): { width: number; height: number; floats: number } {
+  const texels = Math.ceil(t.instanceCount * t.jointCount * COMPACT_FLOATS_PER_JOINT / 4);
+  const width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+  return { width, height, floats: width * height * 4 };
 }
 
 /** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */
