@@ -134,6 +134,23 @@ const CESIUM = join(MODELS_DIR, 'CesiumMan.glb');
 const noCesium = existsSync(CESIUM) ? '' : `skipped: ${CESIUM} is absent (the shared test models are not on this machine)`;
 if (noCesium) console.log(noCesium);
 
+// A crowd whose compact joint poses span two texture rows, one joint's 6 floats split across them
+// (82 × 19 joints × 1.5 texels: 2,337 texels in two rows of 1,169; 1,169 is not a multiple of 3).
+describe.skipIf(!!reason || !!noCesium)('compact joint poses across texture rows', () => {
+  test('a crowd of 82 CesiumMen: each instance\'s shader output = the CPU on its own pose', async () => {
+    const times = Array.from({ length: 82 }, (_, i) => 0.05 + 0.023 * i);
+    const r = await fixture.page.evaluate(([f, t]) => (window as unknown as { __gpu: { crowd(a: string, b: number[]): Promise<{ format: string; rows: number; width: number; instances: number; positionError: number; pixelDiff: number }> } })
+      .__gpu.crowd(f, t), [`/@fs${CESIUM}`, times] as const);
+    console.log(`crowd of ${r.instances}: joint poses ${r.format}, ${r.rows} rows of ${r.width} texels; GPU − CPU ≤ ${r.positionError.toExponential(2)} of the height`);
+    expect(r.format).toBe('compact');
+    expect(r.rows).toBe(2);
+    expect(r.width % 3).not.toBe(0); // some joint's floats straddle the rows
+    expect(r.positionError).toBeLessThan(POSITION_TOLERANCE);
+    expect(r.pixelDiff).toBeLessThan(PIXEL_TOLERANCE);
+    expect(fixture.errors).toEqual([]);
+  }, 300000);
+});
+
 describe.skipIf(!!reason || !!noCesium)('8 influences per vertex on the GPU (CesiumMan, weights spread onto 5–8 joints)', () => {
   const file = join(ROOT, 'build', 'test-models', 'cesium-8.glb');
   beforeAll(async () => {

@@ -244,6 +244,9 @@ export interface CrowdResult {
   path: string; tableSlots: number; instances: number;
   /** the joint poses' format uploaded (poseFormat) */
   format: string;
+  /** rows and width of the texture the frame uploaded */
+  rows: number;
+  width: number;
   /** worst |GPU − CPU| over every instance's vertices (each instance at its own clip time), of the height */
   positionError: number;
   /** share of pixels differing between the crowd's instance 0 (one instanced draw) and the CPU backend's character at the same pose */
@@ -278,7 +281,8 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
   renderer.render(drawn, camera);
   drawn.remove(c.mesh);
   const sections = c.sections, height = c.rig.height;
-  const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, format: poseFormat(sections), positionError: 0, pixelDiff: 1, coverage: 0 };
+  const result: CrowdResult = { path: sections.path, tableSlots: sections.tableSlots, instances: times.length, format: poseFormat(sections), positionError: 0, pixelDiff: 1, coverage: 0,
+    ...(({ height: rows, width }) => ({ rows, width }))((poseFormat(sections) === 'compact' ? sections.compactTexture! : sections.texture).image as { width: number; height: number }) };
   const uniforms = vertexUniforms(c.mesh);
   const base = uniforms.gcsBase!.value as number, stride = uniforms.gcsStride!.value as number;
   times.forEach((_, i) => {

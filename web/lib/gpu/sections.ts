@@ -277,10 +277,14 @@ interface PreviousPoses {
  */
 export const compactPoses = new WeakMap<THREE.Texture, { texture: THREE.DataTexture; format: { value: number } }>();
 
-/** The compact texture's size: instanceCount · J · COMPACT_FLOATS_PER_JOINT floats in RGBA texels, at most `maxWidth` wide. */
+/**
+ * The compact texture's size: instanceCount · J · COMPACT_FLOATS_PER_JOINT floats in RGBA texels,
+ * at most `maxWidth` wide, its rows as even as they can be (less than a row of padding uploaded
+ * with a crowd's last one).
+ */
 function compactSize(t: PoseTexels, maxWidth: number): { width: number; height: number; floats: number } {
   const texels = Math.ceil(t.instanceCount * t.jointCount * COMPACT_FLOATS_PER_JOINT / 4);
-  const width = Math.min(maxWidth, texels), height = Math.ceil(texels / width);
+  const height = Math.ceil(texels / maxWidth), width = Math.ceil(texels / height);
   return { width, height, floats: width * height * 4 };
 }
 
