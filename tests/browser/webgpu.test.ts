@@ -154,7 +154,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
   // vertex stage only reads and blends. Its texels against the GLSL pass's (node-pass.ts, itself
   // checked against the CPU in tests/lib/gpu-joints.test.ts) from the same joint poses; a crowd
   // wide enough to span several rows of the targets.
-  interface NodePassResult { nodes: number; rows: number; largest: number; scale: number; runs: number[]; vertexNodeMaths: boolean; vertexLoads: number; drawCalls: number; coverage: number }
+  interface NodePassResult { nodes: number; rows: number; largest: number; scale: number; runs: number[]; vertexNodeMaths: boolean; vertexLoads: number; vertexSizeQueries: number; drawCalls: number; coverage: number }
   for (const [name, model, missing, count, clip, centres] of [
     ['the human', 'human-morph', false, 1, 'walk', false],
     ['the human, centres of rotation', 'human-morph', false, 1, 'walk', true],
