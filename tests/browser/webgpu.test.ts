@@ -155,7 +155,7 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
   // vertex stage only reads and blends. Its texels against the GLSL pass's (node-pass.ts, itself
   // checked against the CPU in tests/lib/gpu-joints.test.ts) from the same joint poses; a crowd
   // wide enough to span several rows of the targets.
-  interface NodePassResult { nodes: number; rows: number; largest: number; scale: number; runs: number[]; vertexNodeMaths: boolean; vertexLoads: number; drawCalls: number; coverage: number }
+  interface NodePassResult { nodes: number; rows: number; largest: number; scale: number; runs: number[]; vertexNodeMaths: boolean; vertexLoads: number; vertexSizeQueries: number; drawCalls: number; coverage: number }
   for (const [name, model, missing, count, clip, centres] of [
     ['the human', 'human-morph', false, 1, 'walk', false],
     ['the human, centres of rotation', 'human-morph', false, 1, 'walk', true],
@@ -164,10 +164,11 @@ describe.skipIf(!!reason)('gcs-skin/webgpu on WebGPURenderer (WebGL2 backend)', 
   ] as const) {
     test.skipIf(missing)(`node pass, ${name}: once per frame, TSL texels = GLSL texels, no node maths per vertex`, async () => {
       const r = await call<NodePassResult>('nodePass', model, count, { smooth: true, centres }, clip);
-      console.log(`node pass ${name}: ${r.nodes} nodes in ${r.rows} row(s); TSL vs GLSL texels within ${r.largest.toExponential(2)} (translations up to ${r.scale.toFixed(3)}); runs ${r.runs.join(', ')}; vertex shader: node maths ${r.vertexNodeMaths}, ${r.vertexLoads} texel loads; ${r.drawCalls} draw call(s)`);
+      console.log(`node pass ${name}: ${r.nodes} nodes in ${r.rows} row(s); TSL vs GLSL texels within ${r.largest.toExponential(2)} (translations up to ${r.scale.toFixed(3)}); runs ${r.runs.join(', ')}; vertex shader: node maths ${r.vertexNodeMaths}, ${r.vertexLoads} texel loads, ${r.vertexSizeQueries} size queries; ${r.drawCalls} draw call(s)`);
       expect(r.runs).toEqual([1, 1, 2]); // first frame, the same frame drawn again, the next frame
       expect(r.vertexNodeMaths).toBe(false);
       expect(r.vertexLoads).toBeGreaterThan(0);
+      expect(r.vertexSizeQueries).toBe(0); // rows flipped once per node coordinate, not per load (texel-tsl.ts)
       expect(r.drawCalls).toBe(1);
       expect(r.coverage).toBeGreaterThan(0.01);
       expect(r.scale).toBeGreaterThan(0);

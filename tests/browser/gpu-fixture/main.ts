@@ -257,8 +257,8 @@ export interface CrowdResult {
 /**
  * GcsCrowd: instance i posed at `times[i]`. What the shader computes for each instance (its texels
  * at gcsBase + i · gcsStride, read back as in check) against the CPU deformer on that instance's
- * skin matrices; then the crowd drawn (instance 0 placed where the source stands) against the CPU
- * backend's picture of the character at times[0].
+ * skin matrices; then the crowd drawn (instance 0 placed where the source stands, the source turned
+ * and scaled unevenly first) against the CPU backend's picture of the character at times[0].
  */
 async function crowd(model: string, times: number[], clipName?: string, gpuPath: GpuPath | 'auto' = 'auto'): Promise<CrowdResult> {
   const gcs = await gcsReady;
@@ -294,7 +294,10 @@ async function crowd(model: string, times: number[], clipName?: string, gpuPath:
       if (!(dp <= result.positionError)) result.positionError = Number.isNaN(dp) ? Infinity : dp;
     }
   });
-  // The picture: the character on the CPU backend at times[0], then the crowd's instance 0 in its place.
+  // The picture: the character on the CPU backend at times[0], then the crowd's instance 0 in its place,
+  // turned and scaled unevenly (the joint-level path folds the placement into the node pass).
+  root.rotation.y += 0.6;
+  root.scale.multiply(new THREE.Vector3(1.2, 0.85, 1.1));
   mixer.setTime(times[0]);
   const character = new GcsCharacter(gcs, root, { backend: 'cpu' });
   character.update();

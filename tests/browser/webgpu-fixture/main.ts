@@ -572,6 +572,8 @@ export interface NodePassResult {
   runs: number[];
   /** the crowd's vertex shader: whether it still holds the node maths, and how many texels it loads */
   vertexNodeMaths: boolean; vertexLoads: number;
+  /** texture size queries in the vertex shader (three.js's per-load row flip on the WebGL2 backend asks one per load) */
+  vertexSizeQueries: number;
   drawCalls: number; coverage: number;
 }
 
@@ -627,6 +629,7 @@ async function nodePass(model: string, count: number, gcsOptions: GcsOptions, cl
     nodes, rows, largest, scale, runs,
     vertexNodeMaths: /gcsNodeBlend|gcsRotation|gcsNormalTexel/.test(vertexShader),
     vertexLoads: (vertexShader.match(/texelFetch/g) ?? []).length,
+    vertexSizeQueries: (vertexShader.match(/textureSize/g) ?? []).length,
     drawCalls: calls.count, coverage: coverage(picture),
   };
 }

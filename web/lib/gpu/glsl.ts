@@ -331,12 +331,30 @@ void gcsSectionBlend( const in int base, const in int row, const in int s, out m
 	#endif
 	gcsBlend( base, row, gcsTexel( gcsTable, at ), gcsTexel( gcsTable, at + 1 ), joints1, weights1, gcsTexel( gcsTable, at + GCS_TABLE_TEXELS - 1 ), M, T, N );
 }
+#ifdef GCS_PLACED
+uniform highp sampler2D gcsPlacements;
+// A crowd's instance placement P folded into its nodes (the vertex stage then places nothing):
+// x ↦ P·(M x + T), and the normal texel's scale y / ∛det(P)² so that N = cof(P·M·x)·y turns a
+// normal by P's rotation where P scales uniformly (by P⁻ᵀ, up to length, where it does not).
+void gcsPlace( const in int instance, inout mat3 M, inout vec3 T, inout vec4 N ) {
+	int i = 4 * instance;
+	mat4 P = mat4( gcsTexel( gcsPlacements, i ), gcsTexel( gcsPlacements, i + 1 ), gcsTexel( gcsPlacements, i + 2 ), gcsTexel( gcsPlacements, i + 3 ) );
+	mat3 P3 = mat3( P );
+	M = P3 * M;
+	T = P3 * T + P[ 3 ].xyz;
+	float d = determinant( P3 );
+	if ( d != 0.0 ) N.y /= sign( d ) * pow( abs( d ), 2.0 / 3.0 );
+}
+#endif
 void main() {
 	int node = ( int( gl_FragCoord.y ) - gcsFirstRow ) * gcsTargetWidth + int( gl_FragCoord.x );
 	if ( node >= gcsNodeCount ) { gcsRow0 = gcsRow1 = gcsRow2 = gcsNormal = vec4( 0.0 ); return; }
 	int instance = node / gcsSectionCount;
 	mat3 M; vec3 T; vec4 N;
 	gcsSectionBlend( instance * gcsJointStride, gcsJointRow + instance, node - instance * gcsSectionCount, M, T, N );
+	#ifdef GCS_PLACED
+	gcsPlace( instance, M, T, N );
+	#endif
 	gcsNormal = N;
 	gcsRow0 = vec4( M[ 0 ][ 0 ], M[ 1 ][ 0 ], M[ 2 ][ 0 ], T.x );
 	gcsRow1 = vec4( M[ 0 ][ 1 ], M[ 1 ][ 1 ], M[ 2 ][ 1 ], T.y );
@@ -406,17 +424,29 @@ export function checkVariant(path: unknown, method: unknown, slots: unknown, fn:
 }
 
 /**
- * The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots).
+ * The node pass's shaders (GLSL 3: four outputs) for a section table of `slots` joints per section (GpuSections.tableSlots);
+ * `placed`: each instance's placement (texture gcsPlacements, four texels per instance) folded into its nodes.
  * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
  */
-export function nodePassShaders(slots: TableSlots): {
+export function nodePassShaders(slots: TableSlots, placed = false): {
   /** GLSL 3 vertex shader: one triangle covering the target. */
   vertexShader: string;
   /** GLSL 3 fragment shader: one fragment per node, writing the rows of [M | T] and the normal texel to the four node textures. */
   fragmentShader: string;
 } {
   checkSlots(slots, 'nodePassShaders');
-  return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
+  return { vertexShader: NODE_PASS_VERTEX, fragmentShader: `${placed ? `${PLACED}\n` : ''}${tableDefines(slots)}${NODE_PASS_FRAGMENT}` };
+}
+
+/**
+ * The define that folds a crowd's instance placement into the node pass (gcsPlace) and, in the
+ * vertex stage, makes three.js's instancing chunks place nothing: the placement is in the nodes.
+ */
+const PLACED = '#define GCS_PLACED';
+
+/** A patched vertex shader of a crowd whose node pass places its instances: three.js's `instanceMatrix` is the identity there. */
+export function placedInNodes(vertexShader: string): string {
+  return `${PLACED}\n#ifdef USE_INSTANCING\n#define instanceMatrix mat4( 1.0 )\n#endif\n${vertexShader}`;
 }
 
 /** DQS's joint pass shaders (GLSL 3: four outputs): two fragments per joint, its quaternion, dual part and uniform scale, then its scale part K (internal: not an entry's export). */

@@ -19,7 +19,7 @@
  */
 import * as THREE from 'three/webgpu';
 import {
-  abs, bitAnd, bitOr, bool, cross, dot, float, floatBitsToUint, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, shiftLeft, sqrt, step, texture, textureSize, uint, uniform, vec3, vec4,
+  abs, bitAnd, bitOr, bool, cross, dot, float, floatBitsToUint, Fn, If, int, ivec2, mat3, mat4, max, min, mix, mrt, positionGeometry, screenCoordinate, select, shiftLeft, sqrt, step, textureSize, uint, uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, TextureNode } from 'three/webgpu';
 import {
@@ -28,6 +28,7 @@ import {
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import { NodePage, PagedPass, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
 import { compactPoses, type GpuSections } from './sections.js';
+import { storedRow, texelView } from './texel-tsl.js';
 
 type Bool = Node<'bool'>;
 type Float = Node<'float'>;
@@ -49,7 +50,7 @@ export function largest(m: Mat3): Float {
   return max(max(e.x, e.y), e.z);
 }
 
-/** Texel i of a float texture read with integer coordinates (row-major, the texture's width). */
+/** Texel i of a float data texture read with integer coordinates (row-major, the texture's width; a texelView: no row flip). */
 export function texel(tex: TextureNode, i: Int): Vec4 {
   const w = int((textureSize(tex) as unknown as Node<'ivec2'>).x);
   const y = i.div(w);
@@ -208,7 +209,7 @@ function compactReader(joints: TextureNode): { texture: TextureNode; format: Int
   let reader = compactReaders.get(twin);
   if (!reader) {
     const format = twin.format;
-    reader = { texture: texture(twin.texture), format: uniform(format.value, 'int').onObjectUpdate(() => format.value) as unknown as Int };
+    reader = { texture: texelView(twin.texture), format: uniform(format.value, 'int').onObjectUpdate(() => format.value) as unknown as Int };
     compactReaders.set(twin, reader);
   }
   return reader;
@@ -467,6 +468,8 @@ export class TslNodePass extends PagedPass<TslNodePage> {
   readonly quad: THREE.Mesh;
   /** The vertex stage's offset into the page: the pass's first texel (GCS) or first row (DQS). */
   readonly offset = uniform(0, 'int');
+  /** The page's height in rows: where a backend stores render targets upside down, reads flip rows by it (texel-tsl.ts). */
+  readonly pageRows = uniform(1, 'int');
   /** GCS: the joint pass whose parts the node pass reads (drawn first); null for a joint pass. */
   readonly jointPass: TslNodePass | null;
   private readonly material: THREE.NodeMaterial;
@@ -491,8 +494,8 @@ export class TslNodePass extends PagedPass<TslNodePage> {
     const writesJoints = kind === 'joints', stride = sections.transforms.texelsPerInstance;
     const S = this.perInstance, nodes = sections.instanceCount * S;
     // One fragment per texel: its node from the fragment's position in the pass's rows (texels past the last repeat the last node).
-    const joints = texture(sections.texture);
-    const table = writesJoints ? null : texture(sections.table as DataTexture);
+    const joints = texelView(sections.texture);
+    const table = writesJoints ? null : texelView(sections.table as DataTexture);
     this.jointPass = writesJoints ? null : new TslNodePass(sections, 'joints');
     const parts = this.jointPass;
     const texels = Fn(() => {
@@ -507,7 +510,7 @@ export class TslNodePass extends PagedPass<TslNodePage> {
       const instance = texel.div(S).toVar();
       const inputs: PartsInputs = {
         joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride),
-        parts: [0, 1, 2].map((i) => parts!.textureNode(i)), row: parts!.offset.add(instance),
+        parts: [0, 1, 2].map((i) => parts!.textureNode(i)), row: storedRow(parts!.offset.add(instance), parts!.pageRows),
       };
       return nodeTexelsFromParts(inputs, texel.sub(instance.mul(S)));
     })().toVar() as unknown as Mat4;
@@ -523,7 +526,7 @@ export class TslNodePass extends PagedPass<TslNodePage> {
     this.material.side = THREE.DoubleSide;
     this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0]), 3));
     this.quad = new THREE.Mesh(this.geometry, this.material);
-    this.views = OUTPUTS.map(() => texture(EMPTY));
+    this.views = OUTPUTS.map(() => texelView(EMPTY));
   }
 
   /** The page's target this pass draws into (shared with other passes); null before its first draw. */
@@ -543,13 +546,13 @@ export class TslNodePass extends PagedPass<TslNodePage> {
    * it shows this frame's (no motion).
    */
   previousTextureNode(i: number): TextureNode {
-    this.previousViewNodes ??= OUTPUTS.map((_, t) => texture(this.page ? this.page.previousTextures()[t] : EMPTY));
+    this.previousViewNodes ??= OUTPUTS.map((_, t) => texelView(this.page ? this.page.previousTextures()[t] : EMPTY));
     return this.previousViewNodes[i];
   }
 
   /** The vertex stage's views of the previous frame's targets (previousTextureNode), as textureNode gives this frame's. */
-  previousViews(): { textureNode(i: number): TextureNode } {
-    return { textureNode: (i) => this.previousTextureNode(i) };
+  previousViews(): Pick<TslNodePass, 'textureNode' | 'pageRows'> {
+    return { textureNode: (i) => this.previousTextureNode(i), pageRows: this.pageRows };
   }
 
   /**
@@ -570,6 +573,7 @@ export class TslNodePass extends PagedPass<TslNodePage> {
       this.glsl ??= new NodePass(this.sections, true);
       this.show(this.glsl.target!.textures, null);
       this.offset.value = 0;
+      this.pageRows.value = this.glsl.target!.height;
       return this.glsl.render(renderer as unknown as import('three').WebGLRenderer);
     }
     if (noFloatTargets(renderer)) return `this renderer's WebGL2 backend has no ${FLOAT_TARGET_EXTENSION} (float render targets), which the joint-level path's node pass draws into`;
@@ -600,6 +604,7 @@ export class TslNodePass extends PagedPass<TslNodePage> {
     this.pageWidth.value = width;
     this.rect.value.set(-1, 1 - 2 * firstRow / height, 2 * this.columns / width - 1, 1 - 2 * (firstRow + this.rows) / height);
     this.offset.value = this.kind === 'joints' ? firstRow : firstRow * width;
+    this.pageRows.value = height;
     this.show(tslPage.target.textures, this.previousViewNodes ? tslPage.previousTextures() : null);
   }
 

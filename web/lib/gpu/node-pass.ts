@@ -49,15 +49,19 @@ export class NodePass extends PagedPass<NodePage> {
   private readonly material: THREE.ShaderMaterial;
   private readonly geometry = new THREE.BufferGeometry();
   private readonly ownPage: boolean;
+  /** A crowd's placements folded into its nodes: the instance matrices, their texture, and the version it holds. */
+  private readonly placements: { matrices: THREE.BufferAttribute; texture: THREE.DataTexture; version: number } | null;
 
   /**
    * @param sections The GPU sections whose joint poses and section table the pass reads.
    * @param ownPage A page of its own, exactly its rows and columns, instead of a share of the
    * renderer's (gcs-skin/webgpu under WebGLNodesHandler reads it as a texture of one row).
    * @param kind 'joints': the joint pass (GPU DQS's, and what a GCS node pass reads); 'nodes': the node pass (GCS), with its joint pass.
+   * @param placements A crowd's instance matrices (16 floats per instance), folded into each instance's nodes (kind 'nodes'):
+   * its vertex stage, patched with placedInNodes, places nothing. The pass runs again when they change (their `version`).
    * @throws GcsError `INVALID_ARGUMENT` when an argument is not of its kind (a material that is not a three.js material, uniforms or sections that are not objects, an unknown path, method or slot count).
    */
-  constructor(sections: GpuSections, ownPage = false, kind: PassKind = sections?.method === 'dqs' ? 'joints' : 'nodes') {
+  constructor(sections: GpuSections, ownPage = false, kind: PassKind = sections?.method === 'dqs' ? 'joints' : 'nodes', placements: THREE.BufferAttribute | null = null) {
     checkObject(sections, 'sections', 'NodePass');
     checkObject(sections.deformer, 'sections.deformer', 'NodePass');
     super(sections, kind);
@@ -70,9 +74,12 @@ export class NodePass extends PagedPass<NodePage> {
       gcsTable: u.gcsTable!, gcsJointRow: this.jointPass.firstRowUniform,
       gcsJointParts0: this.jointPass.uniforms.gcsNodes0!, gcsJointParts1: this.jointPass.uniforms.gcsNodes1!, gcsJointParts2: this.jointPass.uniforms.gcsNodes2!,
     } : {};
+    if (placements !== null) checkObject(placements, 'placements', 'NodePass');
+    this.placements = placements && !writesJoints ? { matrices: placements, texture: placementTexture(sections.instanceCount), version: -1 } : null;
     this.material = new THREE.ShaderMaterial({
-      ...(writesJoints ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots)),
+      ...(writesJoints ? dqsPassShaders(sections.tableSlots) : nodePassShaders(sections.tableSlots, this.placements !== null)),
       uniforms: {
+        ...(this.placements ? { gcsPlacements: { value: this.placements.texture } } : {}),
         gcsJoints: u.gcsJoints!, gcsCompactJoints: u.gcsCompactJoints ?? { value: null }, gcsCompactPoses: u.gcsCompactPoses ?? { value: 0 }, ...parts,
         gcsNodeCount: { value: sections.instanceCount * S }, gcsSectionCount: { value: S },
         gcsJointStride: u.gcsStride, gcsTargetWidth: { value: PAGE_WIDTH },
@@ -113,6 +120,16 @@ export class NodePass extends PagedPass<NodePage> {
   render(renderer: Renderer): string | null {
     const why = this.jointPass?.render(renderer) ?? (this.ownPage ? null : this.seat(renderer)); // the parts this pass reads, first
     if (why) return why;
+    const p = this.placements;
+    if (p && p.version !== p.matrices.version) {
+      // The instances the texture holds (a longer attribute's rest is not drawn); no allocation.
+      const data = p.texture.image.data as Float32Array, matrices = p.matrices.array as Float32Array;
+      if (matrices.length <= data.length) data.set(matrices);
+      else for (let i = 0; i < data.length; i++) data[i] = matrices[i];
+      p.texture.needsUpdate = true;
+      p.version = p.matrices.version;
+      this.lost();
+    }
     if (this.stale()) this.page!.run(renderer);
     return null;
   }
@@ -135,6 +152,16 @@ export class NodePass extends PagedPass<NodePage> {
     this.leave();
     this.material.dispose();
     this.geometry.dispose();
+    this.placements?.texture.dispose();
     this.jointPass?.dispose();
   }
+}
+
+/** `count` instance matrices as an RGBA32F texture, four texels (columns) per instance, rows of PAGE_WIDTH (a multiple of 4). */
+function placementTexture(count: number): THREE.DataTexture {
+  const width = Math.min(PAGE_WIDTH, 4 * count), height = Math.ceil(4 * count / width);
+  const texture = new THREE.DataTexture(new Float32Array(4 * width * height), width, height, THREE.RGBAFormat, THREE.FloatType);
+  texture.minFilter = texture.magFilter = THREE.NearestFilter;
+  texture.generateMipmaps = false;
+  return texture;
 }

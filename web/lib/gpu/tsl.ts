@@ -14,7 +14,7 @@
  */
 import {
   abs, attribute, bool, cross, dot, float, Fn, If, instanceIndex, int, ivec2, length, mat3, min, normalGeometry, normalLocal,
-  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, texture, textureSize, transformNormal,
+  OnObjectUpdate, positionGeometry, positionLocal, positionPrevious, pow, referenceAttribute, select, step, tangentGeometry, tangentLocal, transformNormal,
   uniform, vec3, vec4,
 } from 'three/tsl';
 import type { DataTexture, Node, NodeBuilder, TextureNode } from 'three/webgpu';
@@ -24,6 +24,8 @@ import {
 } from './layout.js';
 import { column, gcsNormalTexel, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
+import { storedRow, texelView } from './texel-tsl.js';
+import { PAGE_WIDTH } from './node-atlas.js';
 import { checkObject } from '../arguments.js';
 
 type Bool = Node<'bool'>;
@@ -108,15 +110,14 @@ function decodeNode(r0: Vec4, r1: Vec4, r2: Vec4, n: Vec4): Section {
   return { m, t: vec3(r0.w, r1.w, r2.w).toVar(), n: mat3(cross(a1, a2), cross(a2, a0), cross(a0, a1)).mul(n.y).toVar(), renorm: n.w.lessThan(0).toVar() };
 }
 
-/** Where a skin's nodes come from: the node pass's textures (one texel per node and target), this instance's first node. */
-interface NodeInputs { nodes: TextureNode[]; first: Int }
+/** Where a skin's nodes come from: the node pass's textures (one texel per node and target, rows of PAGE_WIDTH), this instance's first node, the page's height. */
+interface NodeInputs { nodes: TextureNode[]; first: Int; pageRows: Int }
 
 /** Node s of this instance, read from the node pass's targets. */
 function passNode(inputs: NodeInputs, s: Int): Section {
   const i = inputs.first.add(s).toVar();
-  const w = int((textureSize(inputs.nodes[0]) as unknown as Node<'ivec2'>).x);
-  const y = i.div(w);
-  const at = ivec2(i.sub(y.mul(w)), y).toVar();
+  const y = i.div(PAGE_WIDTH).toVar();
+  const at = ivec2(i.sub(y.mul(PAGE_WIDTH)), storedRow(y, inputs.pageRows)).toVar();
   const [r0, r1, r2, n] = inputs.nodes.map((t) => t.load(at).toVar());
   return decodeNode(r0, r1, r2, n);
 }
@@ -255,9 +256,10 @@ function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slot
  * per influence the joint's quaternion, dual part and uniform scale as the pass wrote them, the
  * blend; then M = s·R and the normal by R where every joint of the vertex is a uniform scale (the
  * CPU's quaternion-only path: no scale part read), else the scale parts K_j blended, M = R·K and
- * the normal matrix of gcsNormalTexel(K). `row`: this instance's row of the targets.
+ * the normal matrix of gcsNormalTexel(K). `instanceRow`: this instance's row of the targets, in a page `pageRows` high.
  */
-function dqsVertex(nodes: TextureNode[], row: Int, slots: 4 | 8): VertexTransform {
+function dqsVertex(nodes: TextureNode[], instanceRow: Int, pageRows: Int, slots: 4 | 8): VertexTransform {
+  const row = storedRow(instanceRow, pageRows).toVar();
   const lanes = ['x', 'y', 'z', 'w'] as const;
   const ids: Vec4[] = [], weights: Vec4[] = [];
   for (let g = 0; g < slots / 4; g++) {
@@ -316,7 +318,7 @@ export function previousPositionNode(): Node<'vec3'> {
 }
 
 /** What the vertex stage reads of a node pass: this frame's targets (TslNodePass) or the frame before's (its previousViews()). */
-type PassViews = Pick<TslNodePass, 'textureNode'>;
+type PassViews = Pick<TslNodePass, 'textureNode' | 'pageRows'>;
 
 /** The vertex stage's views of the pass's targets. */
 const passTextures = (pass: PassViews): TextureNode[] => Array.from({ length: GPU_NODE_TEXTURES }, (_, i) => pass.textureNode(i));
@@ -328,14 +330,14 @@ const passTextures = (pass: PassViews): TextureNode[] => Array.from({ length: GP
  * poses (`perFrame`, `first` this instance's first joint texel).
  */
 function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: PassViews | null, nodeFirst: Int): VertexTransform {
-  if (sections.method === 'dqs' && pass) return dqsVertex(passTextures(pass), nodeFirst, sections.tableSlots);
+  if (sections.method === 'dqs' && pass) return dqsVertex(passTextures(pass), nodeFirst, pass.pageRows, sections.tableSlots);
   if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
   if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
   if (pass) {
-    const inputs: NodeInputs = { nodes: passTextures(pass), first: nodeFirst };
+    const inputs: NodeInputs = { nodes: passTextures(pass), first: nodeFirst, pageRows: pass.pageRows };
     return jointVertex((s) => passNode(inputs, s), sections.smooth);
   }
-  const inputs: JointInputs = { joints: perFrame, table: texture(sections.table as DataTexture), slots: sections.tableSlots, first };
+  const inputs: JointInputs = { joints: perFrame, table: texelView(sections.table as DataTexture), slots: sections.tableSlots, first };
   return jointVertex((s) => computedNode(inputs, s), sections.smooth);
 }
 
@@ -359,7 +361,7 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
   checkObject(sections, 'sections', 'gcsPositionNode');
   checkObject(sections.uniforms, 'sections.uniforms', 'gcsPositionNode');
   if (pass !== null) checkObject(pass, 'pass', 'gcsPositionNode');
-  const perFrame = texture(sections.texture);
+  const perFrame = texelView(sections.texture);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);
   const strideNode = uniform(stride.value, 'int').onObjectUpdate(() => stride.value);
@@ -379,7 +381,7 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
       if (pass) OnObjectUpdate(({ renderer }) => pass.fillPrevious(renderer));
       const previous = pass ? vertexTransform(sections, perFrame, first, pass.previousViews(), nodeFirst) : (() => {
         OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
-        return vertexTransform(sections, texture(sections.previousTexture()), first, null, nodeFirst);
+        return vertexTransform(sections, texelView(sections.previousTexture()), first, null, nodeFirst);
       })();
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
     }

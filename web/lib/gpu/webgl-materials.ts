@@ -5,7 +5,7 @@
 import * as THREE from 'three';
 import { GcsError } from '../errors.js';
 import { checkMaterial, checkObject } from '../arguments.js';
-import { checkVariant, patchVertexShader } from './glsl.js';
+import { checkVariant, patchVertexShader, placedInNodes } from './glsl.js';
 import type { GpuMaterialKit, GpuMaterials } from './kit.js';
 import type { GpuMethod, GpuPath, TableSlots } from './layout.js';
 import { NodePass } from './node-pass.js';
@@ -92,21 +92,36 @@ function compileError(renderer: unknown, material: THREE.Material): string | nul
   return `${material.type}'s GCS shader did not compile on this WebGLRenderer${log ? ` (${log})` : ''}`;
 }
 
+/** A patched crowd material whose node pass places the instances: its vertex stage leaves three.js's instancing out (placedInNodes). */
+function placeInNodes<M extends THREE.Material>(material: M): M {
+  const patch = material.onBeforeCompile, key = material.customProgramCacheKey();
+  material.onBeforeCompile = (shader, renderer) => {
+    patch.call(material, shader, renderer);
+    shader.vertexShader = placedInNodes(shader.vertexShader);
+  };
+  material.customProgramCacheKey = () => `${key}|placed`;
+  return material;
+}
+
 /** The GLSL kit: what gcs-skin/three and gcs-skin/crowd draw with. */
 export const glslKit: GpuMaterialKit = {
   entry: 'gcs-skin/three',
   methods: new Set(['gcs', 'lbs', 'dqs']),
   support: gpuMaterialSupport,
-  build(source: THREE.Material | THREE.Material[], sections: GpuSections): GpuMaterials {
+  build(source: THREE.Material | THREE.Material[], sections: GpuSections, instances: THREE.InstancedBufferAttribute | null): GpuMaterials {
     const { smooth, path, method, tableSlots } = sections;
+    const nodes = method === 'gcs' && path === 'joints';
     // GCS, joint-level: the node pass turns joint poses into node transforms once per frame; the vertex stage reads those.
+    // A crowd's: with each instance's placement folded in, once per node, not once per vertex.
     // DQS: the same pass, one fragment per joint (its quaternion and scale part, once per frame).
-    const pass = (method === 'gcs' && path === 'joints') || method === 'dqs' ? new NodePass(sections) : null;
+    const placed = nodes && instances !== null;
+    const pass = nodes || method === 'dqs' ? new NodePass(sections, false, undefined, placed ? instances : null) : null;
     const uniforms = pass ? pass.uniforms : sections.uniforms;
-    const patch = (m: THREE.Material) => gcsMaterial(m, uniforms, smooth, path, method, tableSlots);
+    const patch = <M extends THREE.Material>(m: M): M => (placed ? placeInNodes(gcsMaterial(m, uniforms, smooth, path, method, tableSlots)) : gcsMaterial(m, uniforms, smooth, path, method, tableSlots));
     const material = Array.isArray(source) ? source.map(patch) : patch(source);
     if (pass) for (const m of Array.isArray(material) ? material : [material]) m.userData.gcsNodePass = pass; // what its vertex stage reads (tests read the pass back)
-    const shadow = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, method, tableSlots);
+    const shadowMaterials = gcsShadowMaterials(Array.isArray(source) ? source[0] : source, uniforms, smooth, path, method, tableSlots);
+    const shadow = placed ? { depth: placeInNodes(shadowMaterials.depth), distance: placeInNodes(shadowMaterials.distance) } : shadowMaterials;
     if (!pass) return { material, depth: shadow.depth, distance: shadow.distance, compileError };
     return {
       material, depth: shadow.depth, distance: shadow.distance, compileError,
