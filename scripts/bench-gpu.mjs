@@ -30,8 +30,8 @@ const sizes = (arg('size') ? [arg('size')] : ['640x360', '64x36']).map((s) => s.
 const frames = Number(arg('frames', 30));
 const methods = arg('methods');
 const renderers = (arg('renderer') ?? 'webgl,webgpu').split(',');
-// WebGPURenderer: three.js's SkinnedMesh against gcs-skin/webgpu's default, DQS and LBS.
-const webgpuMethods = arg('methods') ?? 'three,gpu,dqs,lbs';
+// WebGPURenderer: three.js's SkinnedMesh against gcs-skin/webgpu's default (GcsCharacter, GcsCrowd), DQS and LBS.
+const webgpuMethods = arg('methods') ?? 'three,gpu,crowd,dqs,lbs';
 
 const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
 if (!existsSync(chromiumPath)) {
