@@ -27,7 +27,7 @@ import {
 } from './layout.js';
 import { FLOAT_TARGET_EXTENSION, NodePass } from './node-pass.js';
 import { NodePage, PagedPass, PAGE_TARGET_OPTIONS, PAGE_WIDTH, type PageMember, type PassKind } from './node-atlas.js';
-import { compactPoses, type GpuSections } from './sections.js';
+import type { GpuSections } from './sections.js';
 import { storedRow, texelView } from './texel-tsl.js';
 
 type Bool = Node<'bool'>;
@@ -180,8 +180,23 @@ const gcsDqsJointTexels = Fn(([pose, second]: [Mat4, Bool]) => {
 
 // ------------------------------------------------------------ accessors (texel reads, per skin)
 
+/**
+ * The joint poses as the maths reads them: the full format's texture, and where the skin has one
+ * (GCS and DQS on path 'joints') the compact twin with the uniform saying the frame is compact (1).
+ */
+export interface PoseViews { joints: TextureNode; compact: { texture: TextureNode; format: Int } | null }
+
+/** This frame's joint poses (`previous`: the frame before's, for velocity) as PoseViews. */
+export function poseViews(sections: GpuSections, previous = false): PoseViews {
+  const joints = texelView(previous ? sections.previousTexture() : sections.texture);
+  const twin = sections.compactPoses(previous);
+  if (!twin) return { joints, compact: null };
+  const format = uniform(twin.format.value, 'int').onObjectUpdate(() => twin.format.value) as unknown as Int;
+  return { joints, compact: { texture: texelView(twin.texture), format } };
+}
+
 /** The node maths' inputs: joint poses (per frame) and the section table (static, `slots` joints per section). */
-export interface JointInputs { joints: TextureNode; table: TextureNode; slots: TableSlots; first: Int }
+export interface JointInputs extends PoseViews { table: TextureNode; slots: TableSlots; first: Int }
 
 /**
  * Joint j's pose as four texels: the rows of S_j (translation in w) and its rotation quaternion.
@@ -191,7 +206,7 @@ export interface JointInputs { joints: TextureNode; table: TextureNode; slots: T
 export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
   const i = inputs.first.add(j.mul(GPU_TEXELS_PER_JOINT)).toVar();
   const full = () => mat4(texel(inputs.joints, i), texel(inputs.joints, i.add(1)), texel(inputs.joints, i.add(2)), texel(inputs.joints, i.add(3)));
-  const compact = compactReader(inputs.joints);
+  const compact = inputs.compact;
   if (!compact) return full();
   const pose = mat4(vec4(0), vec4(0), vec4(0), vec4(0)).toVar();
   If(compact.format.equal(1), () => {
@@ -199,20 +214,6 @@ export function jointPose(inputs: Omit<JointInputs, 'table'>, j: Int): Mat4 {
     pose.assign(gcsCompactPose(texel(compact.texture, first), texel(compact.texture, first.add(1)), g.bitAnd(1).equal(1)));
   }).Else(() => { pose.assign(full()); });
   return pose;
-}
-
-/** The compact twin of a joint-pose texture and its format uniform, as nodes made once per texture. */
-const compactReaders = new WeakMap<object, { texture: TextureNode; format: Int }>();
-function compactReader(joints: TextureNode): { texture: TextureNode; format: Int } | null {
-  const twin = compactPoses.get(joints.value as THREE.Texture);
-  if (!twin) return null;
-  let reader = compactReaders.get(twin);
-  if (!reader) {
-    const format = twin.format;
-    reader = { texture: texelView(twin.texture), format: uniform(format.value, 'int').onObjectUpdate(() => format.value) as unknown as Int };
-    compactReaders.set(twin, reader);
-  }
-  return reader;
 }
 
 /**
@@ -494,7 +495,7 @@ export class TslNodePass extends PagedPass<TslNodePage> {
     const writesJoints = kind === 'joints', stride = sections.transforms.texelsPerInstance;
     const S = this.perInstance, nodes = sections.instanceCount * S;
     // One fragment per texel: its node from the fragment's position in the pass's rows (texels past the last repeat the last node).
-    const joints = texelView(sections.texture);
+    const poses = poseViews(sections);
     const table = writesJoints ? null : texelView(sections.table as DataTexture);
     this.jointPass = writesJoints ? null : new TslNodePass(sections, 'joints');
     const parts = this.jointPass;
@@ -503,13 +504,13 @@ export class TslNodePass extends PagedPass<TslNodePage> {
       const row = at.y.sub(this.firstRow).toVar();
       if (writesJoints) {
         const joint = at.x.div(DQS_TEXELS_PER_JOINT).toVar();
-        const pose = jointPose({ joints, slots: sections.tableSlots, first: row.mul(stride) }, joint);
+        const pose = jointPose({ ...poses, slots: sections.tableSlots, first: row.mul(stride) }, joint);
         return gcsDqsJointTexels(pose, at.x.notEqual(joint.mul(DQS_TEXELS_PER_JOINT)));
       }
       const texel = (min(row.mul(this.pageWidth).add(at.x) as unknown as Float, int(nodes - 1) as unknown as Float) as unknown as Int).toVar();
       const instance = texel.div(S).toVar();
       const inputs: PartsInputs = {
-        joints, table: table!, slots: sections.tableSlots, first: instance.mul(stride),
+        ...poses, table: table!, slots: sections.tableSlots, first: instance.mul(stride),
         parts: [0, 1, 2].map((i) => parts!.textureNode(i)), row: storedRow(parts!.offset.add(instance), parts!.pageRows),
       };
       return nodeTexelsFromParts(inputs, texel.sub(instance.mul(S)));

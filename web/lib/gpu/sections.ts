@@ -124,7 +124,6 @@ export class GpuSections {
       this.compactTexture = floatTexture(t.texels.subarray(0, size.floats), size.width, size.height);
       keepLive(this.compactTexture.image as { data: ArrayBufferView }, 'data', () => (t.disposed ? null : t.texels.subarray(0, size.floats)));
       base = { ...base, gcsCompactJoints: { value: this.compactTexture }, gcsCompactPoses: { value: (t as JointPoses).compactFormat ? 1 : 0 } };
-      compactPoses.set(this.texture, { texture: this.compactTexture, format: base.gcsCompactPoses! });
     }
     this.tableSlots = 4;
     if (skinning) {
@@ -183,9 +182,20 @@ export class GpuSections {
         compactTexture: compact ? floatTexture(shown.subarray(0, floats), compact.width, compact.height) : null,
         compactViews: compact ? new Map([[shown, shown.subarray(0, floats)], [drawn, drawn.subarray(0, floats)]]) : null,
       };
-      if (this.previous.compactTexture) compactPoses.set(texture, { texture: this.previous.compactTexture, format: this.previous.format });
     }
     return this.previous.texture;
+  }
+
+  /**
+   * @internal The compact twin of `texture` (`previous`: of previousTexture()) and the uniform value saying
+   * whether the frame it shows is compact (1) or full (0): what a reader of the joint poses takes
+   * on a compact frame. Null where there is no compact format (LBS, path 'sections').
+   */
+  compactPoses(previous = false): { texture: THREE.DataTexture; format: { value: number } } | null {
+    if (!previous) return this.compactTexture ? { texture: this.compactTexture, format: this.uniforms.gcsCompactPoses! } : null;
+    this.previousTexture();
+    const p = this.previous!;
+    return p.compactTexture ? { texture: p.compactTexture, format: p.format } : null;
   }
 
   /**
@@ -269,13 +279,6 @@ interface PreviousPoses {
   drawnFormat: number;
   compactViews: Map<Float32Array, Float32Array> | null;
 }
-
-/**
- * A per-frame texture of joint poses in the full format → its compact twin and the uniform saying
- * which one a frame wrote (GpuSections.texture and its previousTexture): how a TSL reader of the
- * texture (node-pass-tsl.ts, jointPose) finds the other.
- */
-export const compactPoses = new WeakMap<THREE.Texture, { texture: THREE.DataTexture; format: { value: number } }>();
 
 /**
  * The compact texture's size: instanceCount · J · COMPACT_FLOATS_PER_JOINT floats in RGBA texels,

@@ -22,7 +22,7 @@ import {
   ALMOST_EQUAL_TRACE, ALMOST_EQUAL_TRACE3, BLEND_ATTRIBUTE, BLEND_THIRD_ATTRIBUTE, COLLAPSED, DQS_TEXELS_PER_JOINT, INFLUENCE_ATTRIBUTES, WEIGHT_ATTRIBUTES, GPU_NODE_TEXTURES,
   GPU_TEXELS_PER_SECTION, LENGTH_FIX, NEAR_TRACE, NEAR_TRACE3, PREVIOUS_POSITION_ATTRIBUTE, SECTION_ATTRIBUTE,
 } from './layout.js';
-import { column, gcsNormalTexel, gcsRotation, jointBlend, jointPose, largest, nodeTexels, texel, type JointInputs, type TslNodePass } from './node-pass-tsl.js';
+import { column, gcsNormalTexel, gcsRotation, jointBlend, jointPose, largest, nodeTexels, poseViews, texel, type JointInputs, type PoseViews, type TslNodePass } from './node-pass-tsl.js';
 import type { GpuSections } from './sections.js';
 import { storedRow, texelView } from './texel-tsl.js';
 import { PAGE_WIDTH } from './node-atlas.js';
@@ -221,13 +221,13 @@ const gcsTurnLbs = Fn(([v, m, q]: [Vec3, Mat3, Vec4]) => {
  * no centre, normals as the joint-level path turns an unblended one. (DQS with a joint pass reads
  * its parts instead, dqsVertex; this is a velocity pass's previous frame.)
  */
-function skinVertex(method: 'lbs' | 'dqs', joints: TextureNode, first: Int, slots: 4 | 8): VertexTransform {
+function skinVertex(method: 'lbs' | 'dqs', poses: PoseViews, first: Int, slots: 4 | 8): VertexTransform {
   const ids: Vec4[] = [], weights: Vec4[] = [];
   for (let g = 0; g < slots / 4; g++) {
     ids.push(attribute<'vec4'>(INFLUENCE_ATTRIBUTES[g], 'vec4'));
     weights.push(attribute<'vec4'>(WEIGHT_ATTRIBUTES[g], 'vec4'));
   }
-  const inputs = { joints, first, slots };
+  const inputs = { ...poses, first, slots };
   if (method === 'dqs') {
     const texels = jointBlend(inputs, ids, weights, vec4(0)).toVar();
     const node = decodeNode(column(texels, 0), column(texels, 1), column(texels, 2), column(texels, 3));
@@ -327,17 +327,17 @@ const passTextures = (pass: PassViews): TextureNode[] => Array.from({ length: GP
  * How each vertex moves: path 'sections' from the section transforms; path 'joints' from the node
  * pass's targets (`pass`, `nodeFirst` this instance's first node; DQS's joint pass: its row), or, without one (a velocity
  * pass's previous frame, or a caller that built no pass), from nodes computed here from the joint
- * poses (`perFrame`, `first` this instance's first joint texel).
+ * poses (`poses`, `first` this instance's first joint texel).
  */
-function vertexTransform(sections: GpuSections, perFrame: TextureNode, first: Int, pass: PassViews | null, nodeFirst: Int): VertexTransform {
+function vertexTransform(sections: GpuSections, poses: PoseViews, first: Int, pass: PassViews | null, nodeFirst: Int): VertexTransform {
   if (sections.method === 'dqs' && pass) return dqsVertex(passTextures(pass), nodeFirst, pass.pageRows, sections.tableSlots);
-  if (sections.method !== 'gcs') return skinVertex(sections.method, perFrame, first, sections.tableSlots);
-  if (sections.path !== 'joints') return sectionVertex(perFrame, first, sections.smooth);
+  if (sections.method !== 'gcs') return skinVertex(sections.method, poses, first, sections.tableSlots);
+  if (sections.path !== 'joints') return sectionVertex(poses.joints, first, sections.smooth);
   if (pass) {
     const inputs: NodeInputs = { nodes: passTextures(pass), first: nodeFirst, pageRows: pass.pageRows };
     return jointVertex((s) => passNode(inputs, s), sections.smooth);
   }
-  const inputs: JointInputs = { joints: perFrame, table: texelView(sections.table as DataTexture), slots: sections.tableSlots, first };
+  const inputs: JointInputs = { ...poses, table: texelView(sections.table as DataTexture), slots: sections.tableSlots, first };
   return jointVertex((s) => computedNode(inputs, s), sections.smooth);
 }
 
@@ -361,7 +361,7 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
   checkObject(sections, 'sections', 'gcsPositionNode');
   checkObject(sections.uniforms, 'sections.uniforms', 'gcsPositionNode');
   if (pass !== null) checkObject(pass, 'pass', 'gcsPositionNode');
-  const perFrame = texelView(sections.texture);
+  const poses = poseViews(sections);
   const base = sections.uniforms.gcsBase, stride = sections.uniforms.gcsStride;
   const baseNode = uniform(base.value, 'int').onObjectUpdate(() => base.value);
   const strideNode = uniform(stride.value, 'int').onObjectUpdate(() => stride.value);
@@ -373,15 +373,15 @@ export function gcsPositionNode(sections: GpuSections, instanced: boolean, pass:
     // (The pass's rows start at its offset in the page it shares with the renderer's other passes.)
     const offset = pass ? pass.offset : int(0);
     const nodeFirst = (instanced ? offset.add(int(instanceIndex).mul(perInstance)) : offset).toVar();
-    const vertex = vertexTransform(sections, perFrame, first, pass, nodeFirst);
+    const vertex = vertexTransform(sections, poses, first, pass, nodeFirst);
     const placement = instanced ? referenceAttribute('instanceMatrix', 'mat4') as unknown as Mat4 : null;
     const place = (p: Vec3): Vec3 => (placement ? placement.mul(vec4(p, 1)).xyz : p);
     if (needsPreviousData(builder)) {
       // With a node pass, the previous frame's nodes are its targets of the run before (no per-vertex node maths).
       if (pass) OnObjectUpdate(({ renderer }) => pass.fillPrevious(renderer));
-      const previous = pass ? vertexTransform(sections, perFrame, first, pass.previousViews(), nodeFirst) : (() => {
+      const previous = pass ? vertexTransform(sections, poses, first, pass.previousViews(), nodeFirst) : (() => {
         OnObjectUpdate(({ frameId }) => sections.advanceFrame(frameId));
-        return vertexTransform(sections, texelView(sections.previousTexture()), first, null, nodeFirst);
+        return vertexTransform(sections, poseViews(sections, true), first, null, nodeFirst);
       })();
       positionPrevious.assign(place(previous.position(instanced ? positionGeometry : positionPrevious)));
     }
