@@ -17,7 +17,7 @@ import { checkObject } from '../arguments.js';
 import { dqsPassShaders, nodePassShaders } from './glsl.js';
 import { GPU_NODE_TEXTURES } from './layout.js';
 import { NodePage, PagedPass, PAGE_WIDTH, type PassKind } from './node-atlas.js';
-import type { GcsUniforms, GpuSections } from './sections.js';
+import { floatTexture, type GcsUniforms, type GpuSections } from './sections.js';
 
 /** The extension float render targets need in WebGL2 (RGBA32F colour attachments). */
 export const FLOAT_TARGET_EXTENSION = 'EXT_color_buffer_float';
@@ -160,8 +160,5 @@ export class NodePass extends PagedPass<NodePage> {
 /** `count` instance matrices as an RGBA32F texture, four texels (columns) per instance, rows of PAGE_WIDTH (a multiple of 4). */
 function placementTexture(count: number): THREE.DataTexture {
   const width = Math.min(PAGE_WIDTH, 4 * count), height = Math.ceil(4 * count / width);
-  const texture = new THREE.DataTexture(new Float32Array(4 * width * height), width, height, THREE.RGBAFormat, THREE.FloatType);
-  texture.minFilter = texture.magFilter = THREE.NearestFilter;
-  texture.generateMipmaps = false;
-  return texture;
+  return floatTexture(new Float32Array(4 * width * height), width, height);
 }

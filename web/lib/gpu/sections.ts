@@ -292,7 +292,7 @@ function compactSize(t: PoseTexels, maxWidth: number): { width: number; height: 
 }
 
 /** An RGBA32F texture read with texelFetch (nearest, no mipmaps). */
-function floatTexture(data: Float32Array, width: number, height: number): THREE.DataTexture {
+export function floatTexture(data: Float32Array, width: number, height: number): THREE.DataTexture {
   const texture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
   texture.minFilter = THREE.NearestFilter;
   texture.magFilter = THREE.NearestFilter;
